@@ -1,0 +1,59 @@
+//! Pure pose arithmetic shared by the compiler's constant folder and the interpreter.
+//!
+//! Poses are `[x, y, z, rx, ry, rz]` in the robot's base frame (m, rad) with the orientation
+//! R = Rz(rz)·Ry(ry)·Rx(rx), URDF's fixed-axis roll-pitch-yaw.
+
+/// A pose as stored in six slots: x, y, z (m), rx, ry, rz (rad).
+pub type Pose6 = [f64; 6];
+
+/// The rotation matrix (row-major) of fixed-axis roll-pitch-yaw angles.
+pub fn rpy_to_matrix(rx: f64, ry: f64, rz: f64) -> [[f64; 3]; 3] {
+    let (sr, cr) = rx.sin_cos();
+    let (sp, cp) = ry.sin_cos();
+    let (sy, cy) = rz.sin_cos();
+    [
+        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+        [-sp, cp * sr, cp * cr],
+    ]
+}
+
+/// `offset(p, dx, dy, dz)`: translates the pose along the base frame's axes.
+pub fn offset(p: Pose6, dx: f64, dy: f64, dz: f64) -> Pose6 {
+    [p[0] + dx, p[1] + dy, p[2] + dz, p[3], p[4], p[5]]
+}
+
+/// `tool_offset(p, dx, dy, dz)`: translates the pose along its own (tool) axes.
+pub fn tool_offset(p: Pose6, dx: f64, dy: f64, dz: f64) -> Pose6 {
+    let r = rpy_to_matrix(p[3], p[4], p[5]);
+    [
+        p[0] + r[0][0] * dx + r[0][1] * dy + r[0][2] * dz,
+        p[1] + r[1][0] * dx + r[1][1] * dy + r[1][2] * dz,
+        p[2] + r[2][0] * dx + r[2][1] * dy + r[2][2] * dz,
+        p[3],
+        p[4],
+        p[5],
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn tool_offset_follows_the_tool_z_axis() {
+        // Tool pointing down (rx = 180°): +z in the tool frame is -z in the base frame.
+        let p = [0.45, -0.2, 0.3, PI, 0.0, 0.0];
+        let q = tool_offset(p, 0.0, 0.0, 0.1);
+        assert!((q[2] - 0.2).abs() < 1e-12);
+        assert!((q[0] - 0.45).abs() < 1e-12 && (q[1] + 0.2).abs() < 1e-12);
+    }
+
+    #[test]
+    fn rpy_matches_rz_ry_rx() {
+        let r = rpy_to_matrix(0.0, 0.0, PI / 2.0);
+        // Rz(90°) maps x to y.
+        assert!((r[1][0] - 1.0).abs() < 1e-12 && r[0][0].abs() < 1e-12);
+    }
+}

@@ -1,0 +1,374 @@
+//! The syntax tree of one WSL module, as the parser builds it.
+//!
+//! Every node has a [`Span`] (byte offsets into the source). Nodes that failed to parse are
+//! kept as `Error` variants so later passes can go on and report other problems without
+//! repeating the parse error.
+
+use vworks_vm::Dim;
+
+/// A byte range in the source.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Hash)]
+pub struct Span {
+    /// First byte.
+    pub start: u32,
+    /// One past the last byte.
+    pub end: u32,
+}
+
+impl Span {
+    /// A span from byte offsets (saturating at 4 GiB).
+    pub fn new(start: usize, end: usize) -> Span {
+        Span {
+            start: u32::try_from(start).unwrap_or(u32::MAX),
+            end: u32::try_from(end).unwrap_or(u32::MAX),
+        }
+    }
+    /// The smallest span covering both.
+    pub fn to(self, other: Span) -> Span {
+        Span {
+            start: self.start.min(other.start),
+            end: self.end.max(other.end),
+        }
+    }
+    /// As a `Range<usize>`.
+    pub fn range(self) -> std::ops::Range<usize> {
+        self.start as usize..self.end as usize
+    }
+}
+
+/// A name as written.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Ident {
+    /// The text.
+    pub name: String,
+    /// Where.
+    pub span: Span,
+}
+
+/// A whole file.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct SourceModule {
+    /// Declarations in order.
+    pub items: Vec<Item>,
+}
+
+/// A module-level declaration.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Item {
+    /// `global name = value;`
+    Global(VarDecl),
+    /// `const name = value;`
+    Const(VarDecl),
+    /// `var name = value;`
+    Var(VarDecl),
+    /// `proc` or `func`.
+    Proc(ProcDecl),
+}
+
+/// `var`/`const`/`global` declaration.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VarDecl {
+    /// Name.
+    pub name: Ident,
+    /// Optional `: type`.
+    pub ty: Option<Ident>,
+    /// Optional `= value`.
+    pub init: Option<Expr>,
+    /// The whole declaration.
+    pub span: Span,
+}
+
+/// A `proc` or `func`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProcDecl {
+    /// `func` (returns a value, zero time) rather than `proc`.
+    pub is_func: bool,
+    /// Name.
+    pub name: Ident,
+    /// Parameters.
+    pub params: Vec<Param>,
+    /// `-> type` of a func.
+    pub ret: Option<Ident>,
+    /// Body.
+    pub body: Block,
+    /// From the keyword to the end of the parameter list.
+    pub span: Span,
+}
+
+/// `name: type`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Param {
+    /// Name.
+    pub name: Ident,
+    /// Type name.
+    pub ty: Ident,
+}
+
+/// `{ statements }`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Block {
+    /// Statements.
+    pub stmts: Vec<Stmt>,
+    /// Braces included.
+    pub span: Span,
+}
+
+/// A statement.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stmt {
+    /// What it is.
+    pub kind: StmtKind,
+    /// Where.
+    pub span: Span,
+}
+
+/// The motion commands.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MoveKind {
+    /// `move_j`
+    J,
+    /// `move_l`
+    L,
+    /// `move_c`
+    C,
+}
+
+impl MoveKind {
+    /// The keyword.
+    pub fn keyword(self) -> &'static str {
+        match self {
+            MoveKind::J => "move_j",
+            MoveKind::L => "move_l",
+            MoveKind::C => "move_c",
+        }
+    }
+}
+
+/// What fires a `when` handler.
+#[derive(Clone, Debug, PartialEq)]
+pub enum TriggerExpr {
+    /// `every N cycles`
+    EveryCycles(Expr),
+    /// `every T`
+    Every(Expr),
+    /// `after T`
+    After(Expr),
+    /// `when condition do …`
+    Cond(Expr),
+}
+
+/// Statement kinds.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StmtKind {
+    /// `var x = e;`
+    Var(VarDecl),
+    /// `target = e;` or `target += e;` (`op` is the arithmetic of a compound assignment).
+    Assign {
+        /// A name, `p.x` or `j[i]`.
+        target: Expr,
+        /// `+`, `-`, `*`, `/` for `+=` …
+        op: Option<BinOp>,
+        /// Right-hand side.
+        value: Expr,
+    },
+    /// `name(args);`
+    Call {
+        /// Callee.
+        name: Ident,
+        /// Arguments.
+        args: Vec<Expr>,
+    },
+    /// `if c { } else …`
+    If {
+        /// Condition.
+        cond: Expr,
+        /// Then-branch.
+        then: Block,
+        /// `else if` (an `If` statement) or `else { }` (a `Block` statement).
+        els: Option<Box<Stmt>>,
+    },
+    /// `while c { }`
+    While {
+        /// Condition.
+        cond: Expr,
+        /// Body.
+        body: Block,
+    },
+    /// `for i in a..b { }`
+    For {
+        /// Loop variable.
+        var: Ident,
+        /// Start (inclusive).
+        start: Expr,
+        /// End (exclusive).
+        end: Expr,
+        /// Body.
+        body: Block,
+    },
+    /// `break;`
+    Break,
+    /// `continue;`
+    Continue,
+    /// `return;` or `return e;`
+    Return(Option<Expr>),
+    /// `move_j/move_l/move_c`.
+    Move {
+        /// Which command.
+        kind: MoveKind,
+        /// `via` point of `move_c`.
+        via: Option<Expr>,
+        /// Target.
+        target: Expr,
+        /// `speed e`.
+        speed: Option<Expr>,
+        /// `accel e`.
+        accel: Option<Expr>,
+    },
+    /// `delay t;`
+    Delay(Expr),
+    /// `wait_until c [timeout t];`
+    WaitUntil {
+        /// Condition over globals.
+        cond: Expr,
+        /// Optional timeout.
+        timeout: Option<Expr>,
+    },
+    /// `signal robot.name;`
+    Signal {
+        /// Receiver.
+        robot: Ident,
+        /// Signal name.
+        name: Ident,
+    },
+    /// `wait_signal name [timeout t];`
+    WaitSignal {
+        /// Signal name.
+        name: Ident,
+        /// Optional timeout.
+        timeout: Option<Expr>,
+    },
+    /// `parallel { branches }`
+    Parallel(Vec<Stmt>),
+    /// `remote robot.proc(args);`
+    Remote {
+        /// Robot.
+        robot: Ident,
+        /// Procedure in its module.
+        proc: Ident,
+        /// Arguments.
+        args: Vec<Expr>,
+    },
+    /// `when trigger do handler(args);`
+    When {
+        /// What fires it.
+        trigger: TriggerExpr,
+        /// The procedure to run.
+        handler: Ident,
+        /// Its arguments, evaluated at firing time.
+        args: Vec<Expr>,
+    },
+    /// `disable handler;`
+    Disable(Ident),
+    /// `grip part;`
+    Grip(Ident),
+    /// `release part;`
+    Release(Ident),
+    /// `log a, b, …;`
+    Log(Vec<Expr>),
+    /// `fail a, b, …;`
+    Fail(Vec<Expr>),
+    /// `stop;`
+    Stop,
+    /// `{ … }`
+    Block(Block),
+    /// A statement that did not parse (already reported).
+    Error,
+}
+
+/// Unary operators.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum UnOp {
+    /// `-`
+    Neg,
+    /// `not` / `!`
+    Not,
+}
+
+/// Binary operators.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub enum BinOp {
+    Add,
+    Sub,
+    Mul,
+    Div,
+    Mod,
+    Eq,
+    Ne,
+    Lt,
+    Le,
+    Gt,
+    Ge,
+    And,
+    Or,
+}
+
+impl BinOp {
+    /// The operator as written.
+    pub fn symbol(self) -> &'static str {
+        use BinOp::*;
+        match self {
+            Add => "+",
+            Sub => "-",
+            Mul => "*",
+            Div => "/",
+            Mod => "mod",
+            Eq => "==",
+            Ne => "!=",
+            Lt => "<",
+            Le => "<=",
+            Gt => ">",
+            Ge => ">=",
+            And => "and",
+            Or => "or",
+        }
+    }
+}
+
+/// An expression.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Expr {
+    /// What it is.
+    pub kind: ExprKind,
+    /// Where.
+    pub span: Span,
+}
+
+/// Expression kinds.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ExprKind {
+    /// `42`
+    Int(i64),
+    /// `3.5`
+    Num(f64),
+    /// `250mm/s`, in SI.
+    Quantity(f64, Dim),
+    /// `true`/`false`
+    Bool(bool),
+    /// `"text"`
+    Str(String),
+    /// A name.
+    Name(String),
+    /// `-e`, `not e`
+    Unary(UnOp, Box<Expr>),
+    /// `a op b`
+    Binary(BinOp, Box<Expr>, Box<Expr>),
+    /// `f(args)`
+    Call(Ident, Vec<Expr>),
+    /// `e.field`
+    Field(Box<Expr>, Ident),
+    /// `e[i]`
+    Index(Box<Expr>, Box<Expr>),
+    /// Did not parse (already reported).
+    Error,
+}
