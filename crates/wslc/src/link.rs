@@ -344,9 +344,9 @@ pub fn link(cell: &CellSpec<'_>) -> Result<Linked, LinkError> {
                     diags.push(at(
                         m,
                         Code::E0105,
-                        format!("value {} of joints(…) is {got}, but axis {i} of robot `{}` needs {want}", i + 1, r.name),
+                        format!("the value for axis {i} is {got}, but axis {i} of robot `{}` needs {want}", r.name),
                         site.pos,
-                    ));
+                    ).with_help("revolute axes take angles (30deg), linear axes lengths (500mm)"));
                 }
             }
         }

@@ -1,0 +1,212 @@
+//! Data-driven golden tests, in the style of rust-analyzer's and ruff's fixtures.
+//!
+//! - `test_data/ok/NAME.wsl` must compile; its disassembly (with the source beside it) is
+//!   compared with `NAME.disasm`, and its `.wslb` encoding must decode to the same module.
+//! - `test_data/err/NAME.wsl` must fail (or warn); the rendered diagnostics are compared
+//!   with `NAME.stderr`. Each file's first line says which code it is about
+//!   (`// E0021: …`) and that code must be among its diagnostics.
+//! - `test_data/link/NAME/` holds modules and a `cell.txt`; the link diagnostics are
+//!   compared with `expected.txt`.
+//!
+//! Together the `err` and `link` cases must exercise every diagnostic code.
+//! Run with `UPDATE_EXPECT=1` to (re)write the expected files after a deliberate change.
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+
+use expect_test::expect_file;
+use vworks_vm::Module;
+use vworks_vm::bytecode::disassemble;
+use vworks_wslc::link::{CellSpec, RobotSpec, link};
+use vworks_wslc::{Code, Sources, compile, render};
+
+fn dir(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("test_data")
+        .join(name)
+}
+
+fn files(name: &str, ext: &str) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir(name))
+        .unwrap_or_else(|e| panic!("{name}: {e}"))
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == ext))
+        .collect();
+    v.sort();
+    v
+}
+
+fn read(p: &Path) -> String {
+    std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+fn rel(p: &Path) -> String {
+    format!(
+        "{}/{}",
+        p.parent()
+            .and_then(|d| d.file_name())
+            .unwrap_or_default()
+            .to_string_lossy(),
+        p.file_name().unwrap_or_default().to_string_lossy()
+    )
+}
+
+#[test]
+fn ok_programs_compile_to_the_expected_bytecode() {
+    let all = files("ok", "wsl");
+    assert!(all.len() >= 8, "the ok/ corpus is too small");
+    for p in all {
+        let src = read(&p);
+        let name = rel(&p);
+        let out = compile(&name, &src).unwrap_or_else(|e| {
+            let mut s = Sources::new();
+            s.add(&name, &src);
+            panic!(
+                "{name} should compile:\n{}",
+                render(&e.diagnostics, &s, false)
+            )
+        });
+        assert!(
+            out.warnings.is_empty(),
+            "{name} has warnings: {:?}",
+            out.warnings
+        );
+        let listing = disassemble(&out.module, Some(&src));
+        expect_file![p.with_extension("disasm")].assert_eq(&listing);
+        // The binary form round-trips exactly.
+        let back = Module::decode(&out.module.encode()).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(back, out.module, "{name}: encode/decode changed the module");
+    }
+}
+
+fn code_of_header(src: &str, name: &str) -> String {
+    let first = src.lines().next().unwrap_or("");
+    let code = first
+        .trim_start_matches("//")
+        .trim()
+        .split(':')
+        .next()
+        .unwrap_or("")
+        .trim()
+        .to_string();
+    assert!(
+        code.len() == 5 && (code.starts_with('E') || code.starts_with('W')),
+        "{name}: the first line must be `// E0000: what this tests`"
+    );
+    code
+}
+
+#[test]
+fn bad_programs_give_the_expected_diagnostics() {
+    let mut covered = BTreeSet::new();
+    for p in files("err", "wsl") {
+        let src = read(&p);
+        let name = rel(&p);
+        let want = code_of_header(&src, &name);
+        let diags = match compile(&name, &src) {
+            Ok(out) => out.warnings,
+            Err(e) => e.diagnostics,
+        };
+        assert!(!diags.is_empty(), "{name} should give diagnostics");
+        let codes: BTreeSet<&str> = diags.iter().map(|d| d.code.as_str()).collect();
+        assert!(
+            codes.contains(want.as_str()),
+            "{name} is about {want} but gave {codes:?}"
+        );
+        covered.extend(codes.iter().map(|c| c.to_string()));
+        let mut s = Sources::new();
+        s.add(&name, &src);
+        expect_file![p.with_extension("stderr")].assert_eq(&render(&diags, &s, false));
+    }
+    covered.extend(link_cases());
+    let missing: Vec<&str> = Code::ALL
+        .iter()
+        .map(|c| c.as_str())
+        .filter(|c| *c != "E0900" && !covered.contains(*c))
+        .collect();
+    assert!(missing.is_empty(), "no golden test gives {missing:?}");
+}
+
+/// Runs every link case; returns the codes they gave.
+fn link_cases() -> BTreeSet<String> {
+    let mut covered = BTreeSet::new();
+    let mut cases: Vec<PathBuf> = std::fs::read_dir(dir("link"))
+        .unwrap_or_else(|e| panic!("link: {e}"))
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.is_dir())
+        .collect();
+    cases.sort();
+    for case in cases {
+        let cell_txt = read(&case.join("cell.txt"));
+        let case_name = case
+            .file_name()
+            .unwrap_or_default()
+            .to_string_lossy()
+            .to_string();
+        let mut sources = Sources::new();
+        let mut modules: Vec<(String, Module)> = Vec::new();
+        let mut robots = Vec::new();
+        let mut parts = Vec::new();
+        for line in cell_txt
+            .lines()
+            .filter(|l| !l.trim().is_empty() && !l.starts_with('#'))
+        {
+            let w: Vec<&str> = line.split_whitespace().collect();
+            match w[0] {
+                "robot" => {
+                    let file = w[2].to_string();
+                    if !modules.iter().any(|(f, _)| *f == file) {
+                        let name = format!("{case_name}/{file}");
+                        let src = read(&case.join(&file));
+                        sources.add(&name, &src);
+                        let m = compile(&name, &src)
+                            .unwrap_or_else(|e| panic!("{name}: {e}"))
+                            .module;
+                        modules.push((file.clone(), m));
+                    }
+                    let axes: usize = w[3].parse().unwrap_or_else(|_| panic!("{case_name}: axes"));
+                    let linear = w
+                        .iter()
+                        .find_map(|x| x.strip_prefix("linear="))
+                        .map_or(0, |x| x.parse().unwrap_or(0));
+                    let entry = w.iter().find_map(|x| x.strip_prefix("entry="));
+                    robots.push((
+                        w[1].to_string(),
+                        file,
+                        axes,
+                        linear,
+                        entry.map(str::to_string),
+                        w.contains(&"serve_only"),
+                    ));
+                }
+                "part" => parts.push(w[1].to_string()),
+                other => panic!("{case_name}/cell.txt: unknown line kind {other}"),
+            }
+        }
+        let cell = CellSpec {
+            robots: robots
+                .iter()
+                .map(|(n, f, axes, linear, entry, serve)| RobotSpec {
+                    name: n,
+                    module: &modules
+                        .iter()
+                        .find(|(mf, _)| mf == f)
+                        .unwrap_or_else(|| panic!("{case_name}: module {f}"))
+                        .1,
+                    axes: *axes,
+                    linear_axes: *linear,
+                    entry: entry.as_deref(),
+                    serve_only: *serve,
+                })
+                .collect(),
+            parts: parts.iter().map(String::as_str).collect(),
+        };
+        let diags = match link(&cell) {
+            Ok(l) => l.warnings,
+            Err(e) => e.diagnostics,
+        };
+        covered.extend(diags.iter().map(|d| d.code.as_str().to_string()));
+        expect_file![case.join("expected.txt")].assert_eq(&render(&diags, &sources, false));
+    }
+    covered
+}
