@@ -1,0 +1,123 @@
+//! The `vworks` binary as a user runs it: exit codes, messages, files written.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn vworks(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_vworks"))
+        .args(args)
+        .env("NO_COLOR", "1")
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run vworks: {e}"))
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("vworks-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap_or_else(|e| panic!("{e}"));
+    d
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+const THREE_ERRORS: &str = "global parts = 0;
+proc main() {
+    delay 2;
+    parts = prats + 1;
+    var a = 90deg + 10mm;
+}
+";
+
+#[test]
+fn check_prints_every_error_and_exits_1() {
+    let d = temp_dir("check");
+    let f = d.join("three.wsl");
+    std::fs::write(&f, THREE_ERRORS).unwrap_or_else(|e| panic!("{e}"));
+    let out = vworks(&["check", f.to_str().unwrap_or_default()]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = text(&out.stderr);
+    for code in ["error[E0021]", "error[E0010]"] {
+        assert!(err.contains(code), "{err}");
+    }
+    assert_eq!(err.matches("error[").count(), 3, "{err}");
+    assert!(err.contains("three.wsl:3:11"), "{err}");
+    assert!(err.contains("help: write 2s"), "{err}");
+    assert!(err.contains("3 errors"), "{err}");
+}
+
+#[test]
+fn check_accepts_good_files_and_several_at_once() {
+    let d = temp_dir("good");
+    let a = d.join("a.wsl");
+    let b = d.join("b.wsl");
+    std::fs::write(&a, "proc main() { delay 1s; }\n").unwrap_or_else(|e| panic!("{e}"));
+    std::fs::write(&b, "global g = 0;\nproc main() { g = 1; }\n").unwrap_or_else(|e| panic!("{e}"));
+    let out = vworks(&[
+        "check",
+        a.to_str().unwrap_or_default(),
+        b.to_str().unwrap_or_default(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert!(text(&out.stderr).contains("checked 2 files: 0 errors, 0 warnings"));
+}
+
+#[test]
+fn build_then_disasm_shows_source_beside_code() {
+    let d = temp_dir("build");
+    let f = d.join("r1.wsl");
+    std::fs::write(
+        &f,
+        "global parts = 0;\nproc main() {\n    parts = parts + 1;\n}\n",
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let wslb = d.join("r1.wslb");
+    let out = vworks(&[
+        "build",
+        f.to_str().unwrap_or_default(),
+        "-o",
+        wslb.to_str().unwrap_or_default(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert!(wslb.exists());
+    let out = vworks(&["disasm", wslb.to_str().unwrap_or_default()]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let listing = text(&out.stdout);
+    assert!(listing.contains("StoreGlobal   g0 (parts)"), "{listing}");
+    assert!(listing.contains("| parts = parts + 1;"), "{listing}");
+    // A .wsl file is compiled and listed directly.
+    let out = vworks(&["disasm", f.to_str().unwrap_or_default()]);
+    assert_eq!(text(&out.stdout), listing);
+}
+
+#[test]
+fn bad_inputs_are_errors_with_the_file_named() {
+    let d = temp_dir("bad");
+    let missing = d.join("missing.wsl");
+    let out = vworks(&["check", missing.to_str().unwrap_or_default()]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        text(&out.stderr).contains("cannot read"),
+        "{}",
+        text(&out.stderr)
+    );
+    assert!(text(&out.stderr).contains("missing.wsl"));
+
+    let corrupt = d.join("corrupt.wslb");
+    std::fs::write(&corrupt, b"WSLB\x01\x00\x00\x00garbage").unwrap_or_else(|e| panic!("{e}"));
+    let out = vworks(&["disasm", corrupt.to_str().unwrap_or_default()]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = text(&out.stderr);
+    assert!(
+        err.contains("corrupt.wslb") && err.contains("malformed bytecode"),
+        "{err}"
+    );
+
+    let bad = d.join("bad.wsl");
+    std::fs::write(&bad, "proc main() { move_j; }").unwrap_or_else(|e| panic!("{e}"));
+    let out = vworks(&["build", bad.to_str().unwrap_or_default()]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out.stderr).contains("not built"));
+    assert!(!d.join("bad.wslb").exists());
+}
