@@ -278,6 +278,16 @@ impl ConstValue {
         }
     }
 
+    /// True when every number in the value is finite (no NaN or infinity).
+    pub fn is_finite(&self) -> bool {
+        match self {
+            ConstValue::Bool(_) | ConstValue::Int(_) => true,
+            ConstValue::Num(x) => x.is_finite(),
+            ConstValue::Joints(v) => v.iter().all(|x| x.is_finite()),
+            ConstValue::Pose(p) => p.iter().all(|x| x.is_finite()),
+        }
+    }
+
     /// Writes the value into run-time slots (`out.len()` must be the type's width).
     /// Joint vectors are zero-padded to [`MAX_AXES`].
     pub fn write_slots(&self, out: &mut [u64]) {

@@ -2154,6 +2154,17 @@ impl Compiler<'_> {
     fn expr(&mut self, e: &Expr) -> Out {
         let start = self.here();
         let out = self.expr_inner(e);
+        if out.k.as_ref().is_some_and(|k| !k.is_finite()) {
+            self.err(
+                Diagnostic::error(
+                    Code::E0026,
+                    "this constant is too large to be a number",
+                    e.span,
+                )
+                .with_help("numbers must stay below about 1.8e308 in magnitude"),
+            );
+            return Out::err();
+        }
         if let Some(k) = &out.k
             && self.here() > start + 1
         {

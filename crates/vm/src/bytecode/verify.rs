@@ -4,7 +4,8 @@
 //! local, module-variable, global and constant access is inside its area; every jump lands
 //! inside its procedure; no procedure falls off its end; and the operand-stack height is
 //! the same on every path into each instruction, never negative, zero at `Ret` and exactly
-//! the return width at `RetVal`. Functions and conditions (zero-time code) call only
+//! the return width at `RetVal`. Every number in constants, initial values and `PushNum`
+//! is finite. Functions and conditions (zero-time code) call only
 //! functions and contain no scheduling events. Each procedure's `max_stack` is filled in.
 
 use super::instr::Instr;
@@ -36,13 +37,13 @@ impl Module {
             if let Some(n) = c.name {
                 s(n, &format!("constant {i}"))?;
             }
-            if !c.value.fits(c.ty) {
-                return Err(bad(format!("constant {i} does not hold a {}", c.ty)));
+            if !c.value.fits(c.ty) || !c.value.is_finite() {
+                return Err(bad(format!("constant {i} does not hold a finite {}", c.ty)));
             }
         }
         for (i, g) in self.globals.iter().enumerate() {
             s(g.name, &format!("global {i}"))?;
-            if !g.ty.is_scalar() || !g.init.fits(g.ty) {
+            if !g.ty.is_scalar() || !g.init.fits(g.ty) || !g.init.is_finite() {
                 return Err(bad(format!(
                     "global {i} has type {} or a value of another type",
                     g.ty
@@ -56,7 +57,7 @@ impl Module {
                     "module variable {i} lies outside the variable area"
                 )));
             }
-            if !v.init.fits(v.ty) {
+            if !v.init.fits(v.ty) || !v.init.is_finite() {
                 return Err(bad(format!(
                     "module variable {i} has an initial value of another type"
                 )));
@@ -233,6 +234,7 @@ impl Module {
                 Instr::PushConst(k) => (k as usize) < self.consts.len(),
                 Instr::MakeJoints(c) => c >= 1 && c as usize <= MAX_AXES,
                 Instr::PoseGet(f) => f < 6,
+                Instr::PushNum(x) => x.is_finite(),
                 Instr::Call(t) => match self.procs.get(t as usize) {
                     Some(c) if zero_time => c.kind == ProcKind::Func,
                     Some(c) => matches!(c.kind, ProcKind::Proc | ProcKind::Func),

@@ -1,0 +1,184 @@
+//! The verifier rejects each kind of unsafe module, and accepts a minimal good one.
+//! Modules are built by hand here, so these tests do not depend on the compiler.
+
+use vworks_vm::bytecode::ConstInfo;
+use vworks_vm::bytecode::{Instr, LoadError, ProcInfo, ProcKind, SrcPos};
+use vworks_vm::{ConstValue, Module, Type};
+
+fn module(code: Vec<Instr>, kind: ProcKind, ret: Option<Type>, frame: u32) -> Module {
+    Module {
+        source_path: "hand.wsl".into(),
+        strings: vec!["p".into()],
+        procs: vec![ProcInfo {
+            name: 0,
+            kind,
+            params: vec![],
+            ret,
+            frame_slots: frame,
+            code_start: 0,
+            code_len: code.len() as u32,
+            pos: SrcPos { line: 1, col: 1 },
+            max_stack: 0,
+        }],
+        code,
+        ..Module::default()
+    }
+}
+
+fn rejects(mut m: Module, needle: &str) {
+    match m.verify() {
+        Err(LoadError::Invalid(msg)) => {
+            assert!(msg.contains(needle), "expected {needle:?} in {msg:?}")
+        }
+        other => panic!("expected rejection containing {needle:?}, got {other:?}"),
+    }
+}
+
+#[test]
+fn a_good_module_verifies_and_gets_its_stack_depth() {
+    let mut m = module(
+        vec![
+            Instr::PushInt(1),
+            Instr::PushInt(2),
+            Instr::AddI,
+            Instr::StoreLocal(0),
+            Instr::Ret,
+        ],
+        ProcKind::Proc,
+        None,
+        1,
+    );
+    m.verify().unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(m.procs[0].max_stack, 2);
+    // And survives the binary round trip.
+    assert_eq!(Module::decode(&m.encode()), Ok(m));
+}
+
+#[test]
+fn stack_underflow() {
+    rejects(
+        module(vec![Instr::AddI, Instr::Ret], ProcKind::Proc, None, 0),
+        "pops 2 slots but the stack holds 0",
+    );
+}
+
+#[test]
+fn inconsistent_heights_at_a_join() {
+    // One path pushes a value before reaching instruction 3, the other does not.
+    // Instruction 3 is reached with height 0 and with height 1; whichever path the
+    // verifier walks first, the module is rejected there.
+    let code = vec![
+        Instr::PushBool(true),
+        Instr::JumpIfFalse(3),
+        Instr::PushInt(1),
+        Instr::Nop,
+        Instr::Ret,
+    ];
+    rejects(module(code, ProcKind::Proc, None, 0), "instruction 3");
+}
+
+#[test]
+fn jump_outside_the_procedure() {
+    rejects(
+        module(vec![Instr::Jump(7), Instr::Ret], ProcKind::Proc, None, 0),
+        "outside the procedure",
+    );
+}
+
+#[test]
+fn falling_off_the_end() {
+    rejects(
+        module(
+            vec![Instr::PushInt(1), Instr::Pop(1)],
+            ProcKind::Proc,
+            None,
+            0,
+        ),
+        "falls off the end",
+    );
+}
+
+#[test]
+fn local_outside_the_frame() {
+    rejects(
+        module(
+            vec![Instr::LoadLocal(3), Instr::Pop(1), Instr::Ret],
+            ProcKind::Proc,
+            None,
+            2,
+        ),
+        "operand out of range",
+    );
+}
+
+#[test]
+fn events_in_zero_time_code() {
+    let code = vec![
+        Instr::PushNum(1.0),
+        Instr::Delay,
+        Instr::PushBool(true),
+        Instr::RetVal,
+    ];
+    rejects(
+        module(code, ProcKind::Func, Some(Type::Bool), 0),
+        "not allowed in a zero-time func",
+    );
+}
+
+#[test]
+fn returning_with_values_left() {
+    rejects(
+        module(vec![Instr::PushInt(1), Instr::Ret], ProcKind::Proc, None, 0),
+        "returns with 1 slots left",
+    );
+}
+
+#[test]
+fn non_finite_numbers() {
+    rejects(
+        module(
+            vec![Instr::PushNum(f64::NAN), Instr::Pop(1), Instr::Ret],
+            ProcKind::Proc,
+            None,
+            0,
+        ),
+        "PushNum",
+    );
+    let mut m = module(vec![Instr::Ret], ProcKind::Proc, None, 0);
+    m.consts.push(ConstInfo {
+        name: None,
+        ty: Type::Pose,
+        value: ConstValue::Pose([0.0, f64::INFINITY, 0.0, 0.0, 0.0, 0.0]),
+        pos: SrcPos::default(),
+    });
+    rejects(m, "finite");
+}
+
+#[test]
+fn string_index_out_of_range() {
+    let mut m = module(vec![Instr::Ret], ProcKind::Proc, None, 0);
+    m.procs[0].name = 9;
+    rejects(m, "names string 9");
+}
+
+#[test]
+fn truncated_and_foreign_files_are_load_errors() {
+    let m = module(vec![Instr::Ret], ProcKind::Proc, None, 0);
+    let bytes = m.encode();
+    assert_eq!(
+        Module::decode(&bytes[..bytes.len() - 3])
+            .err()
+            .map(|e| matches!(e, LoadError::Malformed { .. })),
+        Some(true)
+    );
+    let mut v = bytes.clone();
+    v[4] = 9;
+    assert_eq!(
+        Module::decode(&v),
+        Err(LoadError::Version {
+            found: 9,
+            supported: 1
+        })
+    );
+    assert_eq!(Module::decode(b"\x7fELF"), Err(LoadError::BadMagic));
+}
