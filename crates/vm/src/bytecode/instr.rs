@@ -465,3 +465,25 @@ impl Instr {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::Instr;
+
+    #[test]
+    fn docs_list_every_instruction() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/bytecode.md");
+        let doc = std::fs::read_to_string(path).unwrap_or_default();
+        assert!(!doc.is_empty(), "docs/bytecode.md is missing");
+        let rows: Vec<&str> = doc
+            .lines()
+            .filter(|l| l.starts_with("| `0x"))
+            .filter_map(|l| l.split('`').nth(3))
+            .collect();
+        assert_eq!(
+            rows,
+            Instr::NAMES,
+            "docs/bytecode.md must list every instruction, in opcode order"
+        );
+    }
+}
