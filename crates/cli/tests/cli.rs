@@ -1,5 +1,7 @@
 //! The `vworks` binary as a user runs it: exit codes, messages, files written.
 
+#![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)] // tests fail by panicking
+
 use std::path::PathBuf;
 use std::process::{Command, Output};
 

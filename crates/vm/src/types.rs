@@ -54,7 +54,7 @@ impl Dim {
     }
 
     /// The dimension of a product, or `None` if an exponent overflows.
-    pub fn mul(self, o: Dim) -> Option<Dim> {
+    pub fn times(self, o: Dim) -> Option<Dim> {
         Some(Dim::new(
             self.length.checked_add(o.length)?,
             self.angle.checked_add(o.angle)?,
@@ -63,7 +63,7 @@ impl Dim {
     }
 
     /// The dimension of a quotient, or `None` if an exponent overflows.
-    pub fn div(self, o: Dim) -> Option<Dim> {
+    pub fn per(self, o: Dim) -> Option<Dim> {
         Some(Dim::new(
             self.length.checked_sub(o.length)?,
             self.angle.checked_sub(o.angle)?,
@@ -360,10 +360,10 @@ mod tests {
 
     #[test]
     fn dimension_algebra() {
-        assert_eq!(Dim::LENGTH.div(Dim::TIME), Some(Dim::SPEED));
-        assert_eq!(Dim::SPEED.div(Dim::TIME), Some(Dim::ACCEL));
+        assert_eq!(Dim::LENGTH.per(Dim::TIME), Some(Dim::SPEED));
+        assert_eq!(Dim::SPEED.per(Dim::TIME), Some(Dim::ACCEL));
         assert_eq!(
-            Dim::LENGTH.mul(Dim::LENGTH).and_then(Dim::sqrt),
+            Dim::LENGTH.times(Dim::LENGTH).and_then(Dim::sqrt),
             Some(Dim::LENGTH)
         );
         assert_eq!(Dim::LENGTH.sqrt(), None);

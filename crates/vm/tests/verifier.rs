@@ -1,6 +1,8 @@
 //! The verifier rejects each kind of unsafe module, and accepts a minimal good one.
 //! Modules are built by hand here, so these tests do not depend on the compiler.
 
+#![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)] // tests fail by panicking
+
 use vworks_vm::bytecode::ConstInfo;
 use vworks_vm::bytecode::{Instr, LoadError, ProcInfo, ProcKind, SrcPos};
 use vworks_vm::{ConstValue, Module, Type};

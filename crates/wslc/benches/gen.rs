@@ -1,7 +1,8 @@
-/// Generates a realistic WSL module of about `lines` lines for the compile benchmark:
-/// constants, globals, functions with arithmetic in units, and procedures with motion,
-/// loops, branches, waits, handlers and parallel work.
+// Generates a realistic WSL module for the compile benchmark (included by the bench and
+// by tests/bench_input.rs).
 
+/// A module of about `lines` lines: constants, globals, functions with arithmetic in
+/// units, and procedures with motion, loops, branches, waits and handlers.
 pub fn program(lines: usize) -> String {
     let mut s = String::with_capacity(lines * 40);
     s.push_str("global parts = 0;\nglobal station_free = true;\nglobal load = 0mm;\n");

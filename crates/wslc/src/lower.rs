@@ -110,8 +110,7 @@ impl Out {
         }
     }
     fn is_zero_literal(&self) -> bool {
-        self.bare && matches!(self.k, Some(ConstValue::Int(0)))
-            || self.bare && matches!(self.k, Some(ConstValue::Num(x)) if x == 0.0)
+        self.bare && matches!(self.k, Some(ConstValue::Int(0) | ConstValue::Num(0.0)))
     }
 }
 
@@ -240,6 +239,9 @@ pub(crate) fn lower(
     c.m
 }
 
+/// A finished procedure's instructions and its (pc, position) rows.
+type ProcCode = (Vec<Instr>, Vec<(u32, SrcPos)>);
+
 struct Compiler<'d> {
     index: LineIndex,
     diags: &'d mut Vec<Diagnostic>,
@@ -248,7 +250,8 @@ struct Compiler<'d> {
     symbols: HashMap<String, (Sym, Span)>,
     sigs: Vec<Sig>,
     facts: Vec<Facts>,
-    proc_code: Vec<(Vec<Instr>, Vec<(u32, SrcPos)>)>,
+    /// Code and line rows (procedure-relative) of each procedure, by index.
+    proc_code: Vec<ProcCode>,
     fns: Vec<FnCtx>,
     pending_conds: Vec<PendingCond>,
     pending_handlers: Vec<PendingHandler>,
@@ -2637,7 +2640,7 @@ impl Compiler<'_> {
                 }
             }
             (Mul | Div, Ty::Num(a), Ty::Num(b)) => {
-                let d = if op == Mul { a.mul(b) } else { a.div(b) };
+                let d = if op == Mul { a.times(b) } else { a.per(b) };
                 let Some(d) = d else {
                     return mismatch(
                         self,

@@ -1,5 +1,7 @@
 //! The compile benchmark's generated program is valid and as large as claimed.
 
+#![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)] // tests fail by panicking
+
 mod generator {
     include!("../benches/gen.rs");
 }

@@ -11,6 +11,8 @@
 //! Together the `err` and `link` cases must exercise every diagnostic code.
 //! Run with `UPDATE_EXPECT=1` to (re)write the expected files after a deliberate change.
 
+#![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)] // tests fail by panicking
+
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 

@@ -10,6 +10,8 @@
 //! return an error or a module that verifies, never panic. The long-running versions of
 //! both are the cargo-fuzz targets in `fuzz/`.
 
+#![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)] // tests fail by panicking
+
 use std::path::PathBuf;
 
 use vworks_vm::Module;

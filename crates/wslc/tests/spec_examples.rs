@@ -7,6 +7,8 @@
 //! is compiled in a procedure that declares the names it uses, and the line
 //! `break; continue; return; return e;` is split so each statement sits where it is legal.
 
+#![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)] // tests fail by panicking
+
 use std::path::PathBuf;
 
 use vworks_wslc::link::{CellSpec, RobotSpec, link};

@@ -1,0 +1,65 @@
+//! The programs of the bundled workcells compile without warnings and link as a cell.
+
+#![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)] // tests fail by panicking
+
+use std::path::PathBuf;
+
+use vworks_wslc::link::{CellSpec, RobotSpec, link};
+use vworks_wslc::{Sources, compile, render};
+
+fn compile_file(path: &PathBuf) -> vworks_vm::Module {
+    let src = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let name = path.display().to_string();
+    match compile(&name, &src) {
+        Ok(out) => {
+            assert!(out.warnings.is_empty(), "{name}: {:?}", out.warnings);
+            out.module
+        }
+        Err(e) => {
+            let mut s = Sources::new();
+            s.add(&name, &src);
+            panic!("{}", render(&e.diagnostics, &s, false))
+        }
+    }
+}
+
+#[test]
+fn handoff_programs_compile_and_link() {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../workcells/handoff");
+    let r1 = compile_file(&dir.join("r1.wsl"));
+    let r2 = compile_file(&dir.join("r2.wsl"));
+    let cell = CellSpec {
+        robots: vec![
+            RobotSpec {
+                name: "r1",
+                module: &r1,
+                axes: 6,
+                linear_axes: 0,
+                entry: None,
+                serve_only: false,
+            },
+            RobotSpec {
+                name: "r2",
+                module: &r2,
+                axes: 6,
+                linear_axes: 0,
+                entry: None,
+                serve_only: false,
+            },
+        ],
+        parts: vec!["part1"],
+    };
+    let linked = link(&cell).unwrap_or_else(|e| panic!("{e}"));
+    assert!(linked.warnings.is_empty(), "{:?}", linked.warnings);
+    let names: Vec<&str> = linked.globals.iter().map(|g| g.name.as_str()).collect();
+    assert_eq!(names, ["handed", "station_free"]);
+    // r2's condition handler depends on exactly `handed`.
+    let c = &r2.conds[0];
+    assert_eq!(
+        c.globals
+            .iter()
+            .map(|g| r2.str(r2.globals[*g as usize].name))
+            .collect::<Vec<_>>(),
+        ["handed"]
+    );
+}
