@@ -1093,7 +1093,7 @@ impl Compiler<'_> {
 
     fn store_local(&mut self, slot: u32, ty: Ty, span: Span) {
         let w = ty.width();
-        let s = u16::try_from(slot).unwrap_or(u16::MAX);
+        let s = slot;
         match w {
             0 => {}
             1 => {
@@ -1106,7 +1106,7 @@ impl Compiler<'_> {
     }
 
     fn load_local(&mut self, slot: u32, ty: Ty, span: Span) {
-        let s = u16::try_from(slot).unwrap_or(u16::MAX);
+        let s = slot;
         match ty.width() {
             0 => {}
             1 => {
@@ -1344,10 +1344,7 @@ impl Compiler<'_> {
                 self.coerce(i, Ty::Int, idx.span, "a joint index");
                 match place {
                     Place::Local(s) => {
-                        self.emit(
-                            Instr::StoreLocalJoint(u16::try_from(s).unwrap_or(u16::MAX)),
-                            sp,
-                        );
+                        self.emit(Instr::StoreLocalJoint(s), sp);
                     }
                     Place::Var(s) => {
                         self.emit(Instr::StoreVarJoint(s), sp);
@@ -1945,9 +1942,14 @@ impl Compiler<'_> {
                 }
             }
             if let Some((what, span, fname)) = impure {
+                let code = if what.starts_with("the module variable") {
+                    Code::E0042
+                } else {
+                    Code::E0041
+                };
                 self.err(
                     Diagnostic::error(
-                        Code::E0041,
+                        code,
                         format!("this condition calls `{fname}`, which reads {what}"),
                         pc.span,
                     )
@@ -2295,7 +2297,7 @@ impl Compiler<'_> {
                 if let (true, Some(Instr::LoadLocalN(s, 6))) = (is_name, last) {
                     let start = self.here() - 1;
                     self.truncate(start);
-                    self.emit(Instr::LoadLocal(s + u16::from(fi)), sp);
+                    self.emit(Instr::LoadLocal(s + u32::from(fi)), sp);
                 } else if let (true, Some(Instr::LoadVarN(s, 6))) = (is_name, last) {
                     let start = self.here() - 1;
                     self.truncate(start);

@@ -736,6 +736,12 @@ impl Parser<'_, '_> {
             TokKind::P(Punct::SlashAssign) => Some(Some(BinOp::Div)),
             _ => None,
         };
+        if self.at_p(Punct::Colon) {
+            let d = Diagnostic::error(Code::E0005, "WSL assigns with `=`", self.span())
+                .with_label("`:=` is RAPID's assignment")
+                .with_help("write `x = value;`");
+            return Err(self.report(d));
+        }
         if let Some(op) = op {
             self.bump();
             let value = self.expr()?;

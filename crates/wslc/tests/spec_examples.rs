@@ -193,3 +193,29 @@ fn the_rules_examples_behave_as_described() {
     // Annotations are optional.
     must_compile("n.wsl", "proc main() { var n: int = 0; var m = 0; n = m; }");
 }
+
+/// Legal programs near the nesting limit compile (no stack overflow in any pass, even in
+/// a debug build on a 2 MiB test thread), and a procedure with more locals than 16-bit
+/// slot numbers could address still compiles.
+#[test]
+fn deep_and_large_programs_compile() {
+    let depth = 80; // plus 40 blocks: just under the 128-level limit
+    let expr = format!("{}1{}", "(".repeat(depth), ")".repeat(depth));
+    let mut body = String::new();
+    for _ in 0..40 {
+        body.push_str("if true { ");
+    }
+    body.push_str(&format!("var x = {expr}; log x;"));
+    for _ in 0..40 {
+        body.push_str(" }");
+    }
+    must_compile("deep.wsl", &format!("proc main() {{ {body} }}"));
+
+    let mut big = String::from("proc main() {\n");
+    for i in 0..6000 {
+        big.push_str(&format!("    var j{i} = current_joints();\n"));
+    }
+    big.push_str("    move_j j5999;\n}\n");
+    let m = must_compile("big.wsl", &big);
+    assert_eq!(m.procs[0].frame_slots, 6000 * 12);
+}

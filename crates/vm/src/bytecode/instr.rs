@@ -91,7 +91,7 @@ macro_rules! operand_le {
         }
     )*};
 }
-operand_le!(u8, u16, u32, i64, f64);
+operand_le!(u8, u32, i64, f64);
 
 impl Operand for bool {
     fn write(self, out: &mut Vec<u8>) {
@@ -197,15 +197,15 @@ instruction_set! {
     /// Discards the top `n` slots.
     0x05 Pop(n: u8);
     /// Pushes local slot `s`.
-    0x10 LoadLocal(s: u16);
+    0x10 LoadLocal(s: u32);
     /// Pops into local slot `s`.
-    0x11 StoreLocal(s: u16);
+    0x11 StoreLocal(s: u32);
     /// Pushes `n` slots starting at local slot `s`.
-    0x12 LoadLocalN(s: u16, n: u8);
+    0x12 LoadLocalN(s: u32, n: u8);
     /// Pops `n` slots into local slots `s..s+n`.
-    0x13 StoreLocalN(s: u16, n: u8);
+    0x13 StoreLocalN(s: u32, n: u8);
     /// Pops an index and a num; stores the num as axis `index` of the joints at local `s`.
-    0x14 StoreLocalJoint(s: u16);
+    0x14 StoreLocalJoint(s: u32);
     /// Pushes module-variable slot `s`.
     0x18 LoadVar(s: u32);
     /// Pops into module-variable slot `s`.

@@ -18,6 +18,7 @@ mod verify;
 pub use disasm::disassemble;
 pub use encode::{FORMAT_VERSION, MAGIC};
 pub use instr::{Cmp, Instr, MoveFlags, StackEffect};
+pub use verify::{MAX_FRAME, MAX_STACK};
 
 use crate::types::{ConstValue, Type};
 

@@ -15,6 +15,9 @@ use crate::types::{MAX_AXES, Type};
 /// The deepest operand stack a procedure may need, in slots.
 pub const MAX_STACK: u32 = 1 << 16;
 
+/// The most slots a procedure's frame (parameters and locals) may have.
+pub const MAX_FRAME: u32 = 1 << 20;
+
 fn bad(msg: String) -> LoadError {
     LoadError::Invalid(msg)
 }
@@ -74,7 +77,7 @@ impl Module {
                     "procedure {i} has an empty or out-of-range code range"
                 )));
             }
-            if p.frame_slots < p.param_width() || p.frame_slots > u32::from(u16::MAX) + 1 {
+            if p.frame_slots < p.param_width() || p.frame_slots > MAX_FRAME {
                 return Err(bad(format!(
                     "procedure {i} has a frame of {} slots",
                     p.frame_slots
