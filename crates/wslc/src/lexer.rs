@@ -469,33 +469,11 @@ impl Lexer<'_, '_> {
                     si = value * factor;
                 }
             }
-            if !si.is_finite() {
-                self.error(
-                    Code::E0004,
-                    start,
-                    self.i,
-                    "this number is too large".into(),
-                    None,
-                );
-                self.push(TokKind::Error, start);
-                return;
-            }
-            self.push(TokKind::Quantity(si, dim), start);
+            self.push_finite(TokKind::Quantity(si, dim), si, start);
             return;
         }
         if real {
-            if !value.is_finite() {
-                self.error(
-                    Code::E0004,
-                    start,
-                    self.i,
-                    "this number is too large".into(),
-                    None,
-                );
-                self.push(TokKind::Error, start);
-                return;
-            }
-            self.push(TokKind::Num(value), start);
+            self.push_finite(TokKind::Num(value), value, start);
         } else {
             match digits.parse::<i64>() {
                 Ok(v) => self.push(TokKind::Int(v), start),
@@ -510,6 +488,22 @@ impl Lexer<'_, '_> {
                     self.push(TokKind::Error, start);
                 }
             }
+        }
+    }
+
+    /// Pushes a number token, or an error if `value` overflowed to infinity.
+    fn push_finite(&mut self, kind: TokKind, value: f64, start: usize) {
+        if value.is_finite() {
+            self.push(kind, start);
+        } else {
+            self.error(
+                Code::E0004,
+                start,
+                self.i,
+                "this number is too large".into(),
+                Some("numbers must stay below about 1.8e308 in magnitude"),
+            );
+            self.push(TokKind::Error, start);
         }
     }
 

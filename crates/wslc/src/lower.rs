@@ -1527,49 +1527,11 @@ impl Compiler<'_> {
         }
         if let Some(s) = speed {
             flags |= MoveFlags::SPEED;
-            let out = self.expr(s);
-            if kind == MoveKind::J {
-                self.ratio(out, s.span, "the speed of `move_j`", "50%");
-            } else {
-                let out = self.coerce(
-                    out,
-                    Ty::Num(Dim::SPEED),
-                    s.span,
-                    &format!("the speed of `{}`", kind.keyword()),
-                );
-                if let Some(ConstValue::Num(x)) = out.k
-                    && x <= 0.0
-                {
-                    self.err(Diagnostic::error(
-                        Code::E0025,
-                        "the speed must be greater than zero",
-                        s.span,
-                    ));
-                }
-            }
+            self.motion_rate(kind, s, Dim::SPEED, "speed");
         }
         if let Some(a) = accel {
             flags |= MoveFlags::ACCEL;
-            let out = self.expr(a);
-            if kind == MoveKind::J {
-                self.ratio(out, a.span, "the acceleration of `move_j`", "50%");
-            } else {
-                let out = self.coerce(
-                    out,
-                    Ty::Num(Dim::ACCEL),
-                    a.span,
-                    &format!("the acceleration of `{}`", kind.keyword()),
-                );
-                if let Some(ConstValue::Num(x)) = out.k
-                    && x <= 0.0
-                {
-                    self.err(Diagnostic::error(
-                        Code::E0025,
-                        "the acceleration must be greater than zero",
-                        a.span,
-                    ));
-                }
-            }
+            self.motion_rate(kind, a, Dim::ACCEL, "acceleration");
         }
         let f = MoveFlags(flags);
         self.emit(
@@ -1580,6 +1542,26 @@ impl Compiler<'_> {
             },
             sp,
         );
+    }
+
+    /// The `speed`/`accel` option of a motion: a ratio for `move_j`, else `dim` (> 0).
+    fn motion_rate(&mut self, kind: MoveKind, e: &Expr, dim: Dim, what: &str) {
+        let out = self.expr(e);
+        let what = format!("the {what} of `{}`", kind.keyword());
+        if kind == MoveKind::J {
+            self.ratio(out, e.span, &what, "50%");
+            return;
+        }
+        let out = self.coerce(out, Ty::Num(dim), e.span, &what);
+        if let Some(ConstValue::Num(x)) = out.k
+            && x <= 0.0
+        {
+            self.err(Diagnostic::error(
+                Code::E0025,
+                format!("{what} must be greater than zero"),
+                e.span,
+            ));
+        }
     }
 
     /// A ratio such as `50%`: a plain number in (0, 1], written with `%` when literal.

@@ -11,28 +11,17 @@
 
 use std::path::PathBuf;
 
+mod common;
+
+use common::must_compile;
+use vworks_wslc::compile;
 use vworks_wslc::link::{CellSpec, RobotSpec, link};
-use vworks_wslc::{Sources, compile, render};
 
 fn data(name: &str) -> String {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("test_data/spec")
         .join(name);
     std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
-}
-
-fn must_compile(path: &str, src: &str) -> vworks_vm::Module {
-    match compile(path, src) {
-        Ok(out) => out.module,
-        Err(e) => {
-            let mut s = Sources::new();
-            s.add(path, src);
-            panic!(
-                "{path} does not compile:\n{}\n--- source ---\n{src}",
-                render(&e.diagnostics, &s, false)
-            );
-        }
-    }
 }
 
 #[test]

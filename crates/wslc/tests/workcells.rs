@@ -4,23 +4,21 @@
 
 use std::path::PathBuf;
 
+mod common;
+
+use common::must_compile;
 use vworks_wslc::link::{CellSpec, RobotSpec, link};
-use vworks_wslc::{Sources, compile, render};
 
 fn compile_file(path: &PathBuf) -> vworks_vm::Module {
     let src = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let name = path.display().to_string();
-    match compile(&name, &src) {
-        Ok(out) => {
-            assert!(out.warnings.is_empty(), "{name}: {:?}", out.warnings);
-            out.module
-        }
-        Err(e) => {
-            let mut s = Sources::new();
-            s.add(&name, &src);
-            panic!("{}", render(&e.diagnostics, &s, false))
-        }
-    }
+    let out = vworks_wslc::compile(&name, &src);
+    assert!(
+        out.as_ref().map_or(true, |o| o.warnings.is_empty()),
+        "{name}: {:?}",
+        out.map(|o| o.warnings)
+    );
+    must_compile(&name, &src)
 }
 
 #[test]
