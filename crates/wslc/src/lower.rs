@@ -1771,7 +1771,7 @@ impl Compiler<'_> {
         let h = self.m.handlers.len();
         let action = self.new_proc(&format!("when#{h}"), ProcKind::Handler, sp);
         self.fns.push(FnCtx::new(action, FnKind::Handler, Ty::Void));
-        self.call_args(target, args, handler.span, sp);
+        self.call_args(target, args, sp);
         self.emit(Instr::Call(target), sp);
         self.facts().calls.push((target, handler.span));
         self.emit(Instr::Ret, sp);
@@ -1898,32 +1898,29 @@ impl Compiler<'_> {
             // Every function reachable from the condition.
             let mut globals = BTreeSet::new();
             let mut seen = vec![false; self.facts.len()];
-            let mut stack = vec![(func, pc.span)];
-            let mut impure: Option<(String, Span, String)> = None;
-            while let Some((p, via)) = stack.pop() {
+            // (function, the function the condition itself calls on the way to it)
+            let mut stack = vec![(func, None::<u32>)];
+            let mut impure: Option<(String, Span, u32, u32)> = None;
+            while let Some((p, top)) = stack.pop() {
                 if std::mem::replace(&mut seen[p as usize], true) {
                     continue;
                 }
                 let f = &self.facts[p as usize];
                 globals.extend(f.globals.iter().copied());
-                if p != func
-                    && impure.is_none()
-                    && let Some((what, span)) = &f.impure
-                {
-                    impure = Some((
-                        what.clone(),
-                        *span,
-                        self.sigs
-                            .get(p as usize)
-                            .map_or(String::new(), |s| s.name.clone()),
-                    ));
-                    let _ = via;
+                if let (Some(top), None, Some((what, span))) = (top, &impure, &f.impure) {
+                    impure = Some((what.clone(), *span, top, p));
                 }
-                for (c, s) in &f.calls {
-                    stack.push((*c, *s));
+                for (c, _) in f.calls.iter().rev() {
+                    stack.push((*c, top.or(Some(*c))));
                 }
             }
-            if let Some((what, span, fname)) = impure {
+            if let Some((what, span, top, holder)) = impure {
+                let name = |p: u32| {
+                    self.sigs
+                        .get(p as usize)
+                        .map_or(String::new(), |s| s.name.clone())
+                };
+                let (fname, inner) = (name(top), name(holder));
                 let code = if what.starts_with("the module variable") {
                     Code::E0042
                 } else {
@@ -1932,10 +1929,14 @@ impl Compiler<'_> {
                 self.err(
                     Diagnostic::error(
                         code,
-                        format!("this condition calls `{fname}`, which reads {what}"),
+                        if fname == inner {
+                            format!("this condition calls `{fname}`, which reads {what}")
+                        } else {
+                            format!("this condition calls `{fname}`, which (through `{inner}`) reads {what}")
+                        },
                         pc.span,
                     )
-                    .with_related(span, "read here")
+                    .with_related(span, format!("read here, in `{inner}`"))
                     .with_help("a condition is re-checked only when a global it reads is set, so it may depend only on globals, constants and locals"),
                 );
             } else if globals.is_empty() {
@@ -2740,7 +2741,7 @@ impl Compiler<'_> {
         }
     }
 
-    fn call_args(&mut self, callee: u32, args: &[Expr], name_span: Span, sp: Span) {
+    fn call_args(&mut self, callee: u32, args: &[Expr], sp: Span) {
         let sig = self.sigs[callee as usize].clone();
         if args.len() != sig.params.len() {
             self.err(
@@ -2763,7 +2764,6 @@ impl Compiler<'_> {
             }
             return;
         }
-        let _ = name_span;
         for (a, (pname, pty)) in args.iter().zip(&sig.params) {
             let o = self.expr(a);
             self.coerce(
@@ -2800,7 +2800,7 @@ impl Compiler<'_> {
             if self.fk() == FnKind::Init {
                 return self.not_const(&name.name, "a function", sp);
             }
-            self.call_args(p, args, name.span, sp);
+            self.call_args(p, args, sp);
             self.facts().calls.push((p, name.span));
             self.emit(Instr::Call(p), sp);
             return Out::of(sig.ret);
