@@ -183,3 +183,41 @@ fn truncated_and_foreign_files_are_load_errors() {
     );
     assert_eq!(Module::decode(b"\x7fELF"), Err(LoadError::BadMagic));
 }
+
+#[test]
+fn garbage_behind_an_endless_jump_is_rejected_too() {
+    // Found by the load_bytecode fuzzer: `Jump 0` makes the rest unreachable, but a
+    // loaded module may contain no invalid instruction anywhere.
+    let code = vec![
+        Instr::Jump(0),
+        Instr::PushNum(f64::NAN),
+        Instr::Pop(1),
+        Instr::Ret,
+    ];
+    rejects(module(code, ProcKind::Proc, None, 0), "instruction 1");
+    let code = vec![
+        Instr::Jump(0),
+        Instr::PushConst(99),
+        Instr::Pop(1),
+        Instr::Ret,
+    ];
+    rejects(module(code, ProcKind::Proc, None, 0), "instruction 1");
+    let code = vec![Instr::Jump(0), Instr::Jump(40)];
+    rejects(
+        module(code, ProcKind::Proc, None, 0),
+        "outside the procedure",
+    );
+}
+
+#[test]
+fn code_outside_every_procedure_is_rejected() {
+    // Also found by the fuzzer: a shortened `code_len` left instructions in no procedure.
+    let mut m = module(
+        vec![Instr::Ret, Instr::PushNum(f64::NAN)],
+        ProcKind::Proc,
+        None,
+        0,
+    );
+    m.procs[0].code_len = 1;
+    rejects(m, "the procedures cover 1 instructions, but the code has 2");
+}

@@ -1,6 +1,7 @@
 //! The verifier: proves a module safe to run before the VM sees it.
 //!
-//! After [`Module::verify`] succeeds: every table index and string index is in range; every
+//! After [`Module::verify`] succeeds: the procedures tile the code section exactly; in
+//! every instruction, reachable or not, every table index and string index is in range; every
 //! local, module-variable, global and constant access is inside its area; every jump lands
 //! inside its procedure; no procedure falls off its end; and the operand-stack height is
 //! the same on every path into each instruction, never negative, zero at `Ret` and exactly
@@ -67,6 +68,23 @@ impl Module {
             }
         }
         let ncode = self.code.len() as u64;
+        // Procedures lie back to back in index order and cover all the code: no
+        // instruction is outside a procedure, none belongs to two.
+        let mut next = 0u64;
+        for (i, p) in self.procs.iter().enumerate() {
+            if u64::from(p.code_start) != next {
+                return Err(bad(format!(
+                    "procedure {i} starts at instruction {}, but the previous one ends at {next}",
+                    p.code_start
+                )));
+            }
+            next += u64::from(p.code_len);
+        }
+        if next != ncode {
+            return Err(bad(format!(
+                "the procedures cover {next} instructions, but the code has {ncode}"
+            )));
+        }
         for (i, p) in self.procs.iter().enumerate() {
             s(p.name, &format!("procedure {i}"))?;
             for a in &p.params {
@@ -201,22 +219,9 @@ impl Module {
             c.iter()
                 .all(|c| in_frame(u64::from(c.slot), u64::from(c.width)))
         };
-        let mut height: Vec<Option<u32>> = vec![None; n];
-        let mut work = vec![(0usize, 0u32)];
-        let mut max = 0;
-        while let Some((pc, h)) = work.pop() {
-            match height[pc] {
-                Some(old) if old == h => continue,
-                Some(old) => {
-                    return Err(at(
-                        pc,
-                        format!("stack height {h} here, but {old} on another path"),
-                    ));
-                }
-                None => height[pc] = Some(h),
-            }
-            let ins = code[pc];
-            // Operands.
+        // Every instruction, reachable or not: operands in range, no forbidden events,
+        // jumps inside the procedure. Dead code may hold no garbage either.
+        for (pc, &ins) in code.iter().enumerate() {
             let ok = match ins {
                 Instr::LoadLocal(sl) | Instr::StoreLocal(sl) => in_frame(u64::from(sl), 1),
                 Instr::LoadLocalN(sl, w) | Instr::StoreLocalN(sl, w) => {
@@ -290,6 +295,31 @@ impl Module {
                     ),
                 ));
             }
+            if let Some(t) = ins.jump_target()
+                && t as usize >= n
+            {
+                return Err(at(
+                    pc,
+                    format!("jumps to {t}, outside the procedure's {n} instructions"),
+                ));
+            }
+        }
+        // Stack heights along every path from the entry.
+        let mut height: Vec<Option<u32>> = vec![None; n];
+        let mut work = vec![(0usize, 0u32)];
+        let mut max = 0;
+        while let Some((pc, h)) = work.pop() {
+            match height[pc] {
+                Some(old) if old == h => continue,
+                Some(old) => {
+                    return Err(at(
+                        pc,
+                        format!("stack height {h} here, but {old} on another path"),
+                    ));
+                }
+                None => height[pc] = Some(h),
+            }
+            let ins = code[pc];
             let e = ins.stack_effect(self, p).ok_or_else(|| {
                 at(
                     pc,
@@ -324,12 +354,6 @@ impl Module {
                 _ => {}
             }
             if let Some(t) = ins.jump_target() {
-                if t as usize >= n {
-                    return Err(at(
-                        pc,
-                        format!("jumps to {t}, outside the procedure's {n} instructions"),
-                    ));
-                }
                 work.push((t as usize, after));
             }
             if !ins.ends_block() {
