@@ -36,6 +36,20 @@ pub struct RobotSpec<'a> {
     pub serve_only: bool,
 }
 
+impl<'a> RobotSpec<'a> {
+    /// A robot with revolute axes only, starting at `main`.
+    pub fn new(name: &'a str, module: &'a Module, axes: usize) -> RobotSpec<'a> {
+        RobotSpec {
+            name,
+            module,
+            axes,
+            linear_axes: 0,
+            entry: None,
+            serve_only: false,
+        }
+    }
+}
+
 /// What the linker checks a cell against.
 #[derive(Debug, Clone, Default)]
 pub struct CellSpec<'a> {

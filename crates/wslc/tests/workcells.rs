@@ -27,24 +27,7 @@ fn handoff_programs_compile_and_link() {
     let r1 = compile_file(&dir.join("r1.wsl"));
     let r2 = compile_file(&dir.join("r2.wsl"));
     let cell = CellSpec {
-        robots: vec![
-            RobotSpec {
-                name: "r1",
-                module: &r1,
-                axes: 6,
-                linear_axes: 0,
-                entry: None,
-                serve_only: false,
-            },
-            RobotSpec {
-                name: "r2",
-                module: &r2,
-                axes: 6,
-                linear_axes: 0,
-                entry: None,
-                serve_only: false,
-            },
-        ],
+        robots: vec![RobotSpec::new("r1", &r1, 6), RobotSpec::new("r2", &r2, 6)],
         parts: vec!["part1"],
     };
     let linked = link(&cell).unwrap_or_else(|e| panic!("{e}"));
