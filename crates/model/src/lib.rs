@@ -1,0 +1,29 @@
+//! Robot models for vworks: what the VM moves and the SE checks for collisions.
+//!
+//! - [`urdf`]: URDF import (urdf-rs) with the checks a robot description needs — one root,
+//!   no cycles, finite origins, non-zero axes, usable limits, meshes that exist — each
+//!   failure a [`ModelError`] naming the file and the element.
+//! - [`model`]: links, joints, axes, limits, collision shapes (parry3d, built once at
+//!   load: meshes become convex hulls) and forward kinematics (f64, no allocation).
+//! - [`ik`]: analytic IK for spherical-wrist 6-axis arms (all solutions, nearest chosen)
+//!   and damped-least-squares IK for any chain.
+//! - [`builtin`]: `irb120`, `kr6r900`, `lrmate200id`, `ur5`, `turntable`, `track`.
+//! - [`mesh`]: STL (binary, ASCII) and OBJ vertices.
+//! - [`math`]: the small rigid-transform algebra all of it uses.
+//!
+//! Joint values are radians for revolute axes and metres for prismatic ones. A joint
+//! whose URDF gives no acceleration limit accelerates to full speed in
+//! [`model::DEFAULT_ACCEL_TIME`] (0.3 s).
+
+pub mod builtin;
+pub mod error;
+pub mod ik;
+pub mod math;
+pub mod mesh;
+pub mod model;
+pub mod urdf;
+
+pub use error::ModelError;
+pub use ik::IkError;
+pub use math::Iso;
+pub use model::{JointKind, RobotModel};

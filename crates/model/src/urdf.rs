@@ -1,0 +1,536 @@
+//! URDF import (through urdf-rs), with every check a robot description needs before
+//! vworks trusts it: one root, no cycles, finite origins, non-zero axes, usable limits,
+//! meshes that exist and parse. Each problem is a [`ModelError`] naming the file and the
+//! element.
+//!
+//! Mesh paths are relative to the URDF file; `package://PKG/REST` is looked up as
+//! `DIR/PKG/REST` for the URDF's folder and every folder of the search path.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use parry3d::math::Vector;
+use parry3d::shape::SharedShape;
+
+use crate::error::ModelError;
+use crate::math::{Iso, V3, norm};
+use crate::mesh;
+use crate::model::{
+    AxisDir, DEFAULT_ACCEL_TIME, Geometry, Joint, JointKind, Link, LinkShape, RobotModel,
+};
+
+/// How to load a URDF.
+#[derive(Clone, Debug, Default)]
+pub struct LoadOptions {
+    /// The tool (flange) link; required when the tree branches, else the chain's end.
+    pub tool_link: Option<String>,
+    /// Folders searched for `package://` meshes (besides the URDF's own folder).
+    pub package_paths: Vec<PathBuf>,
+}
+
+/// Loads a URDF file.
+pub fn load_file(path: &Path, opts: &LoadOptions) -> Result<RobotModel, ModelError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| ModelError::Read {
+        file: file.clone(),
+        reason: e.to_string(),
+    })?;
+    load_str(&text, &file, path.parent(), opts)
+}
+
+/// Loads URDF text; `file` names it in errors, `dir` is where relative meshes are.
+pub fn load_str(
+    text: &str,
+    file: &str,
+    dir: Option<&Path>,
+    opts: &LoadOptions,
+) -> Result<RobotModel, ModelError> {
+    let invalid = |element: String, message: String, help: &str| ModelError::Invalid {
+        file: file.to_string(),
+        element,
+        message,
+        help: help.to_string(),
+    };
+    check_joint_types(text, file)?;
+    let robot = urdf_rs::read_from_string(text).map_err(|e| ModelError::Parse {
+        file: file.to_string(),
+        reason: e.to_string(),
+    })?;
+
+    // Links by name.
+    let mut by_name: BTreeMap<&str, usize> = BTreeMap::new();
+    for (i, l) in robot.links.iter().enumerate() {
+        if by_name.insert(l.name.as_str(), i).is_some() {
+            return Err(invalid(
+                format!("link `{}`", l.name),
+                "is declared twice".into(),
+                "give every link a unique name",
+            ));
+        }
+    }
+    if robot.links.is_empty() {
+        return Err(invalid(
+            "robot".into(),
+            "has no links".into(),
+            "a URDF needs at least one <link>",
+        ));
+    }
+
+    // Joints: endpoints, one parent per link, finite numbers.
+    let mut parent_of: Vec<Option<usize>> = vec![None; robot.links.len()];
+    for (ji, j) in robot.joints.iter().enumerate() {
+        let el = || format!("joint `{}`", j.name);
+        let find = |name: &str, role: &str| {
+            by_name.get(name).copied().ok_or_else(|| {
+                invalid(
+                    el(),
+                    format!("its {role} link `{name}` does not exist"),
+                    "name a <link> of this file",
+                )
+            })
+        };
+        find(&j.parent.link, "parent")?;
+        let c = find(&j.child.link, "child")?;
+        if let Some(other) = parent_of[c] {
+            return Err(invalid(
+                el(),
+                format!(
+                    "link `{}` already has the parent joint `{}`",
+                    j.child.link, robot.joints[other].name
+                ),
+                "a URDF is a tree: every link has at most one parent joint",
+            ));
+        }
+        parent_of[c] = Some(ji);
+        let o = &j.origin;
+        if o.xyz.0.iter().chain(o.rpy.0.iter()).any(|x| !x.is_finite()) {
+            return Err(invalid(
+                el(),
+                "its <origin> has a value that is not a finite number".into(),
+                "write numbers for xyz and rpy (no nan or inf)",
+            ));
+        }
+        let a = j.axis.xyz.0;
+        if a.iter().any(|x| !x.is_finite()) || norm(a) < 1e-12 {
+            return Err(invalid(
+                el(),
+                format!("its <axis xyz> is {:?}", a),
+                "give a non-zero direction, e.g. <axis xyz=\"0 0 1\"/>",
+            ));
+        }
+    }
+
+    // Exactly one root, and every link reachable from it.
+    let roots: Vec<usize> = (0..robot.links.len())
+        .filter(|i| parent_of[*i].is_none())
+        .collect();
+    if roots.len() > 1 {
+        let names: Vec<&str> = roots
+            .iter()
+            .map(|r| robot.links[*r].name.as_str())
+            .collect();
+        return Err(invalid(
+            format!("link `{}`", names[1]),
+            format!("the tree has {} roots ({})", roots.len(), names.join(", ")),
+            "connect every link to one base link with a joint",
+        ));
+    }
+    let Some(&root) = roots.first() else {
+        return Err(invalid(
+            "robot".into(),
+            "every link has a parent, so the joints form a cycle".into(),
+            "remove the joint that closes the loop",
+        ));
+    };
+    let mut children: Vec<Vec<usize>> = vec![Vec::new(); robot.links.len()];
+    for (ji, j) in robot.joints.iter().enumerate() {
+        let p = by_name[j.parent.link.as_str()];
+        children[p].push(ji);
+    }
+    // Breadth-first from the root gives parents before children.
+    let mut order = vec![root];
+    let mut k = 0;
+    while k < order.len() {
+        let l = order[k];
+        for &ji in &children[l] {
+            order.push(by_name[robot.joints[ji].child.link.as_str()]);
+        }
+        k += 1;
+    }
+    if order.len() != robot.links.len() {
+        let stray = (0..robot.links.len())
+            .find(|i| !order.contains(i))
+            .unwrap_or(0);
+        return Err(invalid(
+            format!("link `{}`", robot.links[stray].name),
+            "is part of a cycle of joints, not reachable from the base".into(),
+            "a URDF is a tree: remove the joint that closes the loop",
+        ));
+    }
+    let new_index: BTreeMap<usize, usize> =
+        order.iter().enumerate().map(|(n, o)| (*o, n)).collect();
+
+    // Tool link: named, or the end of the chain.
+    let tool_old = match &opts.tool_link {
+        Some(name) => *by_name.get(name.as_str()).ok_or_else(|| {
+            invalid(
+                format!("tool link `{name}`"),
+                "is not a link of this robot".into(),
+                "name one of its links as the tool",
+            )
+        })?,
+        None => {
+            let mut l = root;
+            loop {
+                match children[l].len() {
+                    0 => break l,
+                    1 => l = by_name[robot.joints[children[l][0]].child.link.as_str()],
+                    _ => {
+                        let leaves: Vec<&str> = (0..robot.links.len())
+                            .filter(|i| children[*i].is_empty())
+                            .map(|i| robot.links[i].name.as_str())
+                            .collect();
+                        return Err(invalid(
+                            format!("link `{}`", robot.links[l].name),
+                            "the tree branches here, so the tool link is ambiguous".into(),
+                            &format!(
+                                "name the tool link in the workcell (one of: {})",
+                                leaves.join(", ")
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
+    };
+
+    // Joints in child order, with limits.
+    let mut joints = Vec::with_capacity(robot.joints.len());
+    for &old_child in order.iter().skip(1) {
+        let Some(ji) = parent_of[old_child] else {
+            continue;
+        };
+        let j = &robot.joints[ji];
+        let el = || format!("joint `{}`", j.name);
+        let kind = match j.joint_type {
+            urdf_rs::JointType::Revolute => JointKind::Revolute,
+            urdf_rs::JointType::Continuous => JointKind::Continuous,
+            urdf_rs::JointType::Prismatic => JointKind::Prismatic,
+            urdf_rs::JointType::Fixed => JointKind::Fixed,
+            _ => {
+                return Err(invalid(
+                    el(),
+                    "has a type vworks does not support".into(),
+                    "use revolute, continuous, prismatic or fixed",
+                ));
+            }
+        };
+        let a = j.axis.xyz.0;
+        let n = norm(a);
+        let axis = [a[0] / n, a[1] / n, a[2] / n];
+        let lim = &j.limit;
+        let (lower, upper) = match kind {
+            JointKind::Continuous => (f64::NEG_INFINITY, f64::INFINITY),
+            JointKind::Fixed => (0.0, 0.0),
+            _ => {
+                if !lim.lower.is_finite() || !lim.upper.is_finite() || lim.lower > lim.upper {
+                    return Err(invalid(
+                        el(),
+                        format!(
+                            "its limits lower={} upper={} are not a finite range",
+                            lim.lower, lim.upper
+                        ),
+                        "write <limit lower=\"…\" upper=\"…\" velocity=\"…\"/> with lower ≤ upper",
+                    ));
+                }
+                (lim.lower, lim.upper)
+            }
+        };
+        let (max_velocity, max_accel) = if kind.is_movable() {
+            if !(lim.velocity.is_finite() && lim.velocity > 0.0) {
+                return Err(invalid(
+                    el(),
+                    format!("its velocity limit is {}", lim.velocity),
+                    "a moving joint needs <limit velocity=\"…\"/> greater than 0",
+                ));
+            }
+            let acc = if lim.acceleration.is_finite() && lim.acceleration > 0.0 {
+                lim.acceleration
+            } else {
+                lim.velocity / DEFAULT_ACCEL_TIME
+            };
+            (lim.velocity, acc)
+        } else {
+            (0.0, 0.0)
+        };
+        joints.push(Joint {
+            name: j.name.clone(),
+            kind,
+            parent: new_index[&by_name[j.parent.link.as_str()]],
+            child: new_index[&old_child],
+            origin: Iso::from_xyz_rpy(j.origin.xyz.0, j.origin.rpy.0),
+            axis,
+            dir: AxisDir::new(axis),
+            lower,
+            upper,
+            max_velocity,
+            max_accel,
+            axis_index: None,
+        });
+    }
+
+    // Links with shapes.
+    let mut links = Vec::with_capacity(order.len());
+    for &old in &order {
+        let l = &robot.links[old];
+        let mut shapes = Vec::new();
+        for (ci, c) in l.collision.iter().enumerate() {
+            let el = format!("link `{}` collision {}", l.name, ci + 1);
+            let o = &c.origin;
+            if o.xyz.0.iter().chain(o.rpy.0.iter()).any(|x| !x.is_finite()) {
+                return Err(invalid(
+                    el,
+                    "its <origin> has a value that is not a finite number".into(),
+                    "write numbers for xyz and rpy",
+                ));
+            }
+            let origin = Iso::from_xyz_rpy(o.xyz.0, o.rpy.0);
+            let geometry = geometry(&c.geometry, file, dir, &el, opts)?;
+            shapes.push(build_shape(geometry, origin, file, &el)?);
+        }
+        let index = links.len();
+        links.push(Link {
+            name: l.name.clone(),
+            parent_joint: joints.iter().position(|j| j.child == index),
+            shapes,
+        });
+    }
+
+    // The axes: movable joints from the root to the tool.
+    let tool_link = new_index[&tool_old];
+    let mut path = Vec::new();
+    let mut l = tool_link;
+    while let Some(j) = links[l].parent_joint {
+        path.push(j);
+        l = joints[j].parent;
+    }
+    path.reverse();
+    let axes: Vec<usize> = path
+        .into_iter()
+        .filter(|j| joints[*j].kind.is_movable())
+        .collect();
+    if axes.len() > 12 {
+        return Err(invalid(
+            format!("link `{}`", links[tool_link].name),
+            format!("the chain to the tool has {} axes", axes.len()),
+            "vworks robots have at most 12 axes; split the cell into several robots",
+        ));
+    }
+    for (i, j) in axes.iter().enumerate() {
+        joints[*j].axis_index = Some(i);
+    }
+    let mut model = RobotModel {
+        name: robot.name.clone(),
+        source: file.to_string(),
+        links,
+        joints,
+        axes,
+        tool_link,
+        wrist: None,
+        chain_cache: Vec::new(),
+    };
+    model.chain_cache = model.chain();
+    model.wrist = crate::ik::SphericalWrist::detect(&model);
+    Ok(model)
+}
+
+/// Rejects joint types before urdf-rs does, so the error names the joint.
+fn check_joint_types(text: &str, file: &str) -> Result<(), ModelError> {
+    let mut rest = text;
+    while let Some(i) = rest.find("<joint") {
+        let after = &rest[i + 6..];
+        rest = after;
+        if !after.starts_with(|c: char| c.is_whitespace()) {
+            continue;
+        }
+        let tag = &after[..after.find('>').unwrap_or(after.len())];
+        let attr = |key: &str| -> Option<&str> {
+            let k = tag.find(&format!("{key}="))?;
+            let v = &tag[k + key.len() + 1..];
+            let q = v.chars().next()?;
+            let v = &v[1..];
+            Some(&v[..v.find(q)?])
+        };
+        let name = attr("name").unwrap_or("?");
+        match attr("type") {
+            Some("revolute" | "continuous" | "prismatic" | "fixed") => {}
+            Some(t @ ("floating" | "planar" | "spherical")) => {
+                return Err(ModelError::Invalid {
+                    file: file.into(),
+                    element: format!("joint `{name}`"),
+                    message: format!("type `{t}` is not supported"),
+                    help: "robot joints in vworks are revolute, continuous, prismatic or fixed"
+                        .into(),
+                });
+            }
+            Some(t) => {
+                return Err(ModelError::Invalid {
+                    file: file.into(),
+                    element: format!("joint `{name}`"),
+                    message: format!("unknown joint type `{t}`"),
+                    help: "the types are revolute, continuous, prismatic and fixed".into(),
+                });
+            }
+            None => {
+                return Err(ModelError::Invalid {
+                    file: file.into(),
+                    element: format!("joint `{name}`"),
+                    message: "has no type".into(),
+                    help: "add type=\"revolute\" (or continuous, prismatic, fixed)".into(),
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+fn positive(values: &[f64]) -> bool {
+    values.iter().all(|v| v.is_finite() && *v > 0.0)
+}
+
+fn geometry(
+    g: &urdf_rs::Geometry,
+    file: &str,
+    dir: Option<&Path>,
+    el: &str,
+    opts: &LoadOptions,
+) -> Result<Geometry, ModelError> {
+    let bad = |what: &str| ModelError::Invalid {
+        file: file.into(),
+        element: el.into(),
+        message: format!("its {what} must be positive, finite numbers"),
+        help: "sizes are in metres".into(),
+    };
+    Ok(match g {
+        urdf_rs::Geometry::Box { size } => {
+            if !positive(&size.0) {
+                return Err(bad("box size"));
+            }
+            Geometry::Box {
+                half: [size[0] / 2.0, size[1] / 2.0, size[2] / 2.0],
+            }
+        }
+        urdf_rs::Geometry::Cylinder { radius, length } => {
+            if !positive(&[*radius, *length]) {
+                return Err(bad("cylinder radius and length"));
+            }
+            Geometry::Cylinder {
+                radius: *radius,
+                length: *length,
+            }
+        }
+        urdf_rs::Geometry::Capsule { radius, length } => {
+            if !positive(&[*radius]) || !(length.is_finite() && *length >= 0.0) {
+                return Err(bad("capsule radius and length"));
+            }
+            Geometry::Capsule {
+                radius: *radius,
+                length: *length,
+            }
+        }
+        urdf_rs::Geometry::Sphere { radius } => {
+            if !positive(&[*radius]) {
+                return Err(bad("sphere radius"));
+            }
+            Geometry::Sphere { radius: *radius }
+        }
+        urdf_rs::Geometry::Mesh { filename, scale } => {
+            let scale: V3 = scale.as_ref().map_or([1.0; 3], |s| s.0);
+            if !positive(&scale) {
+                return Err(bad("mesh scale"));
+            }
+            let mesh_err = |message: String| ModelError::Mesh {
+                file: file.into(),
+                element: el.into(),
+                mesh: filename.clone(),
+                message,
+            };
+            let candidates = mesh_candidates(filename, dir, &opts.package_paths);
+            let Some(path) = candidates.iter().find(|p| p.is_file()) else {
+                let looked: Vec<String> =
+                    candidates.iter().map(|p| p.display().to_string()).collect();
+                return Err(mesh_err(format!(
+                    "not found (looked for {}); put the mesh there or add its package's parent folder to the search path",
+                    looked.join(", ")
+                )));
+            };
+            let bytes = std::fs::read(path)
+                .map_err(|e| mesh_err(format!("cannot read {}: {e}", path.display())))?;
+            let points = mesh::read_vertices(&bytes, filename, scale)
+                .map_err(|m| mesh_err(format!("{} ({})", m, path.display())))?;
+            Geometry::Hull {
+                source: path.display().to_string(),
+                points,
+            }
+        }
+    })
+}
+
+fn mesh_candidates(filename: &str, dir: Option<&Path>, packages: &[PathBuf]) -> Vec<PathBuf> {
+    let base = dir.map(Path::to_path_buf).unwrap_or_default();
+    if let Some(rest) = filename.strip_prefix("package://") {
+        let mut v = vec![base.join(rest)];
+        v.extend(packages.iter().map(|p| p.join(rest)));
+        if let Some((_, inner)) = rest.split_once('/') {
+            v.push(base.join(inner));
+        }
+        return v;
+    }
+    if let Some(abs) = filename.strip_prefix("file://") {
+        return vec![PathBuf::from(abs)];
+    }
+    vec![base.join(filename)]
+}
+
+/// Builds the parry shape of a collision body once.
+pub(crate) fn build_shape(
+    geometry: Geometry,
+    origin: Iso,
+    file: &str,
+    el: &str,
+) -> Result<LinkShape, ModelError> {
+    let mut local_pose = origin.to_pose();
+    let shape = match &geometry {
+        Geometry::Box { half } => {
+            SharedShape::cuboid(half[0] as f32, half[1] as f32, half[2] as f32)
+        }
+        Geometry::Sphere { radius } => SharedShape::ball(*radius as f32),
+        Geometry::Capsule { radius, length } => {
+            SharedShape::capsule_z((*length / 2.0) as f32, *radius as f32)
+        }
+        Geometry::Cylinder { radius, length } => {
+            // parry's cylinders stand on y; URDF's on z.
+            let turn = Iso::from_xyz_rpy([0.0; 3], [std::f64::consts::FRAC_PI_2, 0.0, 0.0]);
+            local_pose = origin.mul(&turn).to_pose();
+            SharedShape::cylinder((*length / 2.0) as f32, *radius as f32)
+        }
+        Geometry::Hull { points, .. } => {
+            let pts: Vec<Vector> = points
+                .iter()
+                .map(|p| Vector::new(p[0] as f32, p[1] as f32, p[2] as f32))
+                .collect();
+            SharedShape::convex_hull(&pts).ok_or_else(|| ModelError::Invalid {
+                file: file.into(),
+                element: el.into(),
+                message: "the mesh is flat or degenerate, so it has no convex hull".into(),
+                help: "use a closed mesh with volume, or a box/capsule".into(),
+            })?
+        }
+    };
+    Ok(LinkShape {
+        geometry,
+        origin,
+        shape,
+        local_pose,
+    })
+}
