@@ -111,7 +111,8 @@ pub fn load_str(
             ));
         }
         let a = j.axis.xyz.0;
-        if a.iter().any(|x| !x.is_finite()) || norm(a) < 1e-12 {
+        let moves = j.joint_type != urdf_rs::JointType::Fixed;
+        if moves && (a.iter().any(|x| !x.is_finite()) || norm(a) < 1e-12) {
             return Err(invalid(
                 el(),
                 format!("its <axis xyz> is {:?}", a),
@@ -227,7 +228,11 @@ pub fn load_str(
         };
         let a = j.axis.xyz.0;
         let n = norm(a);
-        let axis = [a[0] / n, a[1] / n, a[2] / n];
+        let axis = if kind.is_movable() {
+            [a[0] / n, a[1] / n, a[2] / n]
+        } else {
+            [0.0, 0.0, 1.0]
+        };
         let lim = &j.limit;
         let (lower, upper) = match kind {
             JointKind::Continuous => (f64::NEG_INFINITY, f64::INFINITY),
@@ -346,7 +351,8 @@ pub fn load_str(
 
 /// Rejects joint types before urdf-rs does, so the error names the joint.
 fn check_joint_types(text: &str, file: &str) -> Result<(), ModelError> {
-    let mut rest = text;
+    let stripped = strip_blocks(text);
+    let mut rest = stripped.as_str();
     while let Some(i) = rest.find("<joint") {
         let after = &rest[i + 6..];
         rest = after;
@@ -392,6 +398,32 @@ fn check_joint_types(text: &str, file: &str) -> Result<(), ModelError> {
         }
     }
     Ok(())
+}
+
+/// The text without comments and without `<transmission>`/`<gazebo>` blocks, whose
+/// `<joint name=…>` elements are references, not joints.
+fn strip_blocks(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    loop {
+        let next = [
+            ("<!--", "-->"),
+            ("<transmission", "</transmission>"),
+            ("<gazebo", "</gazebo>"),
+        ]
+        .iter()
+        .filter_map(|(open, close)| rest.find(open).map(|i| (i, *close)))
+        .min_by_key(|(i, _)| *i);
+        let Some((i, close)) = next else {
+            out.push_str(rest);
+            return out;
+        };
+        out.push_str(&rest[..i]);
+        rest = match rest[i..].find(close) {
+            Some(j) => &rest[i + j + close.len()..],
+            None => "",
+        };
+    }
 }
 
 fn positive(values: &[f64]) -> bool {
