@@ -19,6 +19,12 @@ use std::f64::consts::PI;
 use crate::math::{Iso, M3, V3, cross, mat_mul, mat_vec, norm, rotation_vector, sub, transpose};
 use crate::model::{AxisDir, JointKind, RobotModel};
 
+/// Levenberg–Marquardt iterations per start.
+const ITERATIONS: usize = 500;
+
+/// Starts of the numeric solver: the seed, then deterministic points across the ranges.
+const RESTARTS: usize = 32;
+
 /// The most axes a numeric IK handles (the VM's `MAX_AXES`).
 pub const MAX_AXES: usize = 12;
 
@@ -372,7 +378,7 @@ impl RobotModel {
         let n = self.dof();
         let mut best = (f64::INFINITY, f64::INFINITY);
         let mut rng = 0x9e37_79b9_7f4a_7c15u64;
-        for attempt in 0..16 {
+        for attempt in 0..RESTARTS {
             let mut x = [0.0; MAX_AXES];
             for i in 0..n {
                 let j = self.axis(i);
@@ -407,59 +413,60 @@ impl RobotModel {
         })
     }
 
-    /// Iterates damped least squares in place; returns the final errors.
+    /// The pose error at `x` (target − current: position, rotation vector) and the
+    /// geometric Jacobian (6 × dof, in `jac`).
+    fn residual(&self, target: &Iso, x: &[f64], jac: &mut [[f64; MAX_AXES]; 6]) -> [f64; 6] {
+        let mut f = Iso::IDENTITY;
+        let mut axis_frames = [(Iso::IDENTITY, 0usize); MAX_AXES];
+        for &j in &self.chain_cache {
+            let before = f.mul(&self.joints[j].origin);
+            f = self.joint_step(&f, j, x);
+            if let Some(i) = self.joints[j].axis_index {
+                axis_frames[i] = (before, j);
+            }
+        }
+        for (i, (fr, j)) in axis_frames.iter().enumerate().take(x.len()) {
+            let joint = &self.joints[*j];
+            let z = mat_vec(&fr.r, joint.dir.vector());
+            let (lin, ang) = match joint.kind {
+                JointKind::Prismatic => (z, [0.0; 3]),
+                _ => (cross(z, sub(f.t, fr.t)), z),
+            };
+            for r in 0..3 {
+                jac[r][i] = lin[r];
+                jac[r + 3][i] = ang[r];
+            }
+        }
+        let e_p = sub(target.t, f.t);
+        let e_r = rotation_vector(&mat_mul(&target.r, &transpose(&f.r)));
+        [e_p[0], e_p[1], e_p[2], e_r[0], e_r[1], e_r[2]]
+    }
+
+    /// Levenberg–Marquardt in place: a step that does not reduce the error is rejected and
+    /// the damping raised. Returns the final position and orientation errors.
     fn dls(&self, target: &Iso, x: &mut [f64]) -> (f64, f64) {
         let n = x.len();
-        let mut lambda: f64 = 1e-3;
-        let mut last = f64::INFINITY;
-        let (mut ep, mut er) = (f64::INFINITY, f64::INFINITY);
-        for _ in 0..200 {
-            // Frames of the chain's joints (after their motion) and the tool.
-            let mut f = Iso::IDENTITY;
-            let mut axis_frames = [(Iso::IDENTITY, 0usize); MAX_AXES];
-            for &j in &self.chain_cache {
-                let before = f.mul(&self.joints[j].origin);
-                f = self.joint_step(&f, j, x);
-                if let Some(i) = self.joints[j].axis_index {
-                    axis_frames[i] = (before, j);
-                }
-            }
-            let e_p = sub(target.t, f.t);
-            let e_r = rotation_vector(&mat_mul(&target.r, &transpose(&f.r)));
-            ep = norm(e_p);
-            er = norm(e_r);
+        let split = |e: &[f64; 6]| (norm([e[0], e[1], e[2]]), norm([e[3], e[4], e[5]]));
+        let sq = |e: &[f64; 6]| e.iter().map(|v| v * v).sum::<f64>();
+        let mut jac = [[0.0f64; MAX_AXES]; 6];
+        let mut e = self.residual(target, x, &mut jac);
+        // Sugihara's damping: λ = ½|e|² + w̄ keeps steps well conditioned at singularities
+        // and at the edge of the workspace; `bias` grows when a step fails to help.
+        let mut bias: f64 = 1e-6;
+        let mut trial = [0.0f64; MAX_AXES];
+        let mut trial_jac = [[0.0f64; MAX_AXES]; 6];
+        for _ in 0..ITERATIONS {
+            let (ep, er) = split(&e);
             if ep < 1e-10 && er < 1e-10 {
                 break;
             }
-            let err = ep + er;
-            lambda = if err < last {
-                (lambda * 0.5).max(1e-9)
-            } else {
-                (lambda * 4.0).min(1.0)
-            };
-            last = err;
-            // Jacobian 6×n.
-            let mut jac = [[0.0f64; MAX_AXES]; 6];
-            for i in 0..n {
-                let (fr, j) = axis_frames[i];
-                let joint = &self.joints[j];
-                let z = mat_vec(&fr.r, joint.dir.vector());
-                let (lin, ang) = match joint.kind {
-                    JointKind::Prismatic => (z, [0.0; 3]),
-                    _ => (cross(z, sub(f.t, fr.t)), z),
-                };
-                for r in 0..3 {
-                    jac[r][i] = lin[r];
-                    jac[r + 3][i] = ang[r];
-                }
-            }
-            let e = [e_p[0], e_p[1], e_p[2], e_r[0], e_r[1], e_r[2]];
-            // dq = Jᵀ (J Jᵀ + λ² I)⁻¹ e
+            let lambda = sq(&e) / 2.0 + bias;
+            // dq = Jᵀ (J Jᵀ + λ I)⁻¹ e
             let mut a = nalgebra::Matrix6::<f64>::zeros();
             for r in 0..6 {
                 for c in 0..6 {
                     a[(r, c)] = (0..n).map(|k| jac[r][k] * jac[c][k]).sum::<f64>()
-                        + if r == c { lambda * lambda } else { 0.0 };
+                        + if r == c { lambda } else { 0.0 };
                 }
             }
             let Some(chol) = a.cholesky() else { break };
@@ -467,10 +474,22 @@ impl RobotModel {
             for i in 0..n {
                 let dq: f64 = (0..6).map(|r| jac[r][i] * y[r]).sum();
                 let j = self.axis(i);
-                x[i] = (x[i] + dq).clamp(j.lower, j.upper);
+                trial[i] = (x[i] + dq).clamp(j.lower, j.upper);
+            }
+            let e_new = self.residual(target, &trial[..n], &mut trial_jac);
+            if sq(&e_new) < sq(&e) {
+                x.copy_from_slice(&trial[..n]);
+                e = e_new;
+                jac = trial_jac;
+                bias = (bias / 2.0).max(1e-12);
+            } else {
+                bias *= 4.0;
+                if bias > 1e3 {
+                    break;
+                }
             }
         }
-        (ep, er)
+        split(&e)
     }
 }
 
