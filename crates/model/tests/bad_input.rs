@@ -1,0 +1,273 @@
+//! Every kind of broken robot description is an error that names the file, the element,
+//! what is wrong and what to do — never a panic.
+
+#![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)] // tests fail by panicking
+
+use std::path::{Path, PathBuf};
+
+use vworks_model::urdf::{LoadOptions, load_file};
+use vworks_model::{ModelError, builtin};
+
+fn dir() -> PathBuf {
+    let d = std::env::temp_dir().join(format!("vworks-model-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn link(name: &str) -> String {
+    format!(r#"<link name="{name}"/>"#)
+}
+
+fn joint(name: &str, ty: &str, parent: &str, child: &str, extra: &str) -> String {
+    format!(
+        r#"<joint name="{name}" type="{ty}"><parent link="{parent}"/><child link="{child}"/><origin xyz="0 0 0.1" rpy="0 0 0"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" velocity="1" effort="0"/>{extra}</joint>"#
+    )
+}
+
+fn robot(body: &str) -> String {
+    format!(r#"<?xml version="1.0"?><robot name="bad">{body}</robot>"#)
+}
+
+fn load(file: &str, text: &str) -> Result<vworks_model::RobotModel, ModelError> {
+    let d = dir();
+    let p = d.join(file);
+    std::fs::write(&p, text).unwrap();
+    load_file(&p, &LoadOptions::default())
+}
+
+fn expect_error(
+    case: &str,
+    r: Result<vworks_model::RobotModel, ModelError>,
+    file: &str,
+    needles: &[&str],
+) {
+    let e = match r {
+        Ok(_) => panic!("{case}: should fail"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        e.contains(file),
+        "{case}: the message must name the file {file}: {e}"
+    );
+    for n in needles {
+        assert!(e.contains(n), "{case}: expected {n:?} in: {e}");
+    }
+}
+
+#[test]
+fn missing_file() {
+    let p = dir().join("nowhere.urdf");
+    expect_error(
+        "missing file",
+        load_file(&p, &LoadOptions::default()),
+        "nowhere.urdf",
+        &["cannot read"],
+    );
+}
+
+#[test]
+fn bad_xml() {
+    expect_error(
+        "bad xml",
+        load("badxml.urdf", "<robot name=\"x\"><link name=\"a\"></robot"),
+        "badxml.urdf",
+        &["not a valid URDF"],
+    );
+}
+
+#[test]
+fn unknown_joint_type() {
+    let t = robot(&(link("a") + &link("b") + &joint("j_weird", "banana", "a", "b", "")));
+    expect_error(
+        "unknown type",
+        load("type.urdf", &t),
+        "type.urdf",
+        &["joint `j_weird`", "unknown joint type `banana`", "revolute"],
+    );
+    let t = robot(&(link("a") + &link("b") + &joint("j_float", "floating", "a", "b", "")));
+    expect_error(
+        "floating",
+        load("float.urdf", &t),
+        "float.urdf",
+        &["joint `j_float`", "not supported"],
+    );
+}
+
+#[test]
+fn cycle_in_the_tree() {
+    // base is the root; a and b point at each other and hang off nothing.
+    let t = robot(
+        &(link("base")
+            + &link("a")
+            + &link("b")
+            + &joint("ab", "revolute", "a", "b", "")
+            + &joint("ba", "revolute", "b", "a", "")),
+    );
+    expect_error("cycle", load("cycle.urdf", &t), "cycle.urdf", &["cycle"]);
+    // Without any root at all.
+    let t = robot(
+        &(link("a")
+            + &link("b")
+            + &joint("ab", "revolute", "a", "b", "")
+            + &joint("ba", "revolute", "b", "a", "")),
+    );
+    expect_error(
+        "cycle, no root",
+        load("cycle2.urdf", &t),
+        "cycle2.urdf",
+        &["cycle"],
+    );
+    // A link with two parents.
+    let t = robot(
+        &(link("a")
+            + &link("b")
+            + &link("c")
+            + &joint("ac", "revolute", "a", "c", "")
+            + &joint("bc", "revolute", "b", "c", "")),
+    );
+    expect_error(
+        "two parents",
+        load("parents.urdf", &t),
+        "parents.urdf",
+        &["joint `bc`", "already has the parent joint `ac`"],
+    );
+}
+
+#[test]
+fn two_roots() {
+    let t = robot(&(link("a") + &link("b") + &link("c") + &joint("ab", "revolute", "a", "b", "")));
+    expect_error(
+        "two roots",
+        load("roots.urdf", &t),
+        "roots.urdf",
+        &["2 roots", "a, c"],
+    );
+}
+
+#[test]
+fn missing_mesh() {
+    let body = r#"<link name="a"><collision><geometry><mesh filename="package://arm/meshes/a.stl"/></geometry></collision></link>"#;
+    expect_error(
+        "missing mesh",
+        load("mesh.urdf", &robot(body)),
+        "mesh.urdf",
+        &[
+            "link `a` collision 1",
+            "package://arm/meshes/a.stl",
+            "not found",
+            "search path",
+        ],
+    );
+    // A mesh that exists but is not a mesh.
+    let d = dir();
+    std::fs::write(d.join("junk.stl"), b"this is not an stl").unwrap();
+    let body = r#"<link name="a"><collision><geometry><mesh filename="junk.stl"/></geometry></collision></link>"#;
+    expect_error(
+        "junk mesh",
+        load("junk.urdf", &robot(body)),
+        "junk.urdf",
+        &["junk.stl", "not an STL"],
+    );
+}
+
+#[test]
+fn nan_or_inf_in_an_origin() {
+    let j = joint("j2", "revolute", "a", "b", "").replace(r#"xyz="0 0 0.1""#, r#"xyz="0 nan 0.1""#);
+    expect_error(
+        "nan",
+        load("nan.urdf", &robot(&(link("a") + &link("b") + &j))),
+        "nan.urdf",
+        &["joint `j2`", "<origin>", "finite"],
+    );
+    let j = joint("j3", "revolute", "a", "b", "").replace(r#"rpy="0 0 0""#, r#"rpy="0 inf 0""#);
+    expect_error(
+        "inf",
+        load("inf.urdf", &robot(&(link("a") + &link("b") + &j))),
+        "inf.urdf",
+        &["joint `j3`", "<origin>", "finite"],
+    );
+}
+
+#[test]
+fn zero_axis() {
+    let j = joint("j4", "revolute", "a", "b", "")
+        .replace(r#"<axis xyz="0 0 1"/>"#, r#"<axis xyz="0 0 0"/>"#);
+    expect_error(
+        "zero axis",
+        load("axis.urdf", &robot(&(link("a") + &link("b") + &j))),
+        "axis.urdf",
+        &["joint `j4`", "<axis xyz>", "non-zero"],
+    );
+}
+
+#[test]
+fn more_mistakes() {
+    let j = joint("j5", "revolute", "a", "nowhere", "");
+    expect_error(
+        "missing child",
+        load("child.urdf", &robot(&(link("a") + &j))),
+        "child.urdf",
+        &["joint `j5`", "child link `nowhere`"],
+    );
+    let j = joint("j6", "revolute", "a", "b", "").replace(r#"velocity="1""#, r#"velocity="0""#);
+    expect_error(
+        "no velocity",
+        load("vel.urdf", &robot(&(link("a") + &link("b") + &j))),
+        "vel.urdf",
+        &["joint `j6`", "velocity"],
+    );
+    let j = joint("j7", "revolute", "a", "b", "")
+        .replace(r#"lower="-1" upper="1""#, r#"lower="1" upper="-1""#);
+    expect_error(
+        "inverted limits",
+        load("lim.urdf", &robot(&(link("a") + &link("b") + &j))),
+        "lim.urdf",
+        &["joint `j7`", "lower"],
+    );
+    let body = link("a")
+        + &link("b")
+        + &link("c")
+        + &joint("ab", "revolute", "a", "b", "")
+        + &joint("ac", "revolute", "a", "c", "");
+    expect_error(
+        "branching",
+        load("branch.urdf", &robot(&body)),
+        "branch.urdf",
+        &["branches", "name the tool link", "b, c"],
+    );
+    let body = r#"<link name="a"><collision><geometry><box size="0.1 -0.2 0.1"/></geometry></collision></link>"#;
+    expect_error(
+        "negative box",
+        load("box.urdf", &robot(body)),
+        "box.urdf",
+        &["link `a` collision 1", "box size"],
+    );
+    let e = builtin::load("irb9999")
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(e.contains("irb9999") && e.contains("irb120"), "{e}");
+}
+
+#[test]
+fn branching_tree_loads_with_a_named_tool() {
+    let body = link("a")
+        + &link("b")
+        + &link("c")
+        + &joint("ab", "revolute", "a", "b", "")
+        + &joint("ac", "prismatic", "a", "c", "");
+    let d = dir();
+    let p = d.join("branch_ok.urdf");
+    std::fs::write(&p, robot(&body)).unwrap();
+    let m = load_file(
+        Path::new(&p),
+        &LoadOptions {
+            tool_link: Some("c".into()),
+            package_paths: vec![],
+        },
+    )
+    .unwrap();
+    assert_eq!(m.dof(), 1);
+    assert_eq!(m.axis(0).name, "ac");
+    assert_eq!(m.linear_axes(), 1);
+}
