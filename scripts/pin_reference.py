@@ -62,8 +62,23 @@ def chain_end(model):
         frame = kids[0]
 
 
+def quiet_build(path):
+    """buildModelFromUrdf, without urdfdom's complaints about <capsule> collision elements
+    (the kinematic model does not need collision geometry)."""
+    sys.stderr.flush()
+    saved = os.dup(2)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, 2)
+    try:
+        return pin.buildModelFromUrdf(path)
+    finally:
+        os.dup2(saved, 2)
+        os.close(devnull)
+        os.close(saved)
+
+
 def reference(name, where, rel, tool):
-    model = pin.buildModelFromUrdf(urdf_file(where, rel))
+    model = quiet_build(urdf_file(where, rel))
     data = model.createData()
     tool = tool or chain_end(model)
     tool_joint = model.frames[model.getFrameId(tool)].parentJoint

@@ -290,11 +290,11 @@ impl RobotModel {
         let mut limit_detail = String::new();
         'cand: for s in raw.iter().take(n) {
             let mut q = *s;
-            for i in 0..6 {
+            for (i, qi) in q.iter_mut().enumerate() {
                 let j = self.axis(i);
                 let cur = current.get(i).copied().unwrap_or(0.0);
                 // Whole turns toward the current value, then into the limits if possible.
-                let mut v = q[i] + (2.0 * PI) * ((cur - q[i]) / (2.0 * PI)).round();
+                let mut v = *qi + (2.0 * PI) * ((cur - *qi) / (2.0 * PI)).round();
                 while v > j.upper + 1e-9 && v - 2.0 * PI >= j.lower - 1e-9 {
                     v -= 2.0 * PI;
                 }
@@ -314,7 +314,7 @@ impl RobotModel {
                     }
                     continue 'cand;
                 }
-                q[i] = v;
+                *qi = v;
             }
             // Guard: the solution must reproduce the pose.
             let (dp, dr) = pose_error(&self.flange(&q), target);
@@ -380,9 +380,9 @@ impl RobotModel {
         let mut rng = 0x9e37_79b9_7f4a_7c15u64;
         for attempt in 0..RESTARTS {
             let mut x = [0.0; MAX_AXES];
-            for i in 0..n {
+            for (i, xi) in x.iter_mut().enumerate().take(n) {
                 let j = self.axis(i);
-                x[i] = if attempt == 0 {
+                *xi = if attempt == 0 {
                     seed.get(i).copied().unwrap_or(0.0)
                 } else {
                     rng ^= rng << 13;
@@ -392,7 +392,7 @@ impl RobotModel {
                     let (lo, hi) = (j.lower.max(-PI), j.upper.min(PI));
                     lo + u * (hi - lo)
                 };
-                x[i] = x[i].clamp(j.lower, j.upper);
+                *xi = xi.clamp(j.lower, j.upper);
             }
             let (ep, er) = self.dls(target, &mut x[..n]);
             if ep < 1e-10 && er < 1e-10 {

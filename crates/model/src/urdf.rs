@@ -462,7 +462,7 @@ fn geometry(
             }
         }
         urdf_rs::Geometry::Capsule { radius, length } => {
-            if !positive(&[*radius]) || !(length.is_finite() && *length >= 0.0) {
+            if !(positive(&[*radius]) && length.is_finite() && *length >= 0.0) {
                 return Err(bad("capsule radius and length"));
             }
             Geometry::Capsule {

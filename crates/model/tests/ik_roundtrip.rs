@@ -62,3 +62,53 @@ fn ik_round_trips_on_10000_poses_per_model() {
         assert!(rate >= 0.999, "{name}: only {solved} of {N} solved");
     }
 }
+
+#[test]
+fn each_ik_failure_names_the_pose_and_why() {
+    use vworks_model::IkError;
+    let irb = builtin::load("irb120").unwrap();
+    let ur5 = builtin::load("ur5").unwrap();
+    let mut q = [0.0; 6];
+    // Out of reach (analytic).
+    let mut far = irb.flange(&[0.0; 6]);
+    far.t = [2.5, 0.0, 0.3];
+    let e = irb.ik(&far, &[0.0; 6], &mut q).unwrap_err();
+    assert!(matches!(e, IkError::OutOfReach { .. }), "{e}");
+    assert!(
+        e.to_string().contains("x 2.5000 m") && e.to_string().contains("out of reach"),
+        "{e}"
+    );
+    // Reachable only outside the limits: axis 3 at 100° (its limit is +70°) puts the
+    // wrist where no in-limit configuration reaches; search a few such poses.
+    let mut rng = Rng(99);
+    let mut found = None;
+    for _ in 0..200 {
+        let truth = [
+            rng.unit() - 0.5,
+            rng.unit() - 0.5,
+            100f64.to_radians(),
+            rng.unit() - 0.5,
+            0.5 + rng.unit(),
+            rng.unit(),
+        ];
+        if let Err(e @ IkError::JointLimits { .. }) = irb.ik(&irb.flange(&truth), &[0.0; 6], &mut q)
+        {
+            found = Some(e);
+            break;
+        }
+    }
+    let e = found.expect("some pose is reachable only outside the limits");
+    assert!(
+        e.to_string().contains("outside its joint limits") && e.to_string().contains("limits"),
+        "{e}"
+    );
+    // Numeric: no convergence, with the remaining error.
+    let mut far = ur5.flange(&[0.0; 6]);
+    far.t = [3.0, 0.0, 0.0];
+    let e = ur5.ik(&far, &[0.0; 6], &mut q).unwrap_err();
+    assert!(matches!(e, IkError::NoConvergence { .. }), "{e}");
+    assert!(
+        e.to_string().contains("x 3.0000 m") && e.to_string().contains("singularity"),
+        "{e}"
+    );
+}
