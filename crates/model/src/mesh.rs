@@ -62,29 +62,19 @@ fn stl(b: &[u8]) -> Result<Vec<V3>, String> {
     if !text.trim_start().starts_with("solid") {
         return Err("not an STL file: a binary STL's size must match its triangle count, an ASCII STL starts with `solid`".into());
     }
-    let mut pts = Vec::new();
-    for (i, line) in text.lines().enumerate() {
-        let mut w = line.split_whitespace();
-        if w.next() == Some("vertex") {
-            let v: Vec<f64> = w
-                .map(|x| x.parse::<f64>())
-                .collect::<Result<_, _>>()
-                .map_err(|e| format!("line {}: {e}", i + 1))?;
-            if v.len() != 3 {
-                return Err(format!("line {}: a vertex needs 3 coordinates", i + 1));
-            }
-            pts.push([v[0], v[1], v[2]]);
-        }
-    }
-    Ok(pts)
+    vertex_lines(text, "vertex")
 }
 
 fn obj(b: &[u8]) -> Result<Vec<V3>, String> {
-    let text = String::from_utf8_lossy(b);
+    vertex_lines(&String::from_utf8_lossy(b), "v")
+}
+
+/// The coordinates of every line `KEYWORD x y z` (OBJ may add a 4th, w, which is ignored).
+fn vertex_lines(text: &str, keyword: &str) -> Result<Vec<V3>, String> {
     let mut pts = Vec::new();
     for (i, line) in text.lines().enumerate() {
         let mut w = line.split_whitespace();
-        if w.next() == Some("v") {
+        if w.next() == Some(keyword) {
             let v: Vec<f64> = w
                 .take(3)
                 .map(|x| x.parse::<f64>())
