@@ -176,7 +176,8 @@ impl SphericalWrist {
 
     /// All solutions (internal angles, before limits) for a tool-link pose; returns how
     /// many were written, or the excess distance when the position is out of reach.
-    fn solve(&self, target: &Iso, out: &mut [[f64; 6]; 8]) -> Result<usize, f64> {
+    /// `q4_now` is axis 4's current (internal) angle, kept at a wrist singularity.
+    fn solve(&self, target: &Iso, q4_now: f64, out: &mut [[f64; 6]; 8]) -> Result<usize, f64> {
         let t = self.pre_inv.mul(target).mul(&self.post_inv);
         let wc = sub(t.t, mat_vec(&t.r, [self.hand, 0.0, 0.0]));
         let rho = (wc[0] * wc[0] + wc[1] * wc[1]).sqrt();
@@ -218,10 +219,13 @@ impl SphericalWrist {
                             (m[0][1] / s5).atan2(m[0][2] / s5),
                         )
                     } else {
-                        // Wrist singularity: only t4 + t6 matters; keep t4 = 0 here (the
-                        // caller shifts toward the current joints).
-                        let rest = mat_mul(&m, &transpose(&rot_y(t5)));
-                        (0.0, rest[2][1].atan2(rest[1][1]))
+                        // Wrist singularity: only t4 ± t6 matters; keep axis 4 where it is
+                        // and give axis 6 the rest, so a move through it does not jump.
+                        let rest = mat_mul(
+                            &mat_mul(&transpose(&rot_x(q4_now)), &m),
+                            &transpose(&rot_y(t5)),
+                        );
+                        (q4_now, rest[2][1].atan2(rest[1][1]))
                     };
                     if n < 8 {
                         out[n] = [t1, t2, t3, t4, t5, t6];
@@ -245,6 +249,11 @@ impl SphericalWrist {
 fn rot_z(a: f64) -> M3 {
     let (s, c) = a.sin_cos();
     [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
+}
+
+fn rot_x(a: f64) -> M3 {
+    let (s, c) = a.sin_cos();
+    [[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]]
 }
 
 fn rot_y(a: f64) -> M3 {
@@ -282,7 +291,8 @@ impl RobotModel {
     ) -> Option<Result<usize, IkError>> {
         let w = self.wrist.as_ref()?;
         let mut raw = [[0.0; 6]; 8];
-        let n = match w.solve(target, &mut raw) {
+        let q4_now = w.sign[3] * current.get(3).copied().unwrap_or(0.0);
+        let n = match w.solve(target, q4_now, &mut raw) {
             Ok(n) => n,
             Err(excess) => return Some(Err(self.out_of_reach(target, excess))),
         };
@@ -520,6 +530,29 @@ mod tests {
         // Nearest to the current joints: from q0 itself, IK returns q0.
         m.ik(&target, &q0, &mut q).unwrap_or_else(|e| panic!("{e}"));
         assert!(q.iter().zip(q0).all(|(a, b)| (a - b).abs() < 1e-9), "{q:?}");
+    }
+
+    #[test]
+    fn a_wrist_singularity_keeps_axis_4() {
+        let m = builtin::load("irb120").unwrap_or_else(|e| panic!("{e}"));
+        // Axis 5 at 0: axes 4 and 6 are aligned; only their sum is determined.
+        let truth = [0.2, -0.3, 0.4, 0.7, 0.0, -0.2];
+        let target = m.flange(&truth);
+        let current = [0.2, -0.3, 0.4, 0.5, 0.0, 0.0];
+        let mut q = [0.0; 6];
+        m.ik(&target, &current, &mut q)
+            .unwrap_or_else(|e| panic!("{e}"));
+        let (dp, dr) = super::pose_error(&m.flange(&q), &target);
+        assert!(dp < 1e-9 && dr < 1e-9, "{dp} {dr}");
+        assert!(
+            (q[3] - 0.5).abs() < 1e-9,
+            "axis 4 should stay at 0.5, got {}",
+            q[3]
+        );
+        assert!(
+            (q[3] + q[5] - 0.5).abs() < 1e-9,
+            "axes 4 + 6 carry the wrist angle: {q:?}"
+        );
     }
 
     #[test]
