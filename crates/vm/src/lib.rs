@@ -14,7 +14,10 @@
 //! documented in `docs/bytecode.md`.
 
 pub mod bytecode;
+pub mod exec;
+pub mod machine;
 pub mod math;
+pub mod motion;
 pub mod types;
 
 pub use bytecode::{Instr, LoadError, Module};

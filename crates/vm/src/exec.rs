@@ -1,0 +1,499 @@
+//! The interpreter: runs zero-time code of one thread until it reaches an event
+//! instruction (or returns from its bottom frame), without allocating per instruction.
+//!
+//! A [`Thread`] is a stack of frames over one operand stack and one locals area, both
+//! reserved up front from the module's verified `max_stack` and `frame_slots`, so pushes
+//! never reallocate in steady state. The dispatch loop counts instructions against a
+//! budget: an endless zero-time loop becomes a runtime error naming its line instead of a
+//! hang. Pure instructions run here; instructions with effects outside the thread (events)
+//! stop the loop, leaving `pc` on them.
+
+use crate::bytecode::{Cmp, Instr, Module, ProcInfo, SrcPos};
+use crate::math;
+
+/// One activation record.
+#[derive(Clone, Copy, Debug)]
+pub struct Frame {
+    /// The procedure.
+    pub proc: u32,
+    /// Where to continue in the caller (absolute pc).
+    pub ret_pc: u32,
+    /// First slot of this frame in the locals area.
+    pub base: u32,
+}
+
+/// An execution context: the main program, a handler, or a remote request.
+#[derive(Clone, Debug, Default)]
+pub struct Thread {
+    /// Frames, innermost last.
+    pub frames: Vec<Frame>,
+    /// Operand stack.
+    pub stack: Vec<u64>,
+    /// Locals of all frames.
+    pub locals: Vec<u64>,
+    /// Absolute pc of the next instruction.
+    pub pc: u32,
+}
+
+/// Why the interpreter stopped.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Stop {
+    /// At an event instruction (not executed; `pc` points at it).
+    Event(Instr),
+    /// The bottom frame returned: the thread is finished.
+    Finished,
+}
+
+/// A runtime error, with the position of the instruction that caused it.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{message}")]
+pub struct RuntimeError {
+    /// What went wrong, in plain words.
+    pub message: String,
+    /// Absolute pc of the offending instruction.
+    pub pc: u32,
+    /// Its source position.
+    pub pos: SrcPos,
+}
+
+/// What zero-time code may read from the robot and the cell.
+pub trait Reader {
+    /// The value of module global `g` (slot bits).
+    fn global(&self, g: u32) -> u64;
+    /// Simulated time (s).
+    fn now_s(&self) -> f64;
+    /// Cycle count.
+    fn cycle(&self) -> i64;
+    /// Whether the last timed wait expired.
+    fn timed_out(&self) -> bool;
+    /// The robot's joints now.
+    fn joints(&self) -> [f64; crate::MAX_AXES];
+    /// The robot's TCP now: x, y, z, rx, ry, rz.
+    fn tcp(&self) -> [f64; 6];
+    /// The robot's number of axes.
+    fn axes(&self) -> usize;
+}
+
+#[inline]
+fn f(x: u64) -> f64 {
+    f64::from_bits(x)
+}
+
+#[inline]
+fn b(x: f64) -> u64 {
+    x.to_bits()
+}
+
+impl Thread {
+    /// A thread about to run procedure `proc` whose arguments are `args` (slot values).
+    pub fn start(&mut self, m: &Module, proc: u32, args: &[u64]) {
+        self.frames.clear();
+        self.stack.clear();
+        self.locals.clear();
+        let p = &m.procs[proc as usize];
+        self.locals.extend_from_slice(args);
+        self.locals.resize(p.frame_slots as usize, 0);
+        self.frames.push(Frame {
+            proc,
+            ret_pc: u32::MAX,
+            base: 0,
+        });
+        self.pc = p.code_start;
+    }
+
+    /// Reserves room for the deepest stack and frames a run may need.
+    pub fn reserve(&mut self, m: &Module, depth: usize) {
+        let stack = m
+            .procs
+            .iter()
+            .map(|p| p.max_stack as usize)
+            .max()
+            .unwrap_or(0);
+        let frame = m
+            .procs
+            .iter()
+            .map(|p| p.frame_slots as usize)
+            .max()
+            .unwrap_or(0);
+        self.stack.reserve(stack * depth.min(64) + 64);
+        self.locals.reserve(frame * depth.min(64) + 64);
+        self.frames.reserve(depth.min(1024));
+    }
+
+    #[inline]
+    fn pop(&mut self) -> u64 {
+        self.stack.pop().unwrap_or(0)
+    }
+
+    /// Pops `n` slots into the front of `out`.
+    pub fn pop_n(&mut self, n: usize, out: &mut [u64]) {
+        let at = self.stack.len().saturating_sub(n);
+        for (o, v) in out.iter_mut().zip(self.stack.drain(at..)) {
+            *o = v;
+        }
+    }
+
+    fn frame(&self) -> Frame {
+        self.frames.last().copied().unwrap_or(Frame {
+            proc: 0,
+            ret_pc: u32::MAX,
+            base: 0,
+        })
+    }
+
+    /// Runs until an event instruction or the end of the bottom frame. `budget` counts
+    /// down per instruction; at zero the run fails with the line of the loop.
+    pub fn run(
+        &mut self,
+        m: &Module,
+        r: &dyn Reader,
+        vars: &mut [u64],
+        budget: &mut u64,
+        max_depth: usize,
+    ) -> Result<Stop, RuntimeError> {
+        let err = |pc: u32, message: String| RuntimeError {
+            message,
+            pc,
+            pos: m.pos_of(pc),
+        };
+        loop {
+            let pc = self.pc;
+            let Some(&ins) = m.code.get(pc as usize) else {
+                return Err(err(
+                    pc,
+                    "the program ran past its code (a corrupt module)".into(),
+                ));
+            };
+            if *budget == 0 {
+                return Err(err(
+                    pc,
+                    "this loop ran the instruction budget out without time passing (an endless zero-time loop); add a motion, a delay or a wait inside it".into(),
+                ));
+            }
+            *budget -= 1;
+            self.pc = pc + 1;
+            let base = self.frame().base as usize;
+            match ins {
+                Instr::Nop | Instr::ParBegin => {}
+                Instr::PushBool(v) => self.stack.push(u64::from(v)),
+                Instr::PushInt(i) => self.stack.push(i as u64),
+                Instr::PushNum(x) => self.stack.push(b(x)),
+                Instr::PushConst(k) => {
+                    let c = &m.consts[k as usize];
+                    let w = c.ty.width() as usize;
+                    let at = self.stack.len();
+                    self.stack.resize(at + w, 0);
+                    c.value.write_slots(&mut self.stack[at..]);
+                }
+                Instr::Pop(n) => {
+                    let l = self.stack.len().saturating_sub(n as usize);
+                    self.stack.truncate(l);
+                }
+                Instr::LoadLocal(s) => {
+                    let v = self.locals[base + s as usize];
+                    self.stack.push(v);
+                }
+                Instr::StoreLocal(s) => {
+                    let v = self.pop();
+                    self.locals[base + s as usize] = v;
+                }
+                Instr::LoadLocalN(s, n) => {
+                    let at = base + s as usize;
+                    self.stack
+                        .extend_from_slice(&self.locals[at..at + n as usize]);
+                }
+                Instr::StoreLocalN(s, n) => {
+                    let at = base + s as usize;
+                    let from = self.stack.len() - n as usize;
+                    self.locals[at..at + n as usize].copy_from_slice(&self.stack[from..]);
+                    self.stack.truncate(from);
+                }
+                Instr::StoreLocalJoint(s) => {
+                    let i = self.pop() as i64;
+                    let v = self.pop();
+                    let i = self.joint_index(i, r.axes()).map_err(|e| err(pc, e))?;
+                    self.locals[base + s as usize + i] = v;
+                }
+                Instr::LoadVar(s) => self.stack.push(vars[s as usize]),
+                Instr::StoreVar(s) => vars[s as usize] = self.pop(),
+                Instr::LoadVarN(s, n) => self
+                    .stack
+                    .extend_from_slice(&vars[s as usize..s as usize + n as usize]),
+                Instr::StoreVarN(s, n) => {
+                    let from = self.stack.len() - n as usize;
+                    vars[s as usize..s as usize + n as usize].copy_from_slice(&self.stack[from..]);
+                    self.stack.truncate(from);
+                }
+                Instr::StoreVarJoint(s) => {
+                    let i = self.pop() as i64;
+                    let v = self.pop();
+                    let i = self.joint_index(i, r.axes()).map_err(|e| err(pc, e))?;
+                    vars[s as usize + i] = v;
+                }
+                Instr::LoadGlobal(g) => self.stack.push(r.global(g)),
+                Instr::AddI | Instr::SubI | Instr::MulI | Instr::DivI | Instr::ModI => {
+                    let y = self.pop() as i64;
+                    let x = self.pop() as i64;
+                    let v = match ins {
+                        Instr::AddI => x.checked_add(y),
+                        Instr::SubI => x.checked_sub(y),
+                        Instr::MulI => x.checked_mul(y),
+                        Instr::DivI => x.checked_div(y),
+                        _ => x.checked_rem(y),
+                    };
+                    let Some(v) = v else {
+                        let why = if y == 0 && matches!(ins, Instr::DivI | Instr::ModI) {
+                            "division by zero"
+                        } else {
+                            "integer overflow"
+                        };
+                        return Err(err(pc, format!("{why} ({x} and {y})")));
+                    };
+                    self.stack.push(v as u64);
+                }
+                Instr::NegI => {
+                    let x = self.pop() as i64;
+                    let v = x
+                        .checked_neg()
+                        .ok_or_else(|| err(pc, "integer overflow".into()))?;
+                    self.stack.push(v as u64);
+                }
+                Instr::AddF | Instr::SubF | Instr::MulF | Instr::DivF => {
+                    let y = f(self.pop());
+                    let x = f(self.pop());
+                    if matches!(ins, Instr::DivF) && y == 0.0 {
+                        return Err(err(pc, "division by zero".into()));
+                    }
+                    let v = match ins {
+                        Instr::AddF => x + y,
+                        Instr::SubF => x - y,
+                        Instr::MulF => x * y,
+                        _ => x / y,
+                    };
+                    if !v.is_finite() {
+                        return Err(err(pc, "a number became too large (not finite)".into()));
+                    }
+                    self.stack.push(b(v));
+                }
+                Instr::NegF => {
+                    let x = f(self.pop());
+                    self.stack.push(b(-x));
+                }
+                Instr::IntToNum => {
+                    let x = self.pop() as i64;
+                    self.stack.push(b(x as f64));
+                }
+                Instr::IntToNumBelow => {
+                    let top = self.pop();
+                    let x = self.pop() as i64;
+                    self.stack.push(b(x as f64));
+                    self.stack.push(top);
+                }
+                Instr::NumToInt => {
+                    let x = f(self.pop()).trunc();
+                    if !(x.is_finite() && x.abs() < 9.2e18) {
+                        return Err(err(pc, format!("{x} does not fit in an int")));
+                    }
+                    self.stack.push(x as i64 as u64);
+                }
+                Instr::CmpI(c) => {
+                    let y = self.pop() as i64;
+                    let x = self.pop() as i64;
+                    self.stack.push(u64::from(cmp(c, x.cmp(&y))));
+                }
+                Instr::CmpF(c) => {
+                    let y = f(self.pop());
+                    let x = f(self.pop());
+                    let v = x.partial_cmp(&y).is_some_and(|o| cmp(c, o));
+                    self.stack.push(u64::from(v));
+                }
+                Instr::CmpB(c) => {
+                    let y = self.pop() != 0;
+                    let x = self.pop() != 0;
+                    self.stack.push(u64::from((x == y) == (c == Cmp::Eq)));
+                }
+                Instr::Not => {
+                    let x = self.pop();
+                    self.stack.push(u64::from(x == 0));
+                }
+                Instr::AbsI => {
+                    let x = self.pop() as i64;
+                    let v = x
+                        .checked_abs()
+                        .ok_or_else(|| err(pc, "integer overflow".into()))?;
+                    self.stack.push(v as u64);
+                }
+                Instr::AbsF => {
+                    let x = f(self.pop());
+                    self.stack.push(b(x.abs()));
+                }
+                Instr::MinI | Instr::MaxI => {
+                    let y = self.pop() as i64;
+                    let x = self.pop() as i64;
+                    self.stack.push(if matches!(ins, Instr::MinI) {
+                        x.min(y)
+                    } else {
+                        x.max(y)
+                    } as u64);
+                }
+                Instr::MinF | Instr::MaxF | Instr::Atan2 => {
+                    let y = f(self.pop());
+                    let x = f(self.pop());
+                    let v = match ins {
+                        Instr::MinF => x.min(y),
+                        Instr::MaxF => x.max(y),
+                        _ => x.atan2(y),
+                    };
+                    self.stack.push(b(v));
+                }
+                Instr::Sqrt => {
+                    let x = f(self.pop());
+                    if x < 0.0 {
+                        return Err(err(
+                            pc,
+                            format!("the square root of a negative number ({x})"),
+                        ));
+                    }
+                    self.stack.push(b(x.sqrt()));
+                }
+                Instr::Sin | Instr::Cos => {
+                    let x = f(self.pop());
+                    self.stack.push(b(if matches!(ins, Instr::Sin) {
+                        x.sin()
+                    } else {
+                        x.cos()
+                    }));
+                }
+                Instr::MakeJoints(n) => {
+                    let at = self.stack.len();
+                    self.stack.resize(at - n as usize + crate::MAX_AXES, 0);
+                }
+                Instr::JointsGet => {
+                    let i = self.pop() as i64;
+                    let i = self.joint_index(i, r.axes()).map_err(|e| err(pc, e))?;
+                    let at = self.stack.len() - crate::MAX_AXES;
+                    let v = self.stack[at + i];
+                    self.stack.truncate(at);
+                    self.stack.push(v);
+                }
+                Instr::PoseGet(k) => {
+                    let at = self.stack.len() - 6;
+                    let v = self.stack[at + k as usize];
+                    self.stack.truncate(at);
+                    self.stack.push(v);
+                }
+                Instr::Offset | Instr::ToolOffset => {
+                    let dz = f(self.pop());
+                    let dy = f(self.pop());
+                    let dx = f(self.pop());
+                    let at = self.stack.len() - 6;
+                    let mut p = [0.0; 6];
+                    for (k, v) in p.iter_mut().enumerate() {
+                        *v = f(self.stack[at + k]);
+                    }
+                    let q = if matches!(ins, Instr::Offset) {
+                        math::offset(p, dx, dy, dz)
+                    } else {
+                        math::tool_offset(p, dx, dy, dz)
+                    };
+                    for (k, v) in q.iter().enumerate() {
+                        self.stack[at + k] = b(*v);
+                    }
+                }
+                Instr::Jump(t) => self.pc = self.frame_start(m) + t,
+                Instr::JumpIfFalse(t) => {
+                    if self.pop() == 0 {
+                        self.pc = self.frame_start(m) + t;
+                    }
+                }
+                Instr::JumpIfTrue(t) => {
+                    if self.pop() != 0 {
+                        self.pc = self.frame_start(m) + t;
+                    }
+                }
+                Instr::Call(p) => {
+                    if self.frames.len() >= max_depth {
+                        return Err(err(
+                            pc,
+                            format!("calls nested more than {max_depth} deep (runaway recursion?)"),
+                        ));
+                    }
+                    let callee: &ProcInfo = &m.procs[p as usize];
+                    let nargs = callee.param_width() as usize;
+                    let new_base = self.frame().base as usize
+                        + m.procs[self.frame().proc as usize].frame_slots as usize;
+                    self.locals
+                        .resize(new_base + callee.frame_slots as usize, 0);
+                    let from = self.stack.len() - nargs;
+                    self.locals[new_base..new_base + nargs].copy_from_slice(&self.stack[from..]);
+                    self.locals[new_base + nargs..]
+                        .iter_mut()
+                        .for_each(|v| *v = 0);
+                    self.stack.truncate(from);
+                    self.frames.push(Frame {
+                        proc: p,
+                        ret_pc: pc + 1,
+                        base: new_base as u32,
+                    });
+                    self.pc = callee.code_start;
+                }
+                Instr::Ret | Instr::RetVal => {
+                    let fr = self.frames.pop().unwrap_or(Frame {
+                        proc: 0,
+                        ret_pc: u32::MAX,
+                        base: 0,
+                    });
+                    self.locals.truncate(fr.base as usize);
+                    if self.frames.is_empty() || fr.ret_pc == u32::MAX {
+                        self.frames.clear();
+                        return Ok(Stop::Finished);
+                    }
+                    self.pc = fr.ret_pc;
+                }
+                Instr::Now => self.stack.push(b(r.now_s())),
+                Instr::Cycle => self.stack.push(r.cycle() as u64),
+                Instr::TimedOut => self.stack.push(u64::from(r.timed_out())),
+                Instr::CurrentJoints => {
+                    let j = r.joints();
+                    self.stack.extend(j.iter().map(|x| b(*x)));
+                }
+                Instr::CurrentPose => {
+                    let p = r.tcp();
+                    self.stack.extend(p.iter().map(|x| b(*x)));
+                }
+                _ => {
+                    // An event: stop before it.
+                    self.pc = pc;
+                    *budget += 1;
+                    return Ok(Stop::Event(ins));
+                }
+            }
+        }
+    }
+
+    fn frame_start(&self, m: &Module) -> u32 {
+        m.procs[self.frame().proc as usize].code_start
+    }
+
+    fn joint_index(&self, i: i64, axes: usize) -> Result<usize, String> {
+        if i < 0 || i as usize >= axes {
+            return Err(format!(
+                "joint index {i} is out of range: this robot has axes 0 to {}",
+                axes.saturating_sub(1)
+            ));
+        }
+        Ok(i as usize)
+    }
+}
+
+fn cmp(c: Cmp, o: std::cmp::Ordering) -> bool {
+    use std::cmp::Ordering::*;
+    match c {
+        Cmp::Eq => o == Equal,
+        Cmp::Ne => o != Equal,
+        Cmp::Lt => o == Less,
+        Cmp::Le => o != Greater,
+        Cmp::Gt => o == Greater,
+        Cmp::Ge => o != Less,
+    }
+}

@@ -1,0 +1,1097 @@
+//! One robot's virtual machine: the paper's VM, driven by the simulation engine.
+//!
+//! The VM runs a stretch of independent work at once and stops *before* the next event.
+//! [`Vm::next_event`] returns that event (kind, time, source position) without performing
+//! it, and returns the same event until [`Vm::perform`] executes it, when the SE decides
+//! it is that event's turn. Zero-time work never advances time; time passes only in
+//! motions, delays and waits. The robot's joints are a pure function of time inside a
+//! motion ([`Vm::joints_at`]), so the SE can sample every robot at every cycle boundary.
+
+use std::sync::Arc;
+
+use vworks_model::math::Iso;
+use vworks_model::{IkError, RobotModel};
+
+use crate::MAX_AXES;
+use crate::bytecode::{Instr, LogPart, Module, MoveFlags, SrcPos};
+use crate::exec::{Reader, RuntimeError, Stop, Thread};
+use crate::motion::{NS, Path, Profile, cartesian_at};
+use crate::types::{Dim, Type, fmt_quantity};
+
+/// Settings of one VM.
+#[derive(Clone, Debug)]
+pub struct VmConfig {
+    /// Instructions a segment may run without time passing (default 10 million).
+    pub budget: u64,
+    /// Deepest call nesting (default 256).
+    pub max_depth: usize,
+    /// The cycle period (ns), for `cycle()`.
+    pub cycle_ns: i64,
+    /// Speed of `move_l`/`move_c` without `speed` (m/s).
+    pub default_speed: f64,
+    /// TCP in the tool-link frame.
+    pub tool: Iso,
+    /// Joints at the start.
+    pub start_joints: Vec<f64>,
+}
+
+impl Default for VmConfig {
+    fn default() -> VmConfig {
+        VmConfig {
+            budget: 10_000_000,
+            max_depth: 256,
+            cycle_ns: 4_000_000,
+            default_speed: 0.25,
+            tool: Iso::IDENTITY,
+            start_joints: Vec::new(),
+        }
+    }
+}
+
+/// What an event is.
+#[derive(Clone, Debug, PartialEq)]
+pub enum EventKind {
+    /// A motion begins; it ends `duration_ns` later.
+    MotionStart {
+        /// `move_j`, `move_l` or `move_c`.
+        command: &'static str,
+        /// Exact duration.
+        duration_ns: i64,
+    },
+    /// The motion reached its target.
+    MotionEnd,
+    /// The robot holds still for `duration_ns`.
+    Delay {
+        /// How long.
+        duration_ns: i64,
+    },
+    /// The delay is over.
+    DelayEnd,
+    /// A global is assigned (module global index and the new value's slot bits).
+    Set {
+        /// Index in the module's global table.
+        global: u32,
+        /// The value.
+        value: u64,
+        /// Its type.
+        ty: Type,
+    },
+    /// The robot starts waiting for a condition (index into the module's conditions).
+    WaitUntil {
+        /// The condition.
+        cond: u32,
+        /// Deadline (absolute ns) if a timeout was given.
+        deadline: Option<i64>,
+    },
+    /// The robot starts waiting for a signal (string index of its name).
+    WaitSignal {
+        /// Signal name (string index).
+        name: u32,
+        /// Deadline (absolute ns) if a timeout was given.
+        deadline: Option<i64>,
+    },
+    /// The wait is over.
+    WaitEnd {
+        /// It ended by timeout.
+        timed_out: bool,
+    },
+    /// A signal is sent (signal site index).
+    Signal {
+        /// The site (receiver and name).
+        site: u32,
+    },
+    /// A part is attached to the tool (part site index).
+    Grip {
+        /// The site.
+        site: u32,
+    },
+    /// A part is detached (part site index).
+    Release {
+        /// The site.
+        site: u32,
+    },
+    /// A `log` message.
+    Log {
+        /// The text.
+        text: String,
+    },
+    /// A runtime error or `fail`: the simulation stops.
+    Error {
+        /// The message.
+        message: String,
+    },
+    /// The program ended.
+    End,
+}
+
+impl EventKind {
+    /// The kind's name in event traces.
+    pub fn name(&self) -> &'static str {
+        match self {
+            EventKind::MotionStart { .. } => "motion_start",
+            EventKind::MotionEnd => "motion_end",
+            EventKind::Delay { .. } => "delay",
+            EventKind::DelayEnd => "delay_end",
+            EventKind::Set { .. } => "set",
+            EventKind::WaitUntil { .. } | EventKind::WaitSignal { .. } => "wait_until",
+            EventKind::WaitEnd { .. } => "wait_end",
+            EventKind::Signal { .. } => "signal",
+            EventKind::Grip { .. } => "grip",
+            EventKind::Release { .. } => "release",
+            EventKind::Log { .. } => "log",
+            EventKind::Error { .. } => "error",
+            EventKind::End => "end",
+        }
+    }
+}
+
+/// An event of this VM.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Event {
+    /// Simulated time (ns).
+    pub time: i64,
+    /// What.
+    pub kind: EventKind,
+    /// The statement that caused it.
+    pub pos: SrcPos,
+}
+
+/// What the VM does after its current event.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Next {
+    /// This event, at its time.
+    Event(Event),
+    /// Nothing until the SE releases a wait (a condition or a signal).
+    Blocked,
+    /// The program has ended (or failed).
+    Done,
+}
+
+/// The operands of a motion instruction.
+struct MotionOperands {
+    /// Target slots (6 for a pose, 12 for joints).
+    target: Vec<u64>,
+    /// Via point slots of `move_c`.
+    via: Option<Vec<u64>>,
+    /// `speed`, if given.
+    speed: Option<f64>,
+    /// `accel`, if given.
+    accel: Option<f64>,
+    /// Slots they take on the stack.
+    width: usize,
+}
+
+/// A planned motion.
+#[derive(Clone, Debug)]
+enum Trajectory {
+    /// Joint-space: each axis from `from` by `delta` along a shared normalised profile.
+    Joint {
+        from: [f64; MAX_AXES],
+        delta: [f64; MAX_AXES],
+        profile: Profile,
+    },
+    /// Cartesian: the TCP along `path`, orientation by slerp; joints by IK.
+    Cartesian {
+        path: Path,
+        from: Iso,
+        to: Iso,
+        profile: Profile,
+        end_joints: [f64; MAX_AXES],
+    },
+}
+
+#[derive(Clone, Debug, PartialEq)]
+enum State {
+    /// Must run code to find the next event.
+    Run,
+    /// Stopped before this event.
+    At(Event),
+    /// Moving until `end`.
+    Moving { end: i64, pos: SrcPos },
+    /// Holding still until `end`.
+    Delaying { end: i64, pos: SrcPos },
+    /// Waiting for a condition or a signal.
+    Waiting {
+        cond: Option<u32>,
+        signal: Option<u32>,
+        deadline: Option<i64>,
+        pos: SrcPos,
+    },
+    /// Released from a wait at `time`.
+    Released {
+        time: i64,
+        timed_out: bool,
+        pos: SrcPos,
+    },
+    /// Finished (or failed).
+    Done,
+}
+
+/// The VM of one robot.
+#[derive(Debug)]
+pub struct Vm {
+    m: Arc<Module>,
+    model: Arc<RobotModel>,
+    cfg: VmConfig,
+    main: Thread,
+    vars: Vec<u64>,
+    state: State,
+    time: i64,
+    /// Joints when not moving (at `time`, or at the start of the current motion).
+    rest: [f64; MAX_AXES],
+    motion: Option<(i64, Trajectory)>,
+    /// The motion planned by `next_event`, started by `perform`.
+    pending_motion: Option<Trajectory>,
+    timed_out: bool,
+    /// Scratch thread for evaluating conditions.
+    cond_thread: Thread,
+    /// Pending signals: (name string index, count).
+    signals: Vec<(u32, u32)>,
+    /// Globals as the SE last gave them (slot bits by module global index).
+    globals: Vec<u64>,
+    /// Warnings to report (e.g. a move slowed by an axis speed limit).
+    warnings: Vec<(i64, SrcPos, String)>,
+}
+
+struct View<'a> {
+    vm: &'a Vm,
+    t: i64,
+}
+
+impl Reader for View<'_> {
+    fn global(&self, g: u32) -> u64 {
+        self.vm.globals.get(g as usize).copied().unwrap_or(0)
+    }
+    fn now_s(&self) -> f64 {
+        self.t as f64 / NS
+    }
+    fn cycle(&self) -> i64 {
+        self.t / self.vm.cfg.cycle_ns.max(1)
+    }
+    fn timed_out(&self) -> bool {
+        self.vm.timed_out
+    }
+    fn joints(&self) -> [f64; MAX_AXES] {
+        self.vm.joints_at(self.t)
+    }
+    fn tcp(&self) -> [f64; 6] {
+        let tcp = self.vm.tcp_at(self.t);
+        let rpy = tcp.rpy();
+        [tcp.t[0], tcp.t[1], tcp.t[2], rpy[0], rpy[1], rpy[2]]
+    }
+    fn axes(&self) -> usize {
+        self.vm.model.dof()
+    }
+}
+
+fn to_iso(p: &[u64]) -> Iso {
+    let v = |i: usize| f64::from_bits(p[i]);
+    Iso::from_xyz_rpy([v(0), v(1), v(2)], [v(3), v(4), v(5)])
+}
+
+impl Vm {
+    /// A VM for `module` on `model`, about to run procedure `entry`.
+    pub fn new(m: Arc<Module>, model: Arc<RobotModel>, cfg: VmConfig, entry: u32) -> Vm {
+        let mut vars = vec![0u64; m.var_slots as usize];
+        for v in &m.vars {
+            let w = v.ty.width() as usize;
+            v.init
+                .write_slots(&mut vars[v.slot as usize..v.slot as usize + w]);
+        }
+        let globals = m
+            .globals
+            .iter()
+            .map(|g| {
+                let mut s = [0u64];
+                g.init.write_slots(&mut s);
+                s[0]
+            })
+            .collect();
+        let mut rest = [0.0; MAX_AXES];
+        for (r, q) in rest.iter_mut().zip(&cfg.start_joints) {
+            *r = *q;
+        }
+        let mut main = Thread::default();
+        main.reserve(&m, cfg.max_depth);
+        main.start(&m, entry, &[]);
+        Vm {
+            m,
+            model,
+            cfg,
+            main,
+            vars,
+            state: State::Run,
+            time: 0,
+            rest,
+            motion: None,
+            pending_motion: None,
+            timed_out: false,
+            cond_thread: Thread::default(),
+            signals: Vec::new(),
+            globals,
+            warnings: Vec::new(),
+        }
+    }
+
+    /// The module.
+    pub fn module(&self) -> &Module {
+        &self.m
+    }
+
+    /// The VM's clock: the time of the last event it performed.
+    pub fn time(&self) -> i64 {
+        self.time
+    }
+
+    /// Tells the VM a global's current value (module global index, slot bits). The SE
+    /// calls this for every robot whose module has the global, after each `set`.
+    pub fn set_global(&mut self, g: u32, value: u64) {
+        if let Some(v) = self.globals.get_mut(g as usize) {
+            *v = value;
+        }
+    }
+
+    /// Warnings produced so far (time, position, message); the SE drains them.
+    pub fn take_warnings(&mut self) -> Vec<(i64, SrcPos, String)> {
+        std::mem::take(&mut self.warnings)
+    }
+
+    /// The joints at time `t` (inside or after the current motion).
+    pub fn joints_at(&self, t: i64) -> [f64; MAX_AXES] {
+        let Some((start, traj)) = &self.motion else {
+            return self.rest;
+        };
+        let dt = (t - start) as f64 / NS;
+        match traj {
+            Trajectory::Joint {
+                from,
+                delta,
+                profile,
+            } => {
+                let s = if profile.dist > 0.0 {
+                    profile.at(dt) / profile.dist
+                } else {
+                    1.0
+                };
+                let mut q = *from;
+                for (qi, d) in q.iter_mut().zip(delta) {
+                    *qi += d * s;
+                }
+                q
+            }
+            Trajectory::Cartesian {
+                path,
+                from,
+                to,
+                profile,
+                end_joints,
+            } => {
+                if dt >= profile.t_total {
+                    return *end_joints;
+                }
+                let s = if profile.dist > 0.0 {
+                    profile.at(dt) / profile.dist
+                } else {
+                    1.0
+                };
+                let tcp = cartesian_at(path, from, to, s);
+                let flange = tcp.mul(&self.cfg.tool.inverse());
+                let mut q = [0.0; MAX_AXES];
+                // Seeded from the start joints: the nearest branch is the one the move is on.
+                let n = self.model.dof();
+                if self
+                    .model
+                    .ik(&flange, &self.rest[..n], &mut q[..n])
+                    .is_err()
+                {
+                    return self.rest;
+                }
+                q
+            }
+        }
+    }
+
+    /// The TCP pose at time `t`.
+    pub fn tcp_at(&self, t: i64) -> Iso {
+        if let Some((
+            start,
+            Trajectory::Cartesian {
+                path,
+                from,
+                to,
+                profile,
+                ..
+            },
+        )) = &self.motion
+        {
+            let dt = (t - start) as f64 / NS;
+            let s = if profile.dist > 0.0 {
+                (profile.at(dt) / profile.dist).min(1.0)
+            } else {
+                1.0
+            };
+            return cartesian_at(path, from, to, s);
+        }
+        let q = self.joints_at(t);
+        self.model.tcp(&q[..self.model.dof()], &self.cfg.tool)
+    }
+
+    fn error_event(&self, e: &RuntimeError, time: i64) -> Event {
+        Event {
+            time,
+            kind: EventKind::Error {
+                message: e.message.clone(),
+            },
+            pos: e.pos,
+        }
+    }
+
+    /// The next event of this VM (performing nothing). Calling it again returns the same
+    /// event until [`Vm::perform`] executes it.
+    pub fn next_event(&mut self) -> Next {
+        match &self.state {
+            State::Done => Next::Done,
+            State::At(e) => Next::Event(e.clone()),
+            State::Moving { end, pos } => Next::Event(Event {
+                time: *end,
+                kind: EventKind::MotionEnd,
+                pos: *pos,
+            }),
+            State::Delaying { end, pos } => Next::Event(Event {
+                time: *end,
+                kind: EventKind::DelayEnd,
+                pos: *pos,
+            }),
+            State::Waiting {
+                deadline: Some(d),
+                pos,
+                ..
+            } => Next::Event(Event {
+                time: *d,
+                kind: EventKind::WaitEnd { timed_out: true },
+                pos: *pos,
+            }),
+            State::Waiting { .. } => Next::Blocked,
+            State::Released {
+                time,
+                timed_out,
+                pos,
+            } => Next::Event(Event {
+                time: *time,
+                kind: EventKind::WaitEnd {
+                    timed_out: *timed_out,
+                },
+                pos: *pos,
+            }),
+            State::Run => {
+                let e = self.run_segment();
+                self.state = State::At(e.clone());
+                Next::Event(e)
+            }
+        }
+    }
+
+    /// Runs zero-time code up to the next event instruction and describes that event.
+    fn run_segment(&mut self) -> Event {
+        let mut budget = self.cfg.budget;
+        let t = self.time;
+        let m = Arc::clone(&self.m);
+        let mut thread = std::mem::take(&mut self.main);
+        let mut vars = std::mem::take(&mut self.vars);
+        let stop = thread.run(
+            &m,
+            &View { vm: self, t },
+            &mut vars,
+            &mut budget,
+            self.cfg.max_depth,
+        );
+        self.main = thread;
+        self.vars = vars;
+        let pc = self.main.pc;
+        let pos = m.pos_of(pc);
+        let kind = match stop {
+            Err(e) => return self.error_event(&e, t),
+            Ok(Stop::Finished) => EventKind::End,
+            Ok(Stop::Event(ins)) => match self.describe(ins, t) {
+                Ok(k) => k,
+                Err(message) => EventKind::Error { message },
+            },
+        };
+        Event { time: t, kind, pos }
+    }
+
+    fn top(&self, depth_from_top: usize) -> u64 {
+        let s = &self.main.stack;
+        s[s.len() - 1 - depth_from_top]
+    }
+
+    /// The event an instruction stands for, from the operands on the stack (not popped).
+    fn describe(&mut self, ins: Instr, t: i64) -> Result<EventKind, String> {
+        Ok(match ins {
+            Instr::StoreGlobal(g) => EventKind::Set {
+                global: g,
+                value: self.top(0),
+                ty: self.m.globals[g as usize].ty,
+            },
+            Instr::MoveJ(_) | Instr::MoveL(_) | Instr::MoveC(_) => {
+                let (traj, dur) = self.plan(ins)?;
+                self.pending_motion = Some(traj);
+                EventKind::MotionStart {
+                    command: match ins {
+                        Instr::MoveJ(_) => "move_j",
+                        Instr::MoveL(_) => "move_l",
+                        _ => "move_c",
+                    },
+                    duration_ns: dur,
+                }
+            }
+            Instr::Delay => {
+                let d = f64::from_bits(self.top(0));
+                if d.is_nan() || d < 0.0 {
+                    return Err(format!(
+                        "a delay cannot be negative ({})",
+                        fmt_quantity(d, Dim::TIME)
+                    ));
+                }
+                EventKind::Delay {
+                    duration_ns: (d * NS).round() as i64,
+                }
+            }
+            Instr::WaitUntil(c, timeout) => EventKind::WaitUntil {
+                cond: c,
+                deadline: self.deadline(timeout, t)?,
+            },
+            Instr::WaitSignal(s, timeout) => EventKind::WaitSignal {
+                name: s,
+                deadline: self.deadline(timeout, t)?,
+            },
+            Instr::Signal(s) => EventKind::Signal { site: s },
+            Instr::Grip(s) => EventKind::Grip { site: s },
+            Instr::Release(s) => EventKind::Release { site: s },
+            Instr::Log(f) | Instr::Fail(f) => {
+                let text = self.format(f);
+                if matches!(ins, Instr::Fail(_)) {
+                    EventKind::Error { message: text }
+                } else {
+                    EventKind::Log { text }
+                }
+            }
+            Instr::Stop => EventKind::End,
+            other => {
+                return Err(format!(
+                    "`{}` is not supported by this VM yet",
+                    other.name()
+                ));
+            }
+        })
+    }
+
+    /// The operands of a motion instruction, read (not popped) from the stack.
+    fn motion_operands(&self, ins: Instr) -> MotionOperands {
+        let f = match ins {
+            Instr::MoveJ(f) | Instr::MoveL(f) | Instr::MoveC(f) => f,
+            _ => MoveFlags(0),
+        };
+        let s = &self.main.stack;
+        let mut k = 0;
+        let accel = f.has(MoveFlags::ACCEL).then(|| {
+            k += 1;
+            f64::from_bits(s[s.len() - k])
+        });
+        let speed = f.has(MoveFlags::SPEED).then(|| {
+            k += 1;
+            f64::from_bits(s[s.len() - k])
+        });
+        let tw = if f.has(MoveFlags::TARGET_JOINTS) {
+            MAX_AXES
+        } else {
+            6
+        };
+        let target = s[s.len() - k - tw..s.len() - k].to_vec();
+        k += tw;
+        let via = matches!(ins, Instr::MoveC(_)).then(|| {
+            let vw = if f.has(MoveFlags::VIA_JOINTS) {
+                MAX_AXES
+            } else {
+                6
+            };
+            let v = s[s.len() - k - vw..s.len() - k].to_vec();
+            k += vw;
+            v
+        });
+        MotionOperands {
+            target,
+            via,
+            speed,
+            accel,
+            width: k,
+        }
+    }
+
+    /// A pose operand (6 slots) or a joints operand (12 slots) as a TCP pose.
+    fn operand_pose(&self, slots: &[u64]) -> Iso {
+        if slots.len() == 6 {
+            return to_iso(slots);
+        }
+        let q: Vec<f64> = slots
+            .iter()
+            .take(self.model.dof())
+            .map(|x| f64::from_bits(*x))
+            .collect();
+        self.model.tcp(&q, &self.cfg.tool)
+    }
+
+    fn ik_tcp(&self, tcp: &Iso, near: &[f64]) -> Result<[f64; MAX_AXES], String> {
+        let n = self.model.dof();
+        let mut q = [0.0; MAX_AXES];
+        let flange = tcp.mul(&self.cfg.tool.inverse());
+        self.model
+            .ik(&flange, &near[..n], &mut q[..n])
+            .map_err(|e: IkError| format!("unreachable pose: {e}"))?;
+        Ok(q)
+    }
+
+    /// Plans the motion of `ins` from the robot's state now; returns it and its duration.
+    fn plan(&mut self, ins: Instr) -> Result<(Trajectory, i64), String> {
+        let MotionOperands {
+            target,
+            via,
+            speed,
+            accel,
+            ..
+        } = self.motion_operands(ins);
+        let n = self.model.dof();
+        let from = self.rest;
+        if let Instr::MoveJ(_) = ins {
+            let goal = if target.len() == MAX_AXES {
+                let mut q = [0.0; MAX_AXES];
+                for (i, v) in q.iter_mut().enumerate().take(n) {
+                    *v = f64::from_bits(target[i]);
+                }
+                q
+            } else {
+                self.ik_tcp(&to_iso(&target), &from)?
+            };
+            for (i, g) in goal.iter().enumerate().take(n) {
+                let j = self.model.axis(i);
+                if *g < j.lower - 1e-9 || *g > j.upper + 1e-9 {
+                    return Err(format!(
+                        "joint limit exceeded: axis {} `{}` target {:.3} is outside {:.3}..{:.3}",
+                        i + 1,
+                        j.name,
+                        g,
+                        j.lower,
+                        j.upper
+                    ));
+                }
+            }
+            let ratio = speed.unwrap_or(1.0);
+            let aratio = accel.unwrap_or(1.0);
+            if !(ratio > 0.0 && ratio <= 1.0 && aratio > 0.0 && aratio <= 1.0) {
+                return Err(format!(
+                    "speed and acceleration of move_j must be more than 0% and at most 100% (got {}%, {}%)",
+                    ratio * 100.0,
+                    aratio * 100.0
+                ));
+            }
+            // One normalised profile s(t) ∈ [0, 1] within every axis's limits.
+            let (mut vs, mut as_) = (f64::INFINITY, f64::INFINITY);
+            let mut delta = [0.0; MAX_AXES];
+            for i in 0..n {
+                delta[i] = goal[i] - from[i];
+                let d = delta[i].abs();
+                if d > 0.0 {
+                    let j = self.model.axis(i);
+                    vs = vs.min(ratio * j.max_velocity / d);
+                    as_ = as_.min(aratio * j.max_accel / d);
+                }
+            }
+            let profile = if vs.is_finite() {
+                Profile::new(1.0, vs, as_)
+            } else {
+                Profile::new(0.0, 1.0, 1.0)
+            };
+            let dur = profile.duration_ns();
+            return Ok((
+                Trajectory::Joint {
+                    from,
+                    delta,
+                    profile,
+                },
+                dur,
+            ));
+        }
+        // Cartesian: line or arc, orientation by slerp.
+        let start = self.tcp_at(self.time);
+        let goal = self.operand_pose(&target);
+        let path = match &via {
+            None => Path::Line {
+                from: start.t,
+                to: goal.t,
+            },
+            Some(v) => {
+                let via_pose = self.operand_pose(v);
+                Path::arc(start.t, via_pose.t, goal.t).ok_or_else(|| "move_c: the via point lies on the line from start to target; give a point off that line".to_string())?
+            }
+        };
+        let v = speed.unwrap_or(self.cfg.default_speed);
+        if v.is_nan() || v <= 0.0 {
+            return Err(format!(
+                "the speed must be greater than zero (got {})",
+                fmt_quantity(v, Dim::SPEED)
+            ));
+        }
+        let a = accel.unwrap_or(v / vworks_model::model::DEFAULT_ACCEL_TIME);
+        let len = path.length();
+        let angle = vworks_model::math::norm(vworks_model::math::rotation_vector(
+            &vworks_model::math::mat_mul(&vworks_model::math::transpose(&start.r), &goal.r),
+        ));
+        // Orientation moves at most 180°/s (with the same ramp time).
+        let w = std::f64::consts::PI;
+        let mut vs = f64::INFINITY;
+        let mut as_ = f64::INFINITY;
+        if len > 0.0 {
+            vs = vs.min(v / len);
+            as_ = as_.min(a / len);
+        }
+        if angle > 1e-12 {
+            vs = vs.min(w / angle);
+            as_ = as_.min(w / vworks_model::model::DEFAULT_ACCEL_TIME / angle);
+        }
+        if !vs.is_finite() {
+            let traj = Trajectory::Cartesian {
+                path,
+                from: start,
+                to: goal,
+                profile: Profile::new(0.0, 1.0, 1.0),
+                end_joints: from,
+            };
+            return Ok((traj, 0));
+        }
+        // Joints along the path: reachable, and within every axis's speed at this speed.
+        const SAMPLES: usize = 64;
+        let mut prev = from;
+        let mut worst = 1.0f64;
+        let mut worst_axis = 0;
+        for k in 1..=SAMPLES {
+            let s = k as f64 / SAMPLES as f64;
+            let pose = cartesian_at(&path, &start, &goal, s);
+            let q = self
+                .ik_tcp(&pose, &prev)
+                .map_err(|e| format!("{e} (at {:.0}% of the path)", s * 100.0))?;
+            for i in 0..n {
+                // ds/dt at most vs: axis speed ≈ |Δq/Δs|·vs.
+                let rate = (q[i] - prev[i]).abs() * SAMPLES as f64 * vs;
+                let j = self.model.axis(i);
+                if rate > j.max_velocity && j.max_velocity / rate < worst {
+                    worst = j.max_velocity / rate;
+                    worst_axis = i;
+                }
+            }
+            prev = q;
+        }
+        if worst < 1.0 {
+            vs *= worst;
+            as_ *= worst;
+            let pos = self.m.pos_of(self.main.pc);
+            let j = self.model.axis(worst_axis);
+            self.warnings.push((
+                self.time,
+                pos,
+                format!("the motion is slowed to {:.0}% of its speed: axis {} `{}` would exceed its speed limit", worst * 100.0, worst_axis + 1, j.name),
+            ));
+        }
+        let profile = Profile::new(1.0, vs, as_);
+        let dur = profile.duration_ns();
+        Ok((
+            Trajectory::Cartesian {
+                path,
+                from: start,
+                to: goal,
+                profile,
+                end_joints: prev,
+            },
+            dur,
+        ))
+    }
+
+    fn deadline(&self, timeout: bool, t: i64) -> Result<Option<i64>, String> {
+        if !timeout {
+            return Ok(None);
+        }
+        let d = f64::from_bits(self.top(0));
+        if d.is_nan() || d < 0.0 {
+            return Err(format!(
+                "a timeout cannot be negative ({})",
+                fmt_quantity(d, Dim::TIME)
+            ));
+        }
+        Ok(Some(t + (d * NS).round() as i64))
+    }
+
+    /// The text of a `log`/`fail` message whose values are on top of the stack.
+    fn format(&self, f: u32) -> String {
+        let fmt = &self.m.log_formats[f as usize];
+        let width = fmt.value_width() as usize;
+        let s = &self.main.stack;
+        let mut at = s.len() - width;
+        let mut out = String::new();
+        for p in &fmt.parts {
+            match p {
+                LogPart::Text(i) => out.push_str(self.m.str(*i)),
+                LogPart::Value(ty) => {
+                    let w = ty.width() as usize;
+                    let v = &s[at..at + w];
+                    at += w;
+                    let num = |x: u64| f64::from_bits(x);
+                    match ty {
+                        Type::Bool => out.push_str(if v[0] != 0 { "true" } else { "false" }),
+                        Type::Int => out.push_str(&(v[0] as i64).to_string()),
+                        Type::Num(d) => out.push_str(&fmt_quantity(num(v[0]), *d)),
+                        Type::Pose => {
+                            let parts: Vec<String> = (0..6)
+                                .map(|k| {
+                                    fmt_quantity(
+                                        num(v[k]),
+                                        if k < 3 { Dim::LENGTH } else { Dim::ANGLE },
+                                    )
+                                })
+                                .collect();
+                            out.push_str(&format!("pose({})", parts.join(", ")));
+                        }
+                        Type::Joints => {
+                            let n = self.model.dof();
+                            let parts: Vec<String> = (0..n)
+                                .map(|k| {
+                                    fmt_quantity(
+                                        num(v[k]),
+                                        if (self.model.linear_axes() >> k) & 1 == 1 {
+                                            Dim::LENGTH
+                                        } else {
+                                            Dim::ANGLE
+                                        },
+                                    )
+                                })
+                                .collect();
+                            out.push_str(&format!("joints({})", parts.join(", ")));
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// Performs the event [`Vm::next_event`] returned. Returns an error event's message
+    /// as `Err` only for VM misuse (performing with no event).
+    pub fn perform(&mut self) {
+        let state = std::mem::replace(&mut self.state, State::Run);
+        match state {
+            State::At(e) => {
+                self.time = e.time;
+                let pc = self.main.pc;
+                let ins = self.m.code.get(pc as usize).copied().unwrap_or(Instr::Stop);
+                match e.kind {
+                    EventKind::Error { .. } | EventKind::End => {
+                        self.state = State::Done;
+                        return;
+                    }
+                    EventKind::Set { global, value, .. } => {
+                        self.main.stack.pop();
+                        self.set_global(global, value);
+                    }
+                    EventKind::MotionStart { duration_ns, .. } => {
+                        let width = self.motion_operands(ins).width;
+                        let l = self.main.stack.len() - width;
+                        self.main.stack.truncate(l);
+                        if let Some(traj) = self.pending_motion.take() {
+                            self.motion = Some((e.time, traj));
+                        }
+                        self.state = State::Moving {
+                            end: e.time + duration_ns,
+                            pos: e.pos,
+                        };
+                    }
+                    EventKind::Delay { duration_ns } => {
+                        self.main.stack.pop();
+                        self.state = State::Delaying {
+                            end: e.time + duration_ns,
+                            pos: e.pos,
+                        };
+                    }
+                    EventKind::WaitUntil { cond, deadline } => {
+                        if deadline.is_some() {
+                            self.main.stack.pop();
+                        }
+                        self.timed_out = false;
+                        self.state = if self.eval_cond(cond, e.time) {
+                            State::Released {
+                                time: e.time,
+                                timed_out: false,
+                                pos: e.pos,
+                            }
+                        } else {
+                            State::Waiting {
+                                cond: Some(cond),
+                                signal: None,
+                                deadline,
+                                pos: e.pos,
+                            }
+                        };
+                    }
+                    EventKind::WaitSignal { name, deadline } => {
+                        if deadline.is_some() {
+                            self.main.stack.pop();
+                        }
+                        self.timed_out = false;
+                        let have = self.signals.iter_mut().find(|(n, c)| *n == name && *c > 0);
+                        self.state = if let Some((_, c)) = have {
+                            *c -= 1;
+                            State::Released {
+                                time: e.time,
+                                timed_out: false,
+                                pos: e.pos,
+                            }
+                        } else {
+                            State::Waiting {
+                                cond: None,
+                                signal: Some(name),
+                                deadline,
+                                pos: e.pos,
+                            }
+                        };
+                    }
+                    EventKind::Log { .. } => {
+                        if let Instr::Log(f) = ins {
+                            let w = self.m.log_formats[f as usize].value_width() as usize;
+                            let l = self.main.stack.len() - w;
+                            self.main.stack.truncate(l);
+                        }
+                    }
+                    _ => {}
+                }
+                // Past the event instruction (motions and waits continue after their end).
+                if !matches!(self.state, State::Done) {
+                    self.main.pc = pc + 1;
+                }
+            }
+            State::Moving { end, .. } => {
+                self.time = end;
+                self.rest = self.joints_at(end);
+                if let Some((_, Trajectory::Joint { from, delta, .. })) = &self.motion {
+                    // Exactly the target, not the profile's last float.
+                    let mut q = *from;
+                    for (qi, d) in q.iter_mut().zip(delta) {
+                        *qi += d;
+                    }
+                    self.rest = q;
+                }
+                self.motion = None;
+            }
+            State::Delaying { end, .. } => self.time = end,
+            State::Waiting {
+                deadline: Some(d), ..
+            } => {
+                self.time = d;
+                self.timed_out = true;
+            }
+            State::Released {
+                time, timed_out, ..
+            } => {
+                self.time = time;
+                self.timed_out = timed_out;
+            }
+            other => self.state = other,
+        }
+    }
+
+    /// Evaluates condition `c` with the locals it captures from the main thread's frame.
+    fn eval_cond(&mut self, c: u32, t: i64) -> bool {
+        let m = Arc::clone(&self.m);
+        let cond = &m.conds[c as usize];
+        let base = self.main.frames.last().map_or(0, |f| f.base as usize);
+        let mut args = [0u64; 64];
+        let mut n = 0;
+        for cap in &cond.captures {
+            for k in 0..cap.width as usize {
+                if n < args.len() {
+                    args[n] = self
+                        .main
+                        .locals
+                        .get(base + cap.slot as usize + k)
+                        .copied()
+                        .unwrap_or(0);
+                    n += 1;
+                }
+            }
+        }
+        let mut th = std::mem::take(&mut self.cond_thread);
+        th.start(&m, cond.func, &args[..n]);
+        let mut budget = self.cfg.budget;
+        let mut vars = std::mem::take(&mut self.vars);
+        let r = th.run(
+            &m,
+            &View { vm: self, t },
+            &mut vars,
+            &mut budget,
+            self.cfg.max_depth,
+        );
+        self.vars = vars;
+        let value = matches!(r, Ok(Stop::Finished)) && th.stack.last().copied().unwrap_or(0) != 0;
+        self.cond_thread = th;
+        value
+    }
+
+    /// The SE's `check_wait` at time `t`: re-tests the condition this VM waits on.
+    /// Returns true if the VM is released (its next event becomes `wait_end` at `t`).
+    pub fn check_wait(&mut self, t: i64) -> bool {
+        let State::Waiting {
+            cond: Some(c), pos, ..
+        } = self.state
+        else {
+            return false;
+        };
+        if self.eval_cond(c, t) {
+            self.state = State::Released {
+                time: t,
+                timed_out: false,
+                pos,
+            };
+            return true;
+        }
+        false
+    }
+
+    /// Delivers a signal named `name` at time `t`: releases a matching wait, or is counted
+    /// until one consumes it. Returns true if it released a wait.
+    pub fn deliver_signal(&mut self, name: &str, t: i64) -> bool {
+        let Some(idx) = self
+            .m
+            .strings
+            .iter()
+            .position(|s| s == name)
+            .map(|i| i as u32)
+        else {
+            return false;
+        };
+        if let State::Waiting {
+            signal: Some(s),
+            pos,
+            ..
+        } = self.state
+            && s == idx
+        {
+            self.state = State::Released {
+                time: t,
+                timed_out: false,
+                pos,
+            };
+            return true;
+        }
+        match self.signals.iter_mut().find(|(n, _)| *n == idx) {
+            Some((_, c)) => *c += 1,
+            None => self.signals.push((idx, 1)),
+        }
+        false
+    }
+}
