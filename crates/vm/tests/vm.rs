@@ -89,49 +89,43 @@ fn move_l_stays_on_its_line_and_ends_on_the_target() {
     let mut v = vm(src, "irb120", VmConfig::default());
     let model = builtin::load("irb120").unwrap();
     let mut events = Vec::new();
-    let (mut line_from, mut line_to) = ([0.0; 3], [0.0; 3]);
+    let mut line_to = [0.0; 3];
     let mut worst: f64 = 0.0;
-    loop {
-        match v.next_event() {
-            Next::Event(e) => {
-                if let EventKind::MotionStart {
-                    command: "move_l",
-                    duration_ns,
-                } = e.kind
-                {
-                    line_from = v.tcp_at(e.time).t;
-                    v.perform();
-                    line_to = v.tcp_at(e.time + duration_ns).t;
-                    // Every millisecond of the motion: FK of the sampled joints on the line.
-                    let mut t = e.time;
-                    while t <= e.time + duration_ns {
-                        let q = v.joints_at(t);
-                        let p = model.flange(&q[..6]).t;
-                        let d = [
-                            line_to[0] - line_from[0],
-                            line_to[1] - line_from[1],
-                            line_to[2] - line_from[2],
-                        ];
-                        let w = [
-                            p[0] - line_from[0],
-                            p[1] - line_from[1],
-                            p[2] - line_from[2],
-                        ];
-                        let len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                        let s = (w[0] * d[0] + w[1] * d[1] + w[2] * d[2]) / len2;
-                        let off = [w[0] - s * d[0], w[1] - s * d[1], w[2] - s * d[2]];
-                        worst =
-                            worst.max((off[0] * off[0] + off[1] * off[1] + off[2] * off[2]).sqrt());
-                        t += 1_000_000;
-                    }
-                    events.push(e);
-                    continue;
-                }
-                events.push(e);
-                v.perform();
+    while let Next::Event(e) = v.next_event() {
+        let move_l = match e.kind {
+            EventKind::MotionStart {
+                command: "move_l",
+                duration_ns,
+            } => Some(duration_ns),
+            _ => None,
+        };
+        let line_from = v.tcp_at(e.time).t;
+        v.perform();
+        if let Some(duration_ns) = move_l {
+            line_to = v.tcp_at(e.time + duration_ns).t;
+            // Every millisecond of the motion: FK of the sampled joints lies on the line.
+            let d = [
+                line_to[0] - line_from[0],
+                line_to[1] - line_from[1],
+                line_to[2] - line_from[2],
+            ];
+            let len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            let mut t = e.time;
+            while t <= e.time + duration_ns {
+                let q = v.joints_at(t);
+                let p = model.flange(&q[..6]).t;
+                let w = [
+                    p[0] - line_from[0],
+                    p[1] - line_from[1],
+                    p[2] - line_from[2],
+                ];
+                let s = (w[0] * d[0] + w[1] * d[1] + w[2] * d[2]) / len2;
+                let off = [w[0] - s * d[0], w[1] - s * d[1], w[2] - s * d[2]];
+                worst = worst.max((off[0] * off[0] + off[1] * off[1] + off[2] * off[2]).sqrt());
+                t += 1_000_000;
             }
-            _ => break,
         }
+        events.push(e);
     }
     assert_eq!(
         kinds(&events),
