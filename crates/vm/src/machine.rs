@@ -120,6 +120,48 @@ pub enum EventKind {
         /// The message.
         message: String,
     },
+    /// A `when` handler is enabled (module handler index).
+    EnableWhen {
+        /// The handler.
+        handler: u32,
+    },
+    /// Handlers calling procedure `proc` are disabled.
+    DisableWhen {
+        /// The handler procedure.
+        proc: u32,
+    },
+    /// A handler fires (module handler index); its events follow, then `WhenEnd`.
+    WhenFire {
+        /// The handler.
+        handler: u32,
+    },
+    /// The handler finished.
+    WhenEnd {
+        /// The handler.
+        handler: u32,
+    },
+    /// This robot asks another to run a procedure (remote site index); `req` identifies
+    /// the request in `remote_done`.
+    RemoteCall {
+        /// The remote site.
+        site: u32,
+        /// Request number (per caller).
+        req: u64,
+        /// Argument slots.
+        args: Vec<u64>,
+    },
+    /// This robot waits for the remote work of its `parallel` block.
+    Join,
+    /// This robot starts serving a remote request (procedure index).
+    RemoteStart {
+        /// The procedure.
+        proc: u32,
+    },
+    /// This robot finished a remote request.
+    RemoteEnd {
+        /// The procedure.
+        proc: u32,
+    },
     /// The program ended.
     End,
 }
@@ -140,6 +182,14 @@ impl EventKind {
             EventKind::Release { .. } => "release",
             EventKind::Log { .. } => "log",
             EventKind::Error { .. } => "error",
+            EventKind::EnableWhen { .. } => "enable_when",
+            EventKind::DisableWhen { .. } => "disable_when",
+            EventKind::WhenFire { .. } => "when_fire",
+            EventKind::WhenEnd { .. } => "when_end",
+            EventKind::RemoteCall { .. } => "remote_call",
+            EventKind::Join => "join",
+            EventKind::RemoteStart { .. } => "remote_start",
+            EventKind::RemoteEnd { .. } => "remote_end",
             EventKind::End => "end",
         }
     }
@@ -163,7 +213,9 @@ pub enum Next {
     Event(Event),
     /// Nothing until the SE releases a wait (a condition or a signal).
     Blocked,
-    /// The program has ended (or failed).
+    /// The program has ended; the robot serves remote requests when they come.
+    Idle,
+    /// The program failed (or the VM was stopped): nothing more will happen.
     Done,
 }
 
@@ -223,8 +275,49 @@ enum State {
         timed_out: bool,
         pos: SrcPos,
     },
-    /// Finished (or failed).
+    /// Waiting for the remote work of the `parallel` block at this depth.
+    Joining { depth: u32, pos: SrcPos },
+    /// The program ended; serving remote requests.
+    Idle,
+    /// Failed or stopped for good.
     Done,
+}
+
+/// When an enabled handler fires.
+#[derive(Clone, Debug)]
+enum Firing {
+    /// At `next`, then every `period` if any.
+    Timer { next: i64, period: Option<i64> },
+    /// On each false→true edge of its condition; `last` is the value last seen.
+    Edge { last: bool },
+}
+
+/// An enabled `when` handler.
+#[derive(Clone, Debug)]
+struct Enabled {
+    handler: u32,
+    target: u32,
+    /// Captured slots for the action and for the condition.
+    args: Vec<u64>,
+    cond_args: Vec<u64>,
+    firing: Firing,
+}
+
+/// A remote request waiting to be served.
+#[derive(Clone, Debug)]
+struct Request {
+    proc: u32,
+    args: Vec<u64>,
+    time: i64,
+}
+
+/// Which context produced the event `next_event` returned last.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Source {
+    Main,
+    Handler,
+    Fire(usize),
+    None,
 }
 
 /// The VM of one robot.
@@ -245,6 +338,24 @@ pub struct Vm {
     timed_out: bool,
     /// Scratch thread for evaluating conditions.
     cond_thread: Thread,
+    /// The thread of the handler now running, its state, and (enabled index, firing time).
+    handler: Thread,
+    hstate: State,
+    hrun: Option<(usize, i64)>,
+    /// The module handler index of the running handler.
+    hrun_handler: u32,
+    /// Enabled handlers, in enabling order.
+    enabled: Vec<Enabled>,
+    /// Condition handlers whose edge was seen: (time, enabled index).
+    fires: Vec<(i64, usize)>,
+    /// Outstanding remote requests: (parallel depth, request number).
+    join: Vec<(u32, u64)>,
+    par_depth: u32,
+    next_req: u64,
+    /// Remote requests waiting for this robot, and the one being served.
+    queue: std::collections::VecDeque<Request>,
+    serving: Option<u32>,
+    source: Source,
     /// Pending signals: (name string index, count).
     signals: Vec<(u32, u32)>,
     /// Globals as the SE last gave them (slot bits by module global index).
@@ -290,8 +401,9 @@ fn to_iso(p: &[u64]) -> Iso {
 }
 
 impl Vm {
-    /// A VM for `module` on `model`, about to run procedure `entry`.
-    pub fn new(m: Arc<Module>, model: Arc<RobotModel>, cfg: VmConfig, entry: u32) -> Vm {
+    /// A VM for `module` on `model`, about to run procedure `entry`; with `None` the robot
+    /// only serves remote requests (`serve_only`).
+    pub fn new(m: Arc<Module>, model: Arc<RobotModel>, cfg: VmConfig, entry: Option<u32>) -> Vm {
         let mut vars = vec![0u64; m.var_slots as usize];
         for v in &m.vars {
             let w = v.ty.width() as usize;
@@ -313,20 +425,38 @@ impl Vm {
         }
         let mut main = Thread::default();
         main.reserve(&m, cfg.max_depth);
-        main.start(&m, entry, &[]);
+        if let Some(entry) = entry {
+            main.start(&m, entry, &[]);
+        }
         Vm {
             m,
             model,
             cfg,
             main,
             vars,
-            state: State::Run,
+            state: if entry.is_some() {
+                State::Run
+            } else {
+                State::Idle
+            },
             time: 0,
             rest,
             motion: None,
             pending_motion: None,
             timed_out: false,
             cond_thread: Thread::default(),
+            handler: Thread::default(),
+            hstate: State::Done,
+            hrun: None,
+            hrun_handler: 0,
+            enabled: Vec::new(),
+            fires: Vec::new(),
+            join: Vec::new(),
+            par_depth: 0,
+            next_req: 0,
+            queue: std::collections::VecDeque::new(),
+            serving: None,
+            source: Source::None,
             signals: Vec::new(),
             globals,
             warnings: Vec::new(),
@@ -447,8 +577,66 @@ impl Vm {
     }
 
     /// The next event of this VM (performing nothing). Calling it again returns the same
-    /// event until [`Vm::perform`] executes it.
+    /// event until [`Vm::perform`] executes it. A running handler's events come first;
+    /// then whichever is earlier of the main program's next event and the next handler
+    /// firing (a handler first on a tie).
     pub fn next_event(&mut self) -> Next {
+        if let Some((_, t)) = self.hrun {
+            if self.hstate == State::Run {
+                let e = self.run_segment(true, t);
+                self.hstate = State::At(e);
+            }
+            if let State::At(e) = &self.hstate {
+                self.source = Source::Handler;
+                return Next::Event(e.clone());
+            }
+        }
+        let main = self.main_event();
+        let fire = self.next_fire();
+        match (main, fire) {
+            (Next::Event(e), Some((t, i))) if t <= e.time => self.fire_event(t, i),
+            (Next::Event(e), _) => {
+                self.source = Source::Main;
+                Next::Event(e)
+            }
+            (Next::Done, _) => Next::Done,
+            (other, Some((t, i))) => {
+                let _ = other;
+                self.fire_event(t, i)
+            }
+            (other, None) => {
+                self.source = Source::None;
+                other
+            }
+        }
+    }
+
+    fn fire_event(&mut self, t: i64, i: usize) -> Next {
+        self.source = Source::Fire(i);
+        let h = &self.m.handlers[self.enabled[i].handler as usize];
+        Next::Event(Event {
+            time: t,
+            kind: EventKind::WhenFire {
+                handler: self.enabled[i].handler,
+            },
+            pos: h.pos,
+        })
+    }
+
+    /// The earliest handler firing: (time, enabled index).
+    fn next_fire(&self) -> Option<(i64, usize)> {
+        let timers = self
+            .enabled
+            .iter()
+            .enumerate()
+            .filter_map(|(i, e)| match e.firing {
+                Firing::Timer { next, .. } => Some((next, i)),
+                Firing::Edge { .. } => None,
+            });
+        timers.chain(self.fires.iter().copied()).min()
+    }
+
+    fn main_event(&mut self) -> Next {
         match &self.state {
             State::Done => Next::Done,
             State::At(e) => Next::Event(e.clone()),
@@ -471,7 +659,7 @@ impl Vm {
                 kind: EventKind::WaitEnd { timed_out: true },
                 pos: *pos,
             }),
-            State::Waiting { .. } => Next::Blocked,
+            State::Waiting { .. } | State::Joining { .. } => Next::Blocked,
             State::Released {
                 time,
                 timed_out,
@@ -483,56 +671,137 @@ impl Vm {
                 },
                 pos: *pos,
             }),
+            State::Idle => match self.queue.front() {
+                Some(r) => {
+                    let p = &self.m.procs[r.proc as usize];
+                    let e = Event {
+                        time: r.time.max(self.time),
+                        kind: EventKind::RemoteStart { proc: r.proc },
+                        pos: p.pos,
+                    };
+                    self.state = State::At(e.clone());
+                    Next::Event(e)
+                }
+                None => Next::Idle,
+            },
             State::Run => {
-                let e = self.run_segment();
+                let e = self.run_segment(false, self.time);
                 self.state = State::At(e.clone());
                 Next::Event(e)
             }
         }
     }
 
-    /// Runs zero-time code up to the next event instruction and describes that event.
-    fn run_segment(&mut self) -> Event {
-        let mut budget = self.cfg.budget;
-        let t = self.time;
+    /// Runs zero-time code of the main thread (or the handler thread) up to its next event
+    /// instruction and describes that event.
+    fn run_segment(&mut self, in_handler: bool, t: i64) -> Event {
         let m = Arc::clone(&self.m);
-        let mut thread = std::mem::take(&mut self.main);
-        let mut vars = std::mem::take(&mut self.vars);
-        let stop = thread.run(
-            &m,
-            &View { vm: self, t },
-            &mut vars,
-            &mut budget,
-            self.cfg.max_depth,
-        );
-        self.main = thread;
-        self.vars = vars;
-        let pc = self.main.pc;
-        let pos = m.pos_of(pc);
-        let kind = match stop {
-            Err(e) => return self.error_event(&e, t),
-            Ok(Stop::Finished) => EventKind::End,
-            Ok(Stop::Event(ins)) => match self.describe(ins, t) {
-                Ok(k) => k,
-                Err(message) => EventKind::Error { message },
-            },
-        };
-        Event { time: t, kind, pos }
+        loop {
+            let mut budget = self.cfg.budget;
+            let mut thread = std::mem::take(if in_handler {
+                &mut self.handler
+            } else {
+                &mut self.main
+            });
+            let mut vars = std::mem::take(&mut self.vars);
+            let stop = thread.run(
+                &m,
+                &View { vm: self, t },
+                &mut vars,
+                &mut budget,
+                self.cfg.max_depth,
+            );
+            self.vars = vars;
+            let pc = thread.pc;
+            if in_handler {
+                self.handler = thread;
+            } else {
+                self.main = thread;
+            }
+            // A finished thread's pc is past its last `Ret`: report the `Ret`.
+            let pos = m.pos_of(if matches!(stop, Ok(Stop::Finished)) {
+                pc.saturating_sub(1)
+            } else {
+                pc
+            });
+            let kind = match stop {
+                Err(e) => return self.error_event(&e, t),
+                Ok(Stop::Finished) => match (in_handler, self.hrun, self.serving) {
+                    (true, Some(_), _) => EventKind::WhenEnd {
+                        handler: self.hrun_handler,
+                    },
+                    (false, _, Some(proc)) => EventKind::RemoteEnd { proc },
+                    _ => EventKind::End,
+                },
+                Ok(Stop::Event(Instr::ParBegin)) if !in_handler => {
+                    // Not an event: the start of a join group.
+                    self.par_depth += 1;
+                    self.main.pc = pc + 1;
+                    continue;
+                }
+                Ok(Stop::Event(ins)) => match self.describe(ins, t, in_handler) {
+                    Ok(k) => k,
+                    Err(message) => EventKind::Error { message },
+                },
+            };
+            return Event { time: t, kind, pos };
+        }
     }
 
-    fn top(&self, depth_from_top: usize) -> u64 {
-        let s = &self.main.stack;
+    fn thread(&self, in_handler: bool) -> &Thread {
+        if in_handler {
+            &self.handler
+        } else {
+            &self.main
+        }
+    }
+
+    fn top(&self, in_handler: bool, depth_from_top: usize) -> u64 {
+        let s = &self.thread(in_handler).stack;
         s[s.len() - 1 - depth_from_top]
     }
 
     /// The event an instruction stands for, from the operands on the stack (not popped).
-    fn describe(&mut self, ins: Instr, t: i64) -> Result<EventKind, String> {
+    fn describe(&mut self, ins: Instr, t: i64, in_handler: bool) -> Result<EventKind, String> {
+        if in_handler
+            && matches!(
+                ins,
+                Instr::MoveJ(_)
+                    | Instr::MoveL(_)
+                    | Instr::MoveC(_)
+                    | Instr::Delay
+                    | Instr::WaitUntil(..)
+                    | Instr::WaitSignal(..)
+                    | Instr::Grip(_)
+                    | Instr::Release(_)
+                    | Instr::Remote(_)
+                    | Instr::ParBegin
+                    | Instr::ParJoin
+            )
+        {
+            return Err(format!(
+                "a `when` handler runs in zero time and may not take time (`{}`)",
+                ins.name()
+            ));
+        }
         Ok(match ins {
             Instr::StoreGlobal(g) => EventKind::Set {
                 global: g,
-                value: self.top(0),
+                value: self.top(in_handler, 0),
                 ty: self.m.globals[g as usize].ty,
             },
+            Instr::When(h) => EventKind::EnableWhen { handler: h },
+            Instr::Disable(p) => EventKind::DisableWhen { proc: p },
+            Instr::Remote(r) => {
+                let w = self.m.remotes[r as usize].arg_width() as usize;
+                let st = &self.main.stack;
+                EventKind::RemoteCall {
+                    site: r,
+                    req: self.next_req,
+                    args: st[st.len() - w..].to_vec(),
+                }
+            }
+            Instr::ParJoin => EventKind::Join,
             Instr::MoveJ(_) | Instr::MoveL(_) | Instr::MoveC(_) => {
                 let (traj, dur) = self.plan(ins)?;
                 self.pending_motion = Some(traj);
@@ -546,7 +815,7 @@ impl Vm {
                 }
             }
             Instr::Delay => {
-                let d = f64::from_bits(self.top(0));
+                let d = f64::from_bits(self.top(false, 0));
                 if d.is_nan() || d < 0.0 {
                     return Err(format!(
                         "a delay cannot be negative ({})",
@@ -569,7 +838,7 @@ impl Vm {
             Instr::Grip(s) => EventKind::Grip { site: s },
             Instr::Release(s) => EventKind::Release { site: s },
             Instr::Log(f) | Instr::Fail(f) => {
-                let text = self.format(f);
+                let text = self.format(f, in_handler);
                 if matches!(ins, Instr::Fail(_)) {
                     EventKind::Error { message: text }
                 } else {
@@ -819,7 +1088,7 @@ impl Vm {
         if !timeout {
             return Ok(None);
         }
-        let d = f64::from_bits(self.top(0));
+        let d = f64::from_bits(self.top(false, 0));
         if d.is_nan() || d < 0.0 {
             return Err(format!(
                 "a timeout cannot be negative ({})",
@@ -830,10 +1099,10 @@ impl Vm {
     }
 
     /// The text of a `log`/`fail` message whose values are on top of the stack.
-    fn format(&self, f: u32) -> String {
+    fn format(&self, f: u32, in_handler: bool) -> String {
         let fmt = &self.m.log_formats[f as usize];
         let width = fmt.value_width() as usize;
-        let s = &self.main.stack;
+        let s = &self.thread(in_handler).stack;
         let mut at = s.len() - width;
         let mut out = String::new();
         for p in &fmt.parts {
@@ -882,23 +1151,232 @@ impl Vm {
         out
     }
 
-    /// Performs the event [`Vm::next_event`] returned. Returns an error event's message
-    /// as `Err` only for VM misuse (performing with no event).
+    /// Performs the event [`Vm::next_event`] returned last.
     pub fn perform(&mut self) {
+        match std::mem::replace(&mut self.source, Source::None) {
+            Source::Main => self.perform_main(),
+            Source::Handler => self.perform_handler(),
+            Source::Fire(i) => self.perform_fire(i),
+            Source::None => {}
+        }
+    }
+
+    fn perform_fire(&mut self, i: usize) {
+        let Some((t, _)) = self.next_fire().filter(|(_, j)| *j == i) else {
+            return;
+        };
+        self.time = self.time.max(t);
+        self.fires.retain(|(_, j)| *j != i);
+        let Some(e) = self.enabled.get_mut(i) else {
+            return;
+        };
+        if let Firing::Timer { next, period } = &mut e.firing {
+            match period {
+                Some(p) => *next += *p,
+                None => *next = i64::MAX,
+            }
+        }
+        let (action, args) = (self.m.handlers[e.handler as usize].action, e.args.clone());
+        self.hrun_handler = e.handler;
+        self.handler.start(&self.m, action, &args);
+        self.hstate = State::Run;
+        self.hrun = Some((i, t));
+    }
+
+    fn perform_handler(&mut self) {
+        let State::At(e) = std::mem::replace(&mut self.hstate, State::Run) else {
+            return;
+        };
+        let pc = self.handler.pc;
+        let ins = self.m.code.get(pc as usize).copied().unwrap_or(Instr::Stop);
+        match e.kind {
+            EventKind::WhenEnd { .. } => {
+                // An `after` handler is gone once it has run.
+                if let Some((i, _)) = self.hrun
+                    && matches!(
+                        self.enabled.get(i).map(|x| &x.firing),
+                        Some(Firing::Timer { period: None, .. })
+                    )
+                {
+                    self.remove_enabled(|k, _| k == i);
+                }
+                self.hrun = None;
+                self.hstate = State::Done;
+                return;
+            }
+            EventKind::Error { .. } => {
+                self.hrun = None;
+                self.hstate = State::Done;
+                self.state = State::Done;
+                return;
+            }
+            EventKind::End => {
+                // `stop` in a handler ends the robot's program.
+                self.hrun = None;
+                self.hstate = State::Done;
+                self.end_program();
+                return;
+            }
+            _ => {}
+        }
+        self.apply_zero_time(&e, ins, true);
+        self.handler.pc = pc + 1;
+    }
+
+    /// Effects shared by the main program and handlers: set, log, enable, disable.
+    fn apply_zero_time(&mut self, e: &Event, ins: Instr, in_handler: bool) {
+        let th = if in_handler {
+            &mut self.handler
+        } else {
+            &mut self.main
+        };
+        match &e.kind {
+            EventKind::Set { global, value, .. } => {
+                th.stack.pop();
+                self.set_global(*global, *value);
+            }
+            EventKind::Log { .. } => {
+                if let Instr::Log(f) = ins {
+                    let w = self.m.log_formats[f as usize].value_width() as usize;
+                    let l = th.stack.len() - w;
+                    th.stack.truncate(l);
+                }
+            }
+            EventKind::EnableWhen { handler } => self.enable(*handler, e.time, in_handler),
+            EventKind::DisableWhen { proc } => {
+                let proc = *proc;
+                self.remove_enabled(|_, x| x.target == proc);
+            }
+            _ => {}
+        }
+    }
+
+    /// Enables handler `h`: reads its trigger operand and copies its captured locals.
+    fn enable(&mut self, h: u32, t: i64, in_handler: bool) {
+        let m = Arc::clone(&self.m);
+        let info = &m.handlers[h as usize];
+        let th = if in_handler {
+            &mut self.handler
+        } else {
+            &mut self.main
+        };
+        let operand = if info.trigger.has_operand() {
+            th.stack.pop().unwrap_or(0)
+        } else {
+            0
+        };
+        let base = th.frames.last().map_or(0, |f| f.base as usize);
+        let grab = |caps: &[crate::bytecode::Capture]| -> Vec<u64> {
+            caps.iter()
+                .flat_map(|c| (0..c.width as u32).map(move |k| base + (c.slot + k) as usize))
+                .map(|i| th.locals.get(i).copied().unwrap_or(0))
+                .collect()
+        };
+        let args = grab(&info.captures);
+        let (firing, cond_args) = match info.trigger {
+            crate::bytecode::Trigger::EveryCycles => {
+                let c = self.cfg.cycle_ns.max(1);
+                let n = (operand as i64).max(1);
+                (
+                    Firing::Timer {
+                        next: (t / c + n) * c,
+                        period: Some(n * c),
+                    },
+                    Vec::new(),
+                )
+            }
+            crate::bytecode::Trigger::Every => {
+                let p = ((f64::from_bits(operand) * NS).round() as i64).max(1);
+                (
+                    Firing::Timer {
+                        next: t + p,
+                        period: Some(p),
+                    },
+                    Vec::new(),
+                )
+            }
+            crate::bytecode::Trigger::After => {
+                let p = ((f64::from_bits(operand) * NS).round() as i64).max(0);
+                (
+                    Firing::Timer {
+                        next: t + p,
+                        period: None,
+                    },
+                    Vec::new(),
+                )
+            }
+            crate::bytecode::Trigger::Condition(c) => {
+                let cargs = grab(&m.conds[c as usize].captures);
+                let last = self.eval_cond_with(m.conds[c as usize].func, &cargs, t);
+                (Firing::Edge { last }, cargs)
+            }
+        };
+        self.enabled.push(Enabled {
+            handler: h,
+            target: info.target,
+            args,
+            cond_args,
+            firing,
+        });
+    }
+
+    /// Removes the enabled handlers `gone(index, handler)` selects, keeping the indices of
+    /// pending firings and of the running handler right.
+    fn remove_enabled(&mut self, gone: impl Fn(usize, &Enabled) -> bool) {
+        let mut map = Vec::with_capacity(self.enabled.len());
+        let mut kept = 0;
+        for (k, e) in self.enabled.iter().enumerate() {
+            if gone(k, e) {
+                map.push(None);
+            } else {
+                map.push(Some(kept));
+                kept += 1;
+            }
+        }
+        let mut k = 0;
+        self.enabled.retain(|_| {
+            let keep = map[k].is_some();
+            k += 1;
+            keep
+        });
+        self.fires = self
+            .fires
+            .iter()
+            .filter_map(|(t, i)| map[*i].map(|j| (*t, j)))
+            .collect();
+        if let Some((i, t)) = self.hrun {
+            // A disabled running handler finishes; it just has no index any more.
+            self.hrun = Some((map[i].unwrap_or(usize::MAX), t));
+        }
+    }
+
+    /// The program (not a remote request) ended: handlers go, remote service begins.
+    fn end_program(&mut self) {
+        self.enabled.clear();
+        self.fires.clear();
+        self.state = State::Idle;
+    }
+
+    fn perform_main(&mut self) {
         let state = std::mem::replace(&mut self.state, State::Run);
         match state {
             State::At(e) => {
                 self.time = e.time;
                 let pc = self.main.pc;
                 let ins = self.m.code.get(pc as usize).copied().unwrap_or(Instr::Stop);
-                match e.kind {
-                    EventKind::Error { .. } | EventKind::End => {
+                match &e.kind {
+                    EventKind::Error { .. } => {
                         self.state = State::Done;
                         return;
                     }
-                    EventKind::Set { global, value, .. } => {
-                        self.main.stack.pop();
-                        self.set_global(global, value);
+                    EventKind::End => {
+                        self.end_program();
+                        return;
+                    }
+                    EventKind::RemoteEnd { .. } => {
+                        self.serving = None;
+                        self.state = State::Idle;
+                        return;
                     }
                     EventKind::MotionStart { duration_ns, .. } => {
                         let width = self.motion_operands(ins).width;
@@ -924,7 +1402,7 @@ impl Vm {
                             self.main.stack.pop();
                         }
                         self.timed_out = false;
-                        self.state = if self.eval_cond(cond, e.time) {
+                        self.state = if self.eval_cond(*cond, e.time) {
                             State::Released {
                                 time: e.time,
                                 timed_out: false,
@@ -932,9 +1410,9 @@ impl Vm {
                             }
                         } else {
                             State::Waiting {
-                                cond: Some(cond),
+                                cond: Some(*cond),
                                 signal: None,
-                                deadline,
+                                deadline: *deadline,
                                 pos: e.pos,
                             }
                         };
@@ -944,7 +1422,7 @@ impl Vm {
                             self.main.stack.pop();
                         }
                         self.timed_out = false;
-                        let have = self.signals.iter_mut().find(|(n, c)| *n == name && *c > 0);
+                        let have = self.signals.iter_mut().find(|(n, c)| n == name && *c > 0);
                         self.state = if let Some((_, c)) = have {
                             *c -= 1;
                             State::Released {
@@ -955,25 +1433,46 @@ impl Vm {
                         } else {
                             State::Waiting {
                                 cond: None,
-                                signal: Some(name),
-                                deadline,
+                                signal: Some(*name),
+                                deadline: *deadline,
                                 pos: e.pos,
                             }
                         };
                     }
-                    EventKind::Log { .. } => {
-                        if let Instr::Log(f) = ins {
-                            let w = self.m.log_formats[f as usize].value_width() as usize;
-                            let l = self.main.stack.len() - w;
-                            self.main.stack.truncate(l);
-                        }
+                    EventKind::RemoteCall { req, args, .. } => {
+                        let l = self.main.stack.len() - args.len();
+                        self.main.stack.truncate(l);
+                        self.join.push((self.par_depth, *req));
+                        self.next_req += 1;
                     }
-                    _ => {}
+                    EventKind::Join => {
+                        let d = self.par_depth;
+                        self.state = if self.join.iter().any(|(depth, _)| *depth == d) {
+                            State::Joining {
+                                depth: d,
+                                pos: e.pos,
+                            }
+                        } else {
+                            self.par_depth = self.par_depth.saturating_sub(1);
+                            State::Released {
+                                time: e.time,
+                                timed_out: false,
+                                pos: e.pos,
+                            }
+                        };
+                    }
+                    EventKind::RemoteStart { proc } => {
+                        let Some(r) = self.queue.pop_front() else {
+                            return;
+                        };
+                        self.main.start(&self.m, *proc, &r.args);
+                        self.serving = Some(*proc);
+                        self.state = State::Run;
+                        return;
+                    }
+                    _ => self.apply_zero_time(&e, ins, false),
                 }
-                // Past the event instruction (motions and waits continue after their end).
-                if !matches!(self.state, State::Done) {
-                    self.main.pc = pc + 1;
-                }
+                self.main.pc = pc + 1;
             }
             State::Moving { end, .. } => {
                 self.time = end;
@@ -1005,6 +1504,58 @@ impl Vm {
         }
     }
 
+    /// The SE's `check_when` at time `t`: re-tests every condition handler; each
+    /// false→true edge schedules a firing at `t`. Returns how many will fire.
+    pub fn check_when(&mut self, t: i64) -> usize {
+        let m = Arc::clone(&self.m);
+        let mut fired = 0;
+        for i in 0..self.enabled.len() {
+            let Firing::Edge { last } = self.enabled[i].firing else {
+                continue;
+            };
+            let crate::bytecode::Trigger::Condition(c) =
+                m.handlers[self.enabled[i].handler as usize].trigger
+            else {
+                continue;
+            };
+            let args = std::mem::take(&mut self.enabled[i].cond_args);
+            let now = self.eval_cond_with(m.conds[c as usize].func, &args, t);
+            self.enabled[i].cond_args = args;
+            self.enabled[i].firing = Firing::Edge { last: now };
+            if now && !last {
+                self.fires.push((t, i));
+                fired += 1;
+            }
+        }
+        fired
+    }
+
+    /// Queues a remote request to run procedure `proc` with `args` (arriving at `t`).
+    /// It starts when the robot is idle, in arrival order.
+    pub fn request_remote(&mut self, proc: u32, args: Vec<u64>, t: i64) {
+        self.queue.push_back(Request {
+            proc,
+            args,
+            time: t,
+        });
+    }
+
+    /// Tells the caller that its remote request `req` ended at `t`; releases its join when
+    /// it was the last of its `parallel` block.
+    pub fn remote_done(&mut self, req: u64, t: i64) {
+        self.join.retain(|(_, r)| *r != req);
+        if let State::Joining { depth, pos } = self.state
+            && !self.join.iter().any(|(d, _)| *d == depth)
+        {
+            self.par_depth = self.par_depth.saturating_sub(1);
+            self.state = State::Released {
+                time: t,
+                timed_out: false,
+                pos,
+            };
+        }
+    }
+
     /// Evaluates condition `c` with the locals it captures from the main thread's frame.
     fn eval_cond(&mut self, c: u32, t: i64) -> bool {
         let m = Arc::clone(&self.m);
@@ -1025,8 +1576,14 @@ impl Vm {
                 }
             }
         }
+        self.eval_cond_with(cond.func, &args[..n], t)
+    }
+
+    /// Runs condition function `func` with `args`; false if it fails.
+    fn eval_cond_with(&mut self, func: u32, args: &[u64], t: i64) -> bool {
+        let m = Arc::clone(&self.m);
         let mut th = std::mem::take(&mut self.cond_thread);
-        th.start(&m, cond.func, &args[..n]);
+        th.start(&m, func, args);
         let mut budget = self.cfg.budget;
         let mut vars = std::mem::take(&mut self.vars);
         let r = th.run(

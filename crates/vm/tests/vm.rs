@@ -12,7 +12,7 @@ fn vm(src: &str, robot: &str, cfg: VmConfig) -> Vm {
     let out = vworks_wslc::compile("t.wsl", src).unwrap_or_else(|e| panic!("{e}"));
     let m = Arc::new(out.module);
     let entry = m.proc_index("main").unwrap();
-    Vm::new(m, Arc::new(builtin::load(robot).unwrap()), cfg, entry)
+    Vm::new(m, Arc::new(builtin::load(robot).unwrap()), cfg, Some(entry))
 }
 
 /// Runs the VM alone until it ends or blocks; sets are applied to its own globals.
@@ -28,7 +28,7 @@ fn run(vm: &mut Vm) -> Vec<Event> {
                     vm.check_wait(e.time);
                 }
             }
-            Next::Blocked | Next::Done => break,
+            Next::Blocked | Next::Done | Next::Idle => break,
         }
     }
     events
@@ -257,4 +257,358 @@ fn a_wait_for_a_signal_blocks_until_it_arrives() {
     let ev = run(&mut v);
     assert_eq!(kinds(&ev), ["wait_end", "log", "end"]);
     assert_eq!(ev[0].time, 7_000);
+}
+
+fn logs(ev: &[Event]) -> Vec<(i64, String)> {
+    ev.iter()
+        .filter_map(|e| match &e.kind {
+            EventKind::Log { text } => Some((e.time, text.clone())),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Like `run`, but answers `set` with `check_when` too.
+fn run_with_handlers(vm: &mut Vm) -> Vec<Event> {
+    let mut events = Vec::new();
+    for _ in 0..100_000 {
+        match vm.next_event() {
+            Next::Event(e) => {
+                events.push(e.clone());
+                vm.perform();
+                if let EventKind::Set { .. } = e.kind {
+                    vm.check_wait(e.time);
+                    vm.check_when(e.time);
+                }
+            }
+            _ => break,
+        }
+    }
+    events
+}
+
+#[test]
+fn handlers_fire_by_cycles_by_time_once_and_on_edges() {
+    let src = r#"
+        global parts = 0;
+        var ticks = 0;
+        proc tick() { ticks += 1; }
+        proc sample() { log "sample ", now(); }
+        proc alarm() { log "alarm ", now(); }
+        proc report(n: int) { log "report ", n; }
+        proc main() {
+            when every 10 cycles do tick();
+            when every 100ms do sample();
+            when after 250ms do alarm();
+            when parts >= 2 do report(parts);
+            delay 0.3s;
+            parts = 1;
+            parts = 2;
+            parts = 3;
+            disable tick;
+            log "ticks ", ticks;
+        }"#;
+    let mut v = vm(src, "irb120", VmConfig::default());
+    let ev = run_with_handlers(&mut v);
+    let ms = 1_000_000;
+    assert_eq!(
+        logs(&ev),
+        [
+            (100 * ms, "sample 0.1s".to_string()),
+            (200 * ms, "sample 0.2s".to_string()),
+            (250 * ms, "alarm 0.25s".to_string()),
+            (300 * ms, "sample 0.3s".to_string()),
+            (300 * ms, "report 2".to_string()),
+            (300 * ms, "ticks 7".to_string()),
+        ]
+    );
+    // Every 10 cycles of 4 ms: 40, 80, …, 280 ms; every fire has its end.
+    let fires = ev
+        .iter()
+        .filter(|e| matches!(e.kind, EventKind::WhenFire { .. }))
+        .count();
+    let ends = ev
+        .iter()
+        .filter(|e| matches!(e.kind, EventKind::WhenEnd { .. }))
+        .count();
+    assert_eq!(fires, 7 + 3 + 1 + 1);
+    assert_eq!(ends, fires);
+    assert_eq!(
+        ev.iter().filter(|e| e.kind.name() == "enable_when").count(),
+        4
+    );
+}
+
+#[test]
+fn a_handler_runs_while_the_motion_goes_on() {
+    let src = r#"
+        proc mark() { log "mark ", now(); }
+        proc main() {
+            when after 0.5s do mark();
+            move_j joints(90deg);
+            log "arrived ", now();
+        }"#;
+    let mut v = vm(src, "turntable", VmConfig::default());
+    let ev = run_with_handlers(&mut v);
+    assert_eq!(
+        logs(&ev),
+        [
+            (500_000_000, "mark 0.5s".into()),
+            (1_300_000_000, "arrived 1.3s".into())
+        ]
+    );
+    assert_eq!(
+        kinds(&ev),
+        [
+            "enable_when",
+            "motion_start",
+            "when_fire",
+            "log",
+            "when_end",
+            "motion_end",
+            "log",
+            "end"
+        ]
+    );
+}
+
+#[test]
+fn a_handler_that_takes_time_is_a_runtime_error() {
+    // The compiler rejects this; bytecode from elsewhere is caught by the VM.
+    let out = vworks_wslc::compile(
+        "t.wsl",
+        "proc h() { log \"x\"; log \"y\"; }\nproc main() { when every 1 cycles do h(); delay 1s; }",
+    )
+    .unwrap();
+    let mut m = out.module;
+    let h = m.proc_index("h").unwrap() as usize;
+    let at = m.procs[h].code_start as usize;
+    m.code[at] = vworks_vm::Instr::PushNum(1.0);
+    m.code[at + 1] = vworks_vm::Instr::Delay;
+    m.verify().unwrap();
+    let entry = m.proc_index("main");
+    let mut v = Vm::new(
+        Arc::new(m),
+        Arc::new(builtin::load("irb120").unwrap()),
+        VmConfig::default(),
+        entry,
+    );
+    let ev = run_with_handlers(&mut v);
+    let EventKind::Error { message } = &ev.last().unwrap().kind else {
+        panic!("{ev:?}")
+    };
+    assert!(message.contains("zero time"), "{message}");
+}
+
+/// Plays the SE for several VMs: earliest event first (ties by robot order), routing
+/// sets, signals and remote requests.
+fn run_cell(vms: &mut [Vm], names: &[&str]) -> Vec<(usize, Event)> {
+    let mut serving: Vec<std::collections::VecDeque<(usize, u64)>> =
+        vec![Default::default(); vms.len()];
+    let mut out = Vec::new();
+    for _ in 0..100_000 {
+        let mut best: Option<(i64, usize)> = None;
+        for (i, v) in vms.iter_mut().enumerate() {
+            if let Next::Event(e) = v.next_event()
+                && best.is_none_or(|(t, _)| e.time < t)
+            {
+                best = Some((e.time, i));
+            }
+        }
+        let Some((_, i)) = best else { break };
+        let Next::Event(e) = vms[i].next_event() else {
+            unreachable!()
+        };
+        vms[i].perform();
+        match &e.kind {
+            EventKind::RemoteCall { site, req, args } => {
+                let m = vms[i].module();
+                let (robot, proc) = (
+                    m.str(m.remotes[*site as usize].robot).to_string(),
+                    m.str(m.remotes[*site as usize].proc).to_string(),
+                );
+                let t = names.iter().position(|n| *n == robot).unwrap();
+                let p = vms[t].module().proc_index(&proc).unwrap();
+                vms[t].request_remote(p, args.clone(), e.time);
+                serving[t].push_back((i, *req));
+            }
+            EventKind::RemoteEnd { .. } => {
+                let (caller, req) = serving[i].pop_front().unwrap();
+                vms[caller].remote_done(req, e.time);
+            }
+            EventKind::Set { global, value, .. } => {
+                let m = vms[i].module();
+                let name = m.str(m.globals[*global as usize].name).to_string();
+                for v in vms.iter_mut() {
+                    if let Some(g) = v.module().global_index(&name) {
+                        v.set_global(g, *value);
+                        v.check_wait(e.time);
+                        v.check_when(e.time);
+                    }
+                }
+            }
+            EventKind::Signal { site } => {
+                let m = vms[i].module();
+                let s = &m.signals_sent[*site as usize];
+                let (robot, name) = (m.str(s.robot).to_string(), m.str(s.name).to_string());
+                let t = names.iter().position(|n| *n == robot).unwrap();
+                vms[t].deliver_signal(&name, e.time);
+            }
+            _ => {}
+        }
+        out.push((i, e));
+    }
+    out
+}
+
+#[test]
+fn parallel_waits_for_remote_work_served_when_the_robot_is_idle() {
+    let r1 = r#"
+        proc main() {
+            parallel {
+                remote r2.weld(2, 100mm);
+                { delay 0.5s; }
+            }
+            log "joined at ", now();
+            signal r2.done;
+        }"#;
+    let r2 = r#"
+        proc main() { delay 0.2s; log "r2 main done"; }
+        proc weld(n: int, len: length) { delay len / 100mm/s; log "welded ", n, " at ", now(); }
+        proc never() { wait_signal done; }"#;
+    let mut vms = vec![
+        vm(r1, "irb120", VmConfig::default()),
+        vm(r2, "irb120", VmConfig::default()),
+    ];
+    let ev = run_cell(&mut vms, &["r1", "r2"]);
+    let logs: Vec<(usize, String)> = ev
+        .iter()
+        .filter_map(|(i, e)| match &e.kind {
+            EventKind::Log { text } => Some((*i, text.clone())),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(
+        logs,
+        [
+            (1, "r2 main done".into()),
+            (1, "welded 2 at 1.2s".into()),
+            (0, "joined at 1.2s".into())
+        ]
+    );
+    let trace: Vec<(usize, &str)> = ev.iter().map(|(i, e)| (*i, e.kind.name())).collect();
+    assert!(
+        trace.contains(&(0, "remote_call"))
+            && trace.contains(&(1, "remote_start"))
+            && trace.contains(&(1, "remote_end"))
+            && trace.contains(&(0, "join"))
+    );
+}
+
+#[test]
+fn move_c_follows_its_arc_to_the_target() {
+    let src = "
+        const start = joints(0deg, 10deg, 20deg, 0deg, 60deg, 0deg);
+        proc main() {
+            move_j start;
+            var p = current_pose();
+            move_c offset(p, 50mm, 50mm, 0mm), offset(p, 100mm, 0mm, 0mm) speed 100mm/s;
+        }";
+    let mut v = vm(src, "irb120", VmConfig::default());
+    let model = builtin::load("irb120").unwrap();
+    let mut start = [0.0; 3];
+    let mut ev = Vec::new();
+    while let Next::Event(e) = v.next_event() {
+        if let EventKind::MotionStart {
+            command: "move_c", ..
+        } = e.kind
+        {
+            start = v.tcp_at(e.time).t;
+        }
+        ev.push(e);
+        v.perform();
+    }
+    assert_eq!(
+        kinds(&ev),
+        [
+            "motion_start",
+            "motion_end",
+            "motion_start",
+            "motion_end",
+            "end"
+        ]
+    );
+    // Radius 50 mm around (start.x + 50, start.y): every sample at that distance.
+    let (t0, t1) = (ev[2].time, ev[3].time);
+    let center = [start[0] + 0.05, start[1], start[2]];
+    let mut t = t0;
+    while t <= t1 {
+        let p = model.flange(&v.joints_at(t)[..6]).t;
+        let r =
+            ((p[0] - center[0]).powi(2) + (p[1] - center[1]).powi(2) + (p[2] - center[2]).powi(2))
+                .sqrt();
+        assert!(
+            (r - 0.05).abs() < 1e-6,
+            "off the arc by {} at {t}",
+            r - 0.05
+        );
+        t += 2_000_000;
+    }
+    let end = model.flange(&v.joints_at(t1)[..6]).t;
+    assert!(((end[0] - start[0] - 0.1).powi(2) + (end[1] - start[1]).powi(2)).sqrt() < 1e-9);
+}
+
+#[test]
+fn limits_reach_and_speed_are_checked() {
+    // Axis 3 of the IRB 120 stops at +70°.
+    let mut v = vm(
+        "proc main() { move_j joints(0deg, 0deg, 100deg, 0deg, 0deg, 0deg); }",
+        "irb120",
+        VmConfig::default(),
+    );
+    let ev = run(&mut v);
+    let EventKind::Error { message } = &ev[0].kind else {
+        panic!("{ev:?}")
+    };
+    assert!(
+        message.contains("joint limit exceeded: axis 3"),
+        "{message}"
+    );
+    // Three metres away.
+    let mut v = vm(
+        "proc main() { move_l pose(3000mm, 0mm, 300mm, 180deg, 0deg, 0deg); }",
+        "irb120",
+        VmConfig::default(),
+    );
+    let ev = run(&mut v);
+    let EventKind::Error { message } = &ev[0].kind else {
+        panic!("{ev:?}")
+    };
+    assert!(
+        message.contains("unreachable pose") && message.contains("out of reach"),
+        "{message}"
+    );
+    // Passing close to axis 1 at 2 m/s would spin axis 1 beyond 250°/s: slowed, with a warning.
+    let src = "proc main() {
+        move_j pose(300mm, -80mm, 400mm, 180deg, 0deg, 0deg);
+        move_l pose(300mm, 80mm, 400mm, 180deg, 0deg, 0deg) speed 2000mm/s;
+    }";
+    let mut v = vm(src, "irb120", VmConfig::default());
+    let ev = run(&mut v);
+    assert_eq!(
+        kinds(&ev),
+        [
+            "motion_start",
+            "motion_end",
+            "motion_start",
+            "motion_end",
+            "end"
+        ]
+    );
+    let w = v.take_warnings();
+    assert!(
+        w.iter()
+            .any(|(_, pos, m)| m.contains("slowed") && pos.line == 3),
+        "{w:?}"
+    );
 }
