@@ -1,0 +1,83 @@
+//! Interpreter dispatch (target ≥ 100 M simple instructions/s on an int loop) and motion
+//! sampling (the robot's joints at a time inside a move_l, target ≤ 5 µs per sample).
+
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // benches fail by panicking
+
+use std::hint::black_box;
+use std::sync::Arc;
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use vworks_model::builtin;
+use vworks_vm::machine::{EventKind, Next, Vm, VmConfig};
+
+const LOOPS: i64 = 1_000_000;
+
+fn vm(src: &str, robot: &str) -> Vm {
+    let m = Arc::new(vworks_wslc::compile("b.wsl", src).unwrap().module);
+    let entry = m.proc_index("main");
+    let cfg = VmConfig {
+        budget: u64::MAX,
+        ..VmConfig::default()
+    };
+    Vm::new(m, Arc::new(builtin::load(robot).unwrap()), cfg, entry)
+}
+
+fn dispatch(c: &mut Criterion) {
+    // Per iteration: LoadLocal, PushInt, CmpI, JumpIfFalse, LoadLocal, LoadLocal, AddI,
+    // StoreLocal, LoadLocal, PushInt, AddI, StoreLocal, Jump = 13 instructions.
+    let src = format!(
+        "proc main() {{ var i = 0; var s = 0; while i < {LOOPS} {{ s = s + i; i = i + 1; }} delay 1s; }}"
+    );
+    let mut g = c.benchmark_group("interpreter");
+    g.throughput(Throughput::Elements(13 * LOOPS as u64));
+    g.sample_size(20);
+    g.bench_function("int_loop", |b| {
+        b.iter_batched(
+            || vm(&src, "irb120"),
+            |mut v| {
+                let Next::Event(e) = v.next_event() else {
+                    panic!()
+                };
+                assert!(matches!(e.kind, EventKind::Delay { .. }));
+                black_box(e)
+            },
+            criterion::BatchSize::LargeInput,
+        )
+    });
+    g.finish();
+}
+
+fn sampling(c: &mut Criterion) {
+    let src = "
+        const start = joints(0deg, 10deg, 20deg, 0deg, 60deg, 0deg);
+        proc main() {
+            move_j start;
+            var p = current_pose();
+            move_l offset(p, 100mm, -150mm, -80mm) speed 200mm/s;
+        }";
+    let mut v = vm(src, "irb120");
+    // Into the move_l.
+    let (mut t0, mut dur) = (0, 0);
+    while let Next::Event(e) = v.next_event() {
+        v.perform();
+        if let EventKind::MotionStart {
+            command: "move_l",
+            duration_ns,
+        } = e.kind
+        {
+            (t0, dur) = (e.time, duration_ns);
+            break;
+        }
+    }
+    assert!(dur > 0);
+    let mut k = 0i64;
+    c.bench_function("motion/joints_at_inside_move_l", |b| {
+        b.iter(|| {
+            k = (k + 7_919_000) % dur;
+            black_box(v.joints_at(t0 + k))
+        })
+    });
+}
+
+criterion_group!(benches, dispatch, sampling);
+criterion_main!(benches);
