@@ -612,3 +612,113 @@ fn limits_reach_and_speed_are_checked() {
         "{w:?}"
     );
 }
+
+/// Replaces the identifiers a, b, x, y, q, l, p by their constant twins (a_c, …).
+fn rename_vars(e: &str) -> String {
+    let mut out = String::new();
+    let mut word = String::new();
+    // A field name after `.` is not a variable.
+    let flush = |word: &mut String, out: &mut String| {
+        if !out.ends_with('.') && ["a", "b", "x", "y", "q", "l", "p"].contains(&word.as_str()) {
+            word.push_str("_c");
+        }
+        out.push_str(word);
+        word.clear();
+    };
+    for ch in e.chars() {
+        if ch.is_ascii_alphanumeric() || ch == '_' {
+            word.push(ch);
+        } else {
+            flush(&mut word, &mut out);
+            out.push(ch);
+        }
+    }
+    flush(&mut word, &mut out);
+    out
+}
+
+/// The interpreter agrees with the compiler's constant folder: each expression is logged
+/// once folded at compile time (from constants) and once computed at run time (from
+/// module variables, which the compiler cannot fold).
+#[test]
+fn runtime_arithmetic_equals_constant_folding() {
+    let exprs = [
+        "a + b * 3 - 7",
+        "a / b",
+        "a mod b",
+        "-a mod b",
+        "abs(-a) + min(a, b) * max(a, b)",
+        "x * y / 4.5 - x",
+        "sqrt(x * x + y * y)",
+        "atan2(y, x)",
+        "sin(q) + cos(q)",
+        "int(x * 10.7)",
+        "num(a) * 0.5",
+        "x > y and not (a == b) or false",
+        "offset(p, 10mm, -5mm, 1mm).z",
+        "tool_offset(p, 10mm, 20mm, 30mm).x",
+        "tool_offset(p, 10mm, 20mm, 30mm).y",
+        "joints(q, q * 2, 0deg)[1]",
+        "l * 2 + 3mm",
+        "l / 2s",
+    ];
+    let mut src = String::from(
+        "const a_c = 17;\nconst b_c = 5;\nconst x_c = 2.5;\nconst y_c = -1.25;\nconst q_c = 30deg;\nconst l_c = 120mm;\nconst p_c = pose(400mm, -100mm, 300mm, 180deg, 10deg, 30deg);\n",
+    );
+    src.push_str("var a = a_c;\nvar b = b_c;\nvar x = x_c;\nvar y = y_c;\nvar q = q_c;\nvar l = l_c;\nvar p = p_c;\n");
+    for (i, e) in exprs.iter().enumerate() {
+        let folded = rename_vars(e);
+        src.push_str(&format!("const k{i} = {folded};\n"));
+    }
+    src.push_str("proc main() {\n");
+    for (i, e) in exprs.iter().enumerate() {
+        src.push_str(&format!("    log k{i}, \" \", {e};\n"));
+    }
+    src.push_str("}\n");
+    let out = vworks_wslc::compile("fold.wsl", &src);
+    let out = out.unwrap_or_else(|e| panic!("{e}\n{src}"));
+    let m = Arc::new(out.module);
+    let entry = m.proc_index("main");
+    let mut v = Vm::new(
+        m,
+        Arc::new(builtin::load("irb120").unwrap()),
+        VmConfig::default(),
+        entry,
+    );
+    let ev = run(&mut v);
+    let l = logs(&ev);
+    assert_eq!(l.len(), exprs.len(), "{ev:?}");
+    for ((_, text), e) in l.iter().zip(exprs) {
+        let (folded, computed) = text.split_once(' ').unwrap();
+        assert_eq!(folded, computed, "{e}");
+    }
+}
+
+#[test]
+fn runtime_errors_name_their_line() {
+    let cases = [
+        ("var z = 0;\n    var n = 10 / z;", "division by zero", 3),
+        (
+            "var j = current_joints();\n    var k = 9;\n    var v = j[k];",
+            "joint index 9 is out of range",
+            4,
+        ),
+        (
+            "var x = -1.0;\n    var r = sqrt(x);",
+            "square root of a negative",
+            3,
+        ),
+        ("fail \"gripper empty: \", 3;", "gripper empty: 3", 2),
+    ];
+    for (body, msg, line) in cases {
+        let src = format!("proc main() {{\n    {body}\n}}\n");
+        let mut v = vm(&src, "irb120", VmConfig::default());
+        let ev = run(&mut v);
+        let last = ev.last().unwrap();
+        let EventKind::Error { message } = &last.kind else {
+            panic!("{src}: {ev:?}")
+        };
+        assert!(message.contains(msg), "{src}: {message}");
+        assert_eq!(last.pos.line, line, "{src}");
+    }
+}
