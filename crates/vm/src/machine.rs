@@ -219,12 +219,30 @@ pub enum Next {
     Done,
 }
 
+/// Up to 12 slots of a pose (6) or joints (12) operand, without allocating.
+#[derive(Clone, Copy)]
+struct Slots {
+    v: [u64; MAX_AXES],
+    len: usize,
+}
+
+impl Slots {
+    fn read(stack: &[u64], from: usize, len: usize) -> Slots {
+        let mut v = [0u64; MAX_AXES];
+        v[..len].copy_from_slice(&stack[from..from + len]);
+        Slots { v, len }
+    }
+    fn get(&self) -> &[u64] {
+        &self.v[..self.len]
+    }
+}
+
 /// The operands of a motion instruction.
 struct MotionOperands {
     /// Target slots (6 for a pose, 12 for joints).
-    target: Vec<u64>,
+    target: Slots,
     /// Via point slots of `move_c`.
-    via: Option<Vec<u64>>,
+    via: Option<Slots>,
     /// `speed`, if given.
     speed: Option<f64>,
     /// `accel`, if given.
@@ -876,7 +894,7 @@ impl Vm {
         } else {
             6
         };
-        let target = s[s.len() - k - tw..s.len() - k].to_vec();
+        let target = Slots::read(s, s.len() - k - tw, tw);
         k += tw;
         let via = matches!(ins, Instr::MoveC(_)).then(|| {
             let vw = if f.has(MoveFlags::VIA_JOINTS) {
@@ -884,7 +902,7 @@ impl Vm {
             } else {
                 6
             };
-            let v = s[s.len() - k - vw..s.len() - k].to_vec();
+            let v = Slots::read(s, s.len() - k - vw, vw);
             k += vw;
             v
         });
@@ -923,12 +941,13 @@ impl Vm {
     /// Plans the motion of `ins` from the robot's state now; returns it and its duration.
     fn plan(&mut self, ins: Instr) -> Result<(Trajectory, i64), String> {
         let MotionOperands {
-            target,
+            target: target_slots,
             via,
             speed,
             accel,
             ..
         } = self.motion_operands(ins);
+        let target = target_slots.get();
         let n = self.model.dof();
         let from = self.rest;
         if let Instr::MoveJ(_) = ins {
@@ -999,7 +1018,7 @@ impl Vm {
                 to: goal.t,
             },
             Some(v) => {
-                let via_pose = self.operand_pose(v);
+                let via_pose = self.operand_pose(v.get());
                 Path::arc(start.t, via_pose.t, goal.t).ok_or_else(|| "move_c: the via point lies on the line from start to target; give a point off that line".to_string())?
             }
         };

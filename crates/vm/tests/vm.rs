@@ -722,3 +722,46 @@ fn runtime_errors_name_their_line() {
         assert_eq!(last.pos.line, line, "{src}");
     }
 }
+
+#[test]
+fn control_flow_calls_and_components_run_as_written() {
+    let src = r#"
+        var primes = 0;
+        func fact(n: int) -> int { if n <= 1 { return 1; } return n * fact(n - 1); }
+        func is_prime(n: int) -> bool {
+            if n < 2 { return false; }
+            var d = 2;
+            while d * d <= n {
+                if n mod d == 0 { return false; }
+                d += 1;
+            }
+            return true;
+        }
+        proc count(limit: int) {
+            for i in 0..limit {
+                if not is_prime(i) { continue; }
+                if i > 50 { break; }
+                primes += 1;
+            }
+        }
+        proc main() {
+            count(1000);
+            var p = pose(1mm, 2mm, 3mm, 0deg, 0deg, 0deg);
+            p.z = p.z * 10;
+            p.rz += 45deg;
+            var j = joints(0deg, 10deg, 20deg, 30deg, 40deg, 50deg);
+            j[5] = j[5] - 50deg;
+            j[0] += 1deg;
+            log primes, " ", fact(10), " ", p.z, " ", p.rz, " ", j[0], " ", j[5], " ", j;
+        }"#;
+    let mut v = vm(src, "irb120", VmConfig::default());
+    let ev = run(&mut v);
+    assert_eq!(
+        logs(&ev),
+        [(
+            0,
+            "15 3628800 30mm 45deg 1deg 0deg joints(1deg, 10deg, 20deg, 30deg, 40deg, 0deg)"
+                .to_string()
+        )]
+    );
+}
