@@ -958,7 +958,7 @@ impl Vm {
                 }
                 q
             } else {
-                self.ik_tcp(&to_iso(&target), &from)?
+                self.ik_tcp(&to_iso(target), &from)?
             };
             for (i, g) in goal.iter().enumerate().take(n) {
                 let j = self.model.axis(i);
@@ -1011,7 +1011,7 @@ impl Vm {
         }
         // Cartesian: line or arc, orientation by slerp.
         let start = self.tcp_at(self.time);
-        let goal = self.operand_pose(&target);
+        let goal = self.operand_pose(target);
         let path = match &via {
             None => Path::Line {
                 from: start.t,
