@@ -9,9 +9,16 @@
 //!   (`.wslb`), the loader that verifies untrusted bytes, and the disassembler.
 //! - [`math`]: pure pose/joint arithmetic used both for constant folding in the compiler and
 //!   by the interpreter, so compile-time and run-time results are bit-identical.
+//! - [`exec`]: the interpreter — threads of frames over a slot stack, a per-segment
+//!   instruction budget and a call-depth limit, no allocation per instruction.
+//! - [`motion`]: trapezoidal profiles, lines and arcs, slerp: joints as a pure function of
+//!   time inside a motion.
+//! - [`machine`]: [`machine::Vm`], one robot — the segment interface the simulation engine
+//!   drives (`next_event` / `perform`), motions, waits, signals, `when` handlers, remote
+//!   requests and `parallel` joins.
 //!
-//! The interpreter itself (execution segments, motion) arrives with issue 4; the format is
-//! documented in `docs/bytecode.md`.
+//! The format is documented in `docs/bytecode.md`, the contract with the engine in
+//! `docs/engine.md`.
 
 pub mod bytecode;
 pub mod exec;

@@ -765,3 +765,40 @@ fn control_flow_calls_and_components_run_as_written() {
         )]
     );
 }
+
+#[test]
+fn signal_timeouts_and_the_cycle_count() {
+    let src = r#"
+        proc main() {
+            wait_signal go timeout 0.25s;
+            log timed_out(), " ", now(), " ", cycle();
+            delay 1s;
+            wait_signal go timeout 2s;
+            log timed_out(), " ", now(), " ", cycle();
+        }"#;
+    let mut v = vm(
+        src,
+        "irb120",
+        VmConfig {
+            cycle_ns: 4_000_000,
+            ..VmConfig::default()
+        },
+    );
+    let mut ev = Vec::new();
+    while let Next::Event(e) = v.next_event() {
+        v.perform();
+        let is_delay = matches!(e.kind, EventKind::Delay { .. });
+        ev.push(e);
+        if is_delay {
+            // A signal sent during the delay is counted, then consumed at once by the wait.
+            assert!(!v.deliver_signal("go", 500_000_000));
+        }
+    }
+    assert_eq!(
+        logs(&ev),
+        [
+            (250_000_000, "true 0.25s 62".to_string()),
+            (1_250_000_000, "false 1.25s 312".to_string())
+        ]
+    );
+}
