@@ -308,11 +308,11 @@ instruction_set! {
     0x6b CurrentJoints;
     /// Pushes the robot's current TCP pose in the base frame.
     0x6c CurrentPose;
-    /// EVENT `motion_start`: joint move. Pops [accel] [speed] target (see the flags).
+    /// EVENT `motion_start`: joint move. Pops accel and speed (when flagged), then the target.
     0x70 MoveJ(f: MoveFlags);
-    /// EVENT `motion_start`: straight-line move. Pops [accel] [speed] target.
+    /// EVENT `motion_start`: straight-line move. Pops accel and speed (when flagged), then the target.
     0x71 MoveL(f: MoveFlags);
-    /// EVENT `motion_start`: circular move. Pops [accel] [speed] target via.
+    /// EVENT `motion_start`: circular move. Pops accel and speed (when flagged), then the target and the via point.
     0x72 MoveC(f: MoveFlags);
     /// EVENT: pops a time; the robot holds still that long.
     0x73 Delay;
