@@ -33,6 +33,8 @@ pub struct VmConfig {
     pub tool: Iso,
     /// Joints at the start.
     pub start_joints: Vec<f64>,
+    /// This robot's index in the cell (copied into every event).
+    pub robot: u32,
 }
 
 impl Default for VmConfig {
@@ -44,6 +46,7 @@ impl Default for VmConfig {
             default_speed: 0.25,
             tool: Iso::IDENTITY,
             start_joints: Vec::new(),
+            robot: 0,
         }
     }
 }
@@ -200,6 +203,8 @@ impl EventKind {
 pub struct Event {
     /// Simulated time (ns).
     pub time: i64,
+    /// The robot (its index in the cell, from [`VmConfig::robot`]).
+    pub robot: u32,
     /// What.
     pub kind: EventKind,
     /// The statement that caused it.
@@ -586,6 +591,7 @@ impl Vm {
 
     fn error_event(&self, e: &RuntimeError, time: i64) -> Event {
         Event {
+            robot: self.cfg.robot,
             time,
             kind: EventKind::Error {
                 message: e.message.clone(),
@@ -633,6 +639,7 @@ impl Vm {
         self.source = Source::Fire(i);
         let h = &self.m.handlers[self.enabled[i].handler as usize];
         Next::Event(Event {
+            robot: self.cfg.robot,
             time: t,
             kind: EventKind::WhenFire {
                 handler: self.enabled[i].handler,
@@ -659,11 +666,13 @@ impl Vm {
             State::Done => Next::Done,
             State::At(e) => Next::Event(e.clone()),
             State::Moving { end, pos } => Next::Event(Event {
+                robot: self.cfg.robot,
                 time: *end,
                 kind: EventKind::MotionEnd,
                 pos: *pos,
             }),
             State::Delaying { end, pos } => Next::Event(Event {
+                robot: self.cfg.robot,
                 time: *end,
                 kind: EventKind::DelayEnd,
                 pos: *pos,
@@ -673,6 +682,7 @@ impl Vm {
                 pos,
                 ..
             } => Next::Event(Event {
+                robot: self.cfg.robot,
                 time: *d,
                 kind: EventKind::WaitEnd { timed_out: true },
                 pos: *pos,
@@ -683,6 +693,7 @@ impl Vm {
                 timed_out,
                 pos,
             } => Next::Event(Event {
+                robot: self.cfg.robot,
                 time: *time,
                 kind: EventKind::WaitEnd {
                     timed_out: *timed_out,
@@ -693,6 +704,7 @@ impl Vm {
                 Some(r) => {
                     let p = &self.m.procs[r.proc as usize];
                     let e = Event {
+                        robot: self.cfg.robot,
                         time: r.time.max(self.time),
                         kind: EventKind::RemoteStart { proc: r.proc },
                         pos: p.pos,
@@ -762,7 +774,12 @@ impl Vm {
                     Err(message) => EventKind::Error { message },
                 },
             };
-            return Event { time: t, kind, pos };
+            return Event {
+                robot: self.cfg.robot,
+                time: t,
+                kind,
+                pos,
+            };
         }
     }
 
