@@ -477,10 +477,28 @@ fn parallel_waits_for_remote_work_served_when_the_robot_is_idle() {
         proc weld(n: int, len: length) { delay len / 100mm/s; log "welded ", n, " at ", now(); }
         proc never() { wait_signal done; }"#;
     let mut vms = vec![
-        vm(r1, "irb120", VmConfig::default()),
-        vm(r2, "irb120", VmConfig::default()),
+        vm(
+            r1,
+            "irb120",
+            VmConfig {
+                robot: 0,
+                ..VmConfig::default()
+            },
+        ),
+        vm(
+            r2,
+            "irb120",
+            VmConfig {
+                robot: 1,
+                ..VmConfig::default()
+            },
+        ),
     ];
     let ev = run_cell(&mut vms, &["r1", "r2"]);
+    assert!(
+        ev.iter().all(|(i, e)| e.robot as usize == *i),
+        "every event names its robot"
+    );
     let logs: Vec<(usize, String)> = ev
         .iter()
         .filter_map(|(i, e)| match &e.kind {
