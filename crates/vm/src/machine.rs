@@ -727,21 +727,12 @@ impl Vm {
     fn run_segment(&mut self, in_handler: bool, t: i64) -> Event {
         let m = Arc::clone(&self.m);
         loop {
-            let mut budget = self.cfg.budget;
             let mut thread = std::mem::take(if in_handler {
                 &mut self.handler
             } else {
                 &mut self.main
             });
-            let mut vars = std::mem::take(&mut self.vars);
-            let stop = thread.run(
-                &m,
-                &View { vm: self, t },
-                &mut vars,
-                &mut budget,
-                self.cfg.max_depth,
-            );
-            self.vars = vars;
+            let stop = self.run_thread(&mut thread, t);
             let pc = thread.pc;
             if in_handler {
                 self.handler = thread;
@@ -1615,11 +1606,9 @@ impl Vm {
         self.eval_cond_with(cond.func, &args[..n], t)
     }
 
-    /// Runs condition function `func` with `args`; false if it fails.
-    fn eval_cond_with(&mut self, func: u32, args: &[u64], t: i64) -> bool {
+    /// Runs a thread's zero-time code at time `t` over this VM's module variables.
+    fn run_thread(&mut self, th: &mut Thread, t: i64) -> Result<Stop, RuntimeError> {
         let m = Arc::clone(&self.m);
-        let mut th = std::mem::take(&mut self.cond_thread);
-        th.start(&m, func, args);
         let mut budget = self.cfg.budget;
         let mut vars = std::mem::take(&mut self.vars);
         let r = th.run(
@@ -1630,6 +1619,15 @@ impl Vm {
             self.cfg.max_depth,
         );
         self.vars = vars;
+        r
+    }
+
+    /// Runs condition function `func` with `args`; false if it fails.
+    fn eval_cond_with(&mut self, func: u32, args: &[u64], t: i64) -> bool {
+        let m = Arc::clone(&self.m);
+        let mut th = std::mem::take(&mut self.cond_thread);
+        th.start(&m, func, args);
+        let r = self.run_thread(&mut th, t);
         let value = matches!(r, Ok(Stop::Finished)) && th.stack.last().copied().unwrap_or(0) != 0;
         self.cond_thread = th;
         value

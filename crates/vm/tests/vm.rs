@@ -18,14 +18,15 @@ fn vm(src: &str, robot: &str, cfg: VmConfig) -> Vm {
 /// Runs the VM alone until it ends or blocks; sets are applied to its own globals.
 fn run(vm: &mut Vm) -> Vec<Event> {
     let mut events = Vec::new();
-    for _ in 0..10_000 {
+    for _ in 0..100_000 {
         match vm.next_event() {
             Next::Event(e) => {
                 events.push(e.clone());
                 vm.perform();
                 if let EventKind::Set { .. } = e.kind {
-                    // A lone VM: its own set may release its own wait.
+                    // A lone VM: its own set may release its own wait or fire its handlers.
                     vm.check_wait(e.time);
+                    vm.check_when(e.time);
                 }
             }
             Next::Blocked | Next::Done | Next::Idle => break,
@@ -268,25 +269,6 @@ fn logs(ev: &[Event]) -> Vec<(i64, String)> {
         .collect()
 }
 
-/// Like `run`, but answers `set` with `check_when` too.
-fn run_with_handlers(vm: &mut Vm) -> Vec<Event> {
-    let mut events = Vec::new();
-    for _ in 0..100_000 {
-        match vm.next_event() {
-            Next::Event(e) => {
-                events.push(e.clone());
-                vm.perform();
-                if let EventKind::Set { .. } = e.kind {
-                    vm.check_wait(e.time);
-                    vm.check_when(e.time);
-                }
-            }
-            _ => break,
-        }
-    }
-    events
-}
-
 #[test]
 fn handlers_fire_by_cycles_by_time_once_and_on_edges() {
     let src = r#"
@@ -309,7 +291,7 @@ fn handlers_fire_by_cycles_by_time_once_and_on_edges() {
             log "ticks ", ticks;
         }"#;
     let mut v = vm(src, "irb120", VmConfig::default());
-    let ev = run_with_handlers(&mut v);
+    let ev = run(&mut v);
     let ms = 1_000_000;
     assert_eq!(
         logs(&ev),
@@ -349,7 +331,7 @@ fn a_handler_runs_while_the_motion_goes_on() {
             log "arrived ", now();
         }"#;
     let mut v = vm(src, "turntable", VmConfig::default());
-    let ev = run_with_handlers(&mut v);
+    let ev = run(&mut v);
     assert_eq!(
         logs(&ev),
         [
@@ -393,7 +375,7 @@ fn a_handler_that_takes_time_is_a_runtime_error() {
         VmConfig::default(),
         entry,
     );
-    let ev = run_with_handlers(&mut v);
+    let ev = run(&mut v);
     let EventKind::Error { message } = &ev.last().unwrap().kind else {
         panic!("{ev:?}")
     };
