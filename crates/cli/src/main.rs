@@ -51,6 +51,20 @@ enum Command {
         /// A .wslb or .wsl file.
         file: PathBuf,
     },
+    /// Simulate a workcell and print a summary (exit 1 on collision stop, deadlock or error).
+    Run {
+        /// The workcell file (cell.toml).
+        cell: PathBuf,
+        /// Stop at this simulated time ("10s", "250ms", or seconds).
+        #[arg(long)]
+        until: Option<String>,
+        /// Print the result as one JSON object.
+        #[arg(long)]
+        json: bool,
+        /// Print the event trace, one line per event.
+        #[arg(long)]
+        trace: bool,
+    },
 }
 
 fn main() -> ExitCode {
@@ -91,6 +105,129 @@ fn compile_file(path: &Path, color: bool) -> Result<(Option<Module>, usize, usiz
             Ok((None, errors, e.diagnostics.len() - errors))
         }
     }
+}
+
+fn parse_time(s: &str) -> Result<i64, String> {
+    let mut diags = Vec::new();
+    let toks = vworks_wslc::lexer::lex(s.trim(), &mut diags);
+    use vworks_wslc::lexer::TokKind;
+    let secs = match toks.first().map(|t| &t.kind) {
+        Some(TokKind::Quantity(x, d)) if *d == vworks_vm::Dim::TIME && toks.len() == 2 => *x,
+        Some(TokKind::Int(i)) if toks.len() == 2 => *i as f64,
+        Some(TokKind::Num(x)) if toks.len() == 2 => *x,
+        _ => {
+            return Err(format!(
+                "--until `{s}` is not a time; write e.g. 10s or 250ms"
+            ));
+        }
+    };
+    Ok((secs * 1e9).round() as i64)
+}
+
+fn secs(ns: i64) -> String {
+    format!("{:.3} s", ns as f64 / 1e9)
+}
+
+fn run_cell(path: &Path, until: Option<&str>, json: bool, trace: bool) -> Result<ExitCode, String> {
+    let until = until.map(parse_time).transpose()?;
+    let cell = match vworks_se::workcell::load(path) {
+        Ok(c) => std::sync::Arc::new(c),
+        Err(vworks_se::workcell::CellError::Program { rendered, .. }) => {
+            eprint!("{rendered}");
+            return Err(format!("{}: the programs have errors", path.display()));
+        }
+        Err(e) => return Err(e.to_string()),
+    };
+    let started = std::time::Instant::now();
+    let r = vworks_se::engine::Simulation::new(std::sync::Arc::clone(&cell)).run(until);
+    let wall = started.elapsed().as_secs_f64();
+    if trace {
+        for e in &r.trace {
+            println!("{}", e.line(&cell));
+        }
+    }
+    let issue = |i: &vworks_se::engine::Issue| serde_json::json!({"kind": i.kind, "message": i.message, "robot": i.robot, "file": i.file, "line": i.line, "col": i.col});
+    if json {
+        let v = serde_json::json!({
+            "cell": cell.name,
+            "outcome": r.outcome.name(),
+            "end_time_ns": r.end_time_ns,
+            "robots": r.robots.iter().map(|s| serde_json::json!({
+                "name": s.name, "moving_ns": s.moving_ns, "waiting_ns": s.waiting_ns, "idle_ns": s.idle_ns,
+                "handler_ns": s.handler_ns, "motions": s.motions, "end_time_ns": s.end_time_ns, "ended": s.ended,
+            })).collect::<Vec<_>>(),
+            "collisions": r.collisions.iter().map(|c| serde_json::json!({"time_ns": c.time_ns, "a": c.a, "b": c.b, "depth_m": c.depth, "point_m": c.point})).collect::<Vec<_>>(),
+            "warnings": r.warnings.iter().map(issue).collect::<Vec<_>>(),
+            "errors": r.errors.iter().map(issue).collect::<Vec<_>>(),
+            "globals": r.globals.iter().map(|(k, v)| (k.clone(), serde_json::Value::String(v.clone()))).collect::<serde_json::Map<_, _>>(),
+            "cycles": r.cycles,
+            "collision_queries": r.queries,
+            "events": r.trace.len(),
+        });
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&v).map_err(|e| e.to_string())?
+        );
+    } else if !trace {
+        println!(
+            "cell {}: {} at {}",
+            cell.name,
+            r.outcome.name(),
+            secs(r.end_time_ns)
+        );
+        println!(
+            "{:<10} {:>10} {:>10} {:>10} {:>8}  ended",
+            "robot", "moving", "waiting", "idle", "motions"
+        );
+        for s in &r.robots {
+            println!(
+                "{:<10} {:>10} {:>10} {:>10} {:>8}  {} at {}",
+                s.name,
+                secs(s.moving_ns),
+                secs(s.waiting_ns),
+                secs(s.idle_ns),
+                s.motions,
+                s.ended,
+                secs(s.end_time_ns)
+            );
+        }
+        for c in &r.collisions {
+            println!(
+                "collision at {}: {} and {} (depth {:.1} mm)",
+                secs(c.time_ns),
+                c.a,
+                c.b,
+                c.depth * 1e3
+            );
+        }
+        for w in &r.warnings {
+            println!("warning[{}]: {}", w.kind, w.message);
+        }
+        for e in &r.errors {
+            let at = e
+                .file
+                .as_ref()
+                .map_or(String::new(), |f| format!(" ({f}:{}:{})", e.line, e.col));
+            println!("error[{}]: {}{at}", e.kind, e.message);
+        }
+        if !r.globals.is_empty() {
+            let g: Vec<String> = r.globals.iter().map(|(k, v)| format!("{k}={v}")).collect();
+            println!("globals: {}", g.join(", "));
+        }
+        println!(
+            "{} events, {} cycles, {} collision queries; {:.0}x real time",
+            r.trace.len(),
+            r.cycles,
+            r.queries,
+            r.end_time_ns as f64 / 1e9 / wall.max(1e-9)
+        );
+    }
+    Ok(match r.outcome {
+        vworks_se::engine::Outcome::Completed | vworks_se::engine::Outcome::Until => {
+            ExitCode::SUCCESS
+        }
+        _ => ExitCode::FAILURE,
+    })
 }
 
 fn plural(n: usize, word: &str) -> String {
@@ -136,6 +273,12 @@ fn run(cmd: Command, color: bool) -> Result<ExitCode, String> {
             );
             Ok(ExitCode::SUCCESS)
         }
+        Command::Run {
+            cell,
+            until,
+            json,
+            trace,
+        } => run_cell(&cell, until.as_deref(), json, trace),
         Command::Disasm { file } => {
             let bytes = std::fs::read(&file)
                 .map_err(|e| format!("cannot read `{}`: {e}", file.display()))?;

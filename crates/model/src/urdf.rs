@@ -525,7 +525,7 @@ fn mesh_candidates(filename: &str, dir: Option<&Path>, packages: &[PathBuf]) -> 
 }
 
 /// Builds the parry shape of a collision body once.
-pub(crate) fn build_shape(
+pub fn build_shape(
     geometry: Geometry,
     origin: Iso,
     file: &str,

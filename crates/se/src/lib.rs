@@ -1,8 +1,19 @@
-//! The vworks simulation engine (SE).
+//! The vworks simulation engine (SE): the paper's simulation management module.
 //!
-//! Not built yet: this crate will hold the paper's simulation management module, the event
-//! queue, the wait list and the when list, the cycle-boundary synchronisation and the parry
-//! collision checks (issue 5). Until then it only re-exports the link step it will call
-//! when a workcell is loaded, so embedders have one entry point.
+//! - [`workcell`]: workcell files → a [`workcell::Cell`]: models, compiled and linked
+//!   programs, devices and parts.
+//! - [`engine`]: the event queue, the wait and when lists (through each VM), cycle
+//!   boundaries, races, deadlocks, statistics: [`engine::Simulation`].
+//! - [`collide`]: collision checks at cycle boundaries (parry3d).
+//!
+//! ```no_run
+//! let cell = std::sync::Arc::new(vworks_se::workcell::load("workcells/handoff/cell.toml".as_ref()).unwrap());
+//! let result = vworks_se::engine::Simulation::new(cell).run(None);
+//! println!("{} at {} ns", result.outcome.name(), result.end_time_ns);
+//! ```
+
+pub mod collide;
+pub mod engine;
+pub mod workcell;
 
 pub use vworks_wslc::link;

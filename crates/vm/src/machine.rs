@@ -504,6 +504,59 @@ impl Vm {
         }
     }
 
+    /// What the robot waits for, when it is blocked: for deadlock reports.
+    pub fn waiting_for(&self) -> Option<(String, SrcPos)> {
+        match &self.state {
+            State::Waiting {
+                cond: Some(c), pos, ..
+            } => {
+                let info = &self.m.conds[*c as usize];
+                let names: Vec<&str> = info
+                    .globals
+                    .iter()
+                    .map(|g| self.m.str(self.m.globals[*g as usize].name))
+                    .collect();
+                Some((format!("a condition on {}", names.join(", ")), *pos))
+            }
+            State::Waiting {
+                signal: Some(s),
+                pos,
+                ..
+            } => Some((format!("the signal `{}`", self.m.str(*s)), *pos)),
+            State::Joining { pos, .. } => Some((
+                "the remote work of its `parallel` block (join)".into(),
+                *pos,
+            )),
+            _ => None,
+        }
+    }
+
+    /// The globals (module indices) the robot's current wait condition reads.
+    pub fn wait_globals(&self) -> &[u32] {
+        match &self.state {
+            State::Waiting { cond: Some(c), .. } => &self.m.conds[*c as usize].globals,
+            _ => &[],
+        }
+    }
+
+    /// True while a motion is in progress at time `t`.
+    pub fn moving_at(&self, t: i64) -> bool {
+        matches!(self.state, State::Moving { end, .. } if t < end)
+            && self.motion.as_ref().is_some_and(|(s, _)| t > *s)
+    }
+
+    /// The globals (module indices) the enabled condition handlers read.
+    pub fn when_globals(&self) -> impl Iterator<Item = u32> + '_ {
+        self.enabled
+            .iter()
+            .filter_map(|e| match self.m.handlers[e.handler as usize].trigger {
+                crate::bytecode::Trigger::Condition(c) => Some(&self.m.conds[c as usize].globals),
+                _ => None,
+            })
+            .flatten()
+            .copied()
+    }
+
     /// Warnings produced so far (time, position, message); the SE drains them.
     pub fn take_warnings(&mut self) -> Vec<(i64, SrcPos, String)> {
         std::mem::take(&mut self.warnings)
@@ -1046,11 +1099,12 @@ impl Vm {
         let w = std::f64::consts::PI;
         let mut vs = f64::INFINITY;
         let mut as_ = f64::INFINITY;
-        if len > 0.0 {
+        // Below 0.1 µm and 0.1 µrad a move is a rounding error, not a motion.
+        if len > 1e-7 {
             vs = vs.min(v / len);
             as_ = as_.min(a / len);
         }
-        if angle > 1e-12 {
+        if angle > 1e-7 {
             vs = vs.min(w / angle);
             as_ = as_.min(w / vworks_model::model::DEFAULT_ACCEL_TIME / angle);
         }

@@ -1,0 +1,752 @@
+//! The simulation management module: the paper's algorithm (section 3.2, figure 3).
+//!
+//! 1. Every VM runs to its first event, which goes into the event queue.
+//! 2. The earliest entry (time, then the sequence number given when it was queued) is
+//!    taken; its VM performs the event.
+//! 3. On `set`, `check_wait`/`check_when` entries are queued for exactly the robots whose
+//!    wait condition or condition handlers read that global — queued, not called, so
+//!    events already due for those robots run first.
+//! 4. The VM's next event is queued. Repeat until every robot has ended, a collision
+//!    stops the run, a runtime error, a deadlock, or `until`.
+//!
+//! Cycle boundaries k·cycle are synchronisation points: before any event at or after a
+//! boundary, every robot's state at the boundary is sampled and collisions are checked
+//! ([`crate::collide`]). A VM's queued entry carries a generation number; when the VM's
+//! next event changes (a wait released, a request arrived), the old entry is skipped.
+
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+use std::sync::Arc;
+
+use vworks_vm::bytecode::SrcPos;
+use vworks_vm::machine::{Event, EventKind, Next, Vm, VmConfig};
+use vworks_vm::types::fmt_quantity;
+use vworks_vm::{ConstValue, Type};
+
+use crate::collide::{Collider, Contact};
+use crate::workcell::Cell;
+
+/// How the run ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Outcome {
+    /// Every robot's program ended and no remote work is queued.
+    Completed,
+    /// A collision with `on_collision = "stop"`.
+    Collision,
+    /// Every unfinished robot waits and no timed event is pending.
+    Deadlock,
+    /// A runtime error.
+    Error,
+    /// The `until` time was reached.
+    Until,
+}
+
+impl Outcome {
+    /// As in `run --json`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Outcome::Completed => "completed",
+            Outcome::Collision => "collision",
+            Outcome::Deadlock => "deadlock",
+            Outcome::Error => "error",
+            Outcome::Until => "until",
+        }
+    }
+}
+
+/// One line of the event trace.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TraceEvent {
+    /// Time (ns).
+    pub time: i64,
+    /// Robot index, if the event belongs to one.
+    pub robot: Option<usize>,
+    /// Kind, e.g. `motion_start`.
+    pub kind: &'static str,
+    /// Details (no newlines).
+    pub details: String,
+    /// Source position: (file, line, col).
+    pub pos: Option<(Arc<str>, SrcPos)>,
+}
+
+/// A warning or error of the run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Issue {
+    /// `race`, `near_miss`, `slowdown`, `runtime`, `deadlock`, …
+    pub kind: String,
+    /// The message.
+    pub message: String,
+    /// The robot, if one.
+    pub robot: Option<String>,
+    /// Source position, if known.
+    pub file: Option<String>,
+    /// Line (0 if unknown).
+    pub line: u32,
+    /// Column (0 if unknown).
+    pub col: u32,
+}
+
+/// Time spent per robot.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RobotStats {
+    /// Name.
+    pub name: String,
+    /// In motion.
+    pub moving_ns: i64,
+    /// Waiting (conditions, signals, joins).
+    pub waiting_ns: i64,
+    /// Neither (delays, and after the program ended).
+    pub idle_ns: i64,
+    /// In handlers: they run in zero simulated time, so always 0.
+    pub handler_ns: i64,
+    /// Motions started.
+    pub motions: u32,
+    /// When its program ended (or the run ended).
+    pub end_time_ns: i64,
+    /// How it ended: `ended`, `error`, `waiting`, `running`.
+    pub ended: String,
+}
+
+/// What a run produced.
+#[derive(Clone, Debug)]
+pub struct RunResult {
+    /// How it ended.
+    pub outcome: Outcome,
+    /// Simulated end time (ns).
+    pub end_time_ns: i64,
+    /// Per robot.
+    pub robots: Vec<RobotStats>,
+    /// Collisions that started.
+    pub collisions: Vec<Contact>,
+    /// Warnings.
+    pub warnings: Vec<Issue>,
+    /// Errors (runtime errors, deadlock).
+    pub errors: Vec<Issue>,
+    /// Final values of the globals, by name.
+    pub globals: Vec<(String, String)>,
+    /// The event trace.
+    pub trace: Vec<TraceEvent>,
+    /// Cycle boundaries passed and collision queries made.
+    pub cycles: u64,
+    /// Narrow-phase queries made.
+    pub queries: u64,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+enum Entry {
+    /// The robot's next event (robot, generation).
+    Vm(usize, u64),
+    /// Re-test the robot's wait condition after a set of a global (cell index).
+    CheckWait(usize, u32),
+    /// Re-test the robot's condition handlers after a set of a global (cell index).
+    CheckWhen(usize, u32),
+}
+
+/// A running simulation of a cell.
+#[derive(Debug)]
+pub struct Simulation {
+    cell: Arc<Cell>,
+    vms: Vec<Vm>,
+    files: Vec<Arc<str>>,
+    queue: BinaryHeap<Reverse<(i64, u64, Entry)>>,
+    seq: u64,
+    generation: Vec<u64>,
+    queued_at: Vec<Option<i64>>,
+    /// Cell globals: value bits and type.
+    globals: Vec<(u64, Type)>,
+    /// Per robot: cell global index → module global index.
+    to_module: Vec<Vec<Option<u32>>>,
+    /// Per cell global: last set (time, robot, pos) and last condition read at a wait start.
+    last_set: Vec<Option<(i64, usize, SrcPos)>>,
+    last_read: Vec<Option<(i64, usize, SrcPos)>>,
+    /// Remote requests each robot serves, in order: (caller, request number).
+    serving: Vec<std::collections::VecDeque<(usize, u64)>>,
+    /// Open intervals per robot: motion start, wait start.
+    moving_since: Vec<Option<i64>>,
+    waiting_since: Vec<Option<i64>>,
+    stats: Vec<RobotStats>,
+    collider: Collider,
+    next_boundary: i64,
+    time: i64,
+    trace: Vec<TraceEvent>,
+    warnings: Vec<Issue>,
+    errors: Vec<Issue>,
+    collisions: Vec<Contact>,
+    outcome: Option<Outcome>,
+    cycles: u64,
+}
+
+fn format_value(v: u64, ty: Type) -> String {
+    match ty {
+        Type::Bool => (v != 0).to_string(),
+        Type::Int => (v as i64).to_string(),
+        Type::Num(d) => fmt_quantity(f64::from_bits(v), d),
+        _ => format!("{v:#x}"),
+    }
+}
+
+impl Simulation {
+    /// A simulation of `cell` at time 0, every VM created (none has run yet).
+    pub fn new(cell: Arc<Cell>) -> Simulation {
+        let n = cell.robots.len();
+        let globals = cell
+            .linked
+            .globals
+            .iter()
+            .map(|g| {
+                let mut s = [0u64];
+                g.init.write_slots(&mut s);
+                (s[0], g.ty)
+            })
+            .collect::<Vec<_>>();
+        let mut to_module = vec![vec![None; globals.len()]; n];
+        for (r, links) in cell.linked.robots.iter().enumerate() {
+            for (mg, cg) in links.globals.iter().enumerate() {
+                to_module[r][*cg as usize] = Some(mg as u32);
+            }
+        }
+        let vms = cell
+            .robots
+            .iter()
+            .enumerate()
+            .map(|(i, r)| {
+                let cfg = VmConfig {
+                    cycle_ns: cell.cycle_ns,
+                    default_speed: r.default_speed,
+                    tool: r.tool,
+                    start_joints: r.home.clone(),
+                    robot: i as u32,
+                    ..VmConfig::default()
+                };
+                Vm::new(Arc::clone(&r.module), Arc::clone(&r.model), cfg, r.entry)
+            })
+            .collect();
+        let files = cell
+            .robots
+            .iter()
+            .map(|r| Arc::<str>::from(r.program.as_str()))
+            .collect();
+        let stats = cell
+            .robots
+            .iter()
+            .map(|r| RobotStats {
+                name: r.name.clone(),
+                ..RobotStats::default()
+            })
+            .collect();
+        let collider = Collider::new(&cell);
+        Simulation {
+            vms,
+            files,
+            queue: BinaryHeap::new(),
+            seq: 0,
+            generation: vec![0; n],
+            queued_at: vec![None; n],
+            last_set: vec![None; globals.len()],
+            last_read: vec![None; globals.len()],
+            globals,
+            to_module,
+            serving: vec![Default::default(); n],
+            moving_since: vec![None; n],
+            waiting_since: vec![None; n],
+            stats,
+            collider,
+            next_boundary: 0,
+            time: 0,
+            trace: Vec::new(),
+            warnings: Vec::new(),
+            errors: Vec::new(),
+            collisions: Vec::new(),
+            outcome: None,
+            cycles: 0,
+            cell,
+        }
+    }
+
+    /// The simulated time.
+    pub fn time(&self) -> i64 {
+        self.time
+    }
+
+    /// The VM of robot `i`.
+    pub fn vm(&self, i: usize) -> &Vm {
+        &self.vms[i]
+    }
+
+    /// The cell.
+    pub fn cell(&self) -> &Cell {
+        &self.cell
+    }
+
+    /// The trace so far.
+    pub fn trace(&self) -> &[TraceEvent] {
+        &self.trace
+    }
+
+    fn push(&mut self, time: i64, entry: Entry) {
+        self.seq += 1;
+        self.queue.push(Reverse((time, self.seq, entry)));
+    }
+
+    /// (Re)queues robot `r`'s next event; the previous entry becomes stale.
+    fn requeue(&mut self, r: usize) {
+        self.generation[r] += 1;
+        self.queued_at[r] = None;
+        if let Next::Event(e) = self.vms[r].next_event() {
+            self.queued_at[r] = Some(e.time);
+            let g = self.generation[r];
+            self.push(e.time, Entry::Vm(r, g));
+        }
+    }
+
+    fn record(
+        &mut self,
+        time: i64,
+        robot: Option<usize>,
+        kind: &'static str,
+        details: String,
+        pos: Option<SrcPos>,
+    ) {
+        let pos = match (robot, pos) {
+            (Some(r), Some(p)) if p.line > 0 => Some((Arc::clone(&self.files[r]), p)),
+            _ => None,
+        };
+        self.trace.push(TraceEvent {
+            time,
+            robot,
+            kind,
+            details,
+            pos,
+        });
+    }
+
+    fn issue(
+        &self,
+        kind: &str,
+        message: String,
+        robot: Option<usize>,
+        pos: Option<SrcPos>,
+    ) -> Issue {
+        Issue {
+            kind: kind.into(),
+            message,
+            robot: robot.map(|r| self.cell.robots[r].name.clone()),
+            file: robot
+                .filter(|_| pos.is_some())
+                .map(|r| self.files[r].to_string()),
+            line: pos.map_or(0, |p| p.line),
+            col: pos.map_or(0, |p| p.col),
+        }
+    }
+
+    /// Runs to the end (or to `until` ns).
+    pub fn run(mut self, until: Option<i64>) -> RunResult {
+        for r in 0..self.vms.len() {
+            self.requeue(r);
+        }
+        while self.step(until) {}
+        self.finish()
+    }
+
+    /// Handles the next queue entry. Returns false when the run is over.
+    pub fn step(&mut self, until: Option<i64>) -> bool {
+        if self.outcome.is_some() {
+            return false;
+        }
+        let Some(Reverse((t, _, entry))) = self.queue.pop() else {
+            self.end_without_events();
+            return false;
+        };
+        if let Some(u) = until
+            && t > u
+        {
+            self.advance_cycles(u);
+            self.time = u;
+            self.outcome = Some(Outcome::Until);
+            return false;
+        }
+        self.advance_cycles(t);
+        if self.outcome.is_some() {
+            return false;
+        }
+        self.time = t;
+        match entry {
+            Entry::Vm(r, g) => {
+                if g != self.generation[r] {
+                    return true;
+                }
+                self.queued_at[r] = None;
+                self.perform(r);
+            }
+            Entry::CheckWait(r, cg) => {
+                let name = self.cell.linked.globals[cg as usize].name.clone();
+                self.record(t, Some(r), "check_wait", name, None);
+                if self.vms[r].check_wait(t) {
+                    self.requeue(r);
+                }
+            }
+            Entry::CheckWhen(r, cg) => {
+                let name = self.cell.linked.globals[cg as usize].name.clone();
+                self.record(t, Some(r), "check_when", name, None);
+                if self.vms[r].check_when(t) > 0 {
+                    self.requeue(r);
+                }
+            }
+        }
+        self.outcome.is_none()
+    }
+
+    /// Processes every cycle boundary up to and including `t`.
+    fn advance_cycles(&mut self, t: i64) {
+        let c = self.cell.cycle_ns;
+        while self.next_boundary <= t {
+            let b = self.next_boundary;
+            self.next_boundary += c;
+            self.cycles += 1;
+            let moving: Vec<bool> = self.vms.iter().map(|v| v.moving_at(b)).collect();
+            let events = self.collider.check(&self.cell, &self.vms, b, &moving);
+            for ev in events {
+                match ev {
+                    crate::collide::CollisionEvent::Start(contact) => {
+                        let d = format!(
+                            "{} {} depth={} point=({:.4}, {:.4}, {:.4})",
+                            contact.a,
+                            contact.b,
+                            fmt_quantity(contact.depth, vworks_vm::Dim::LENGTH),
+                            contact.point[0],
+                            contact.point[1],
+                            contact.point[2]
+                        );
+                        self.record(b, None, "collision_start", d, None);
+                        self.collisions.push(contact);
+                        if self.cell.stop_on_collision {
+                            self.time = b;
+                            self.outcome = Some(Outcome::Collision);
+                            return;
+                        }
+                    }
+                    crate::collide::CollisionEvent::End(a, bname) => {
+                        self.record(b, None, "collision_end", format!("{a} {bname}"), None)
+                    }
+                    crate::collide::CollisionEvent::NearMiss(a, bname, dist) => {
+                        let m = format!(
+                            "near miss: {a} and {bname} come within {}",
+                            fmt_quantity(dist, vworks_vm::Dim::LENGTH)
+                        );
+                        self.record(b, None, "warning", format!("\"{m}\""), None);
+                        let issue = self.issue("near_miss", m, None, None);
+                        self.warnings.push(issue);
+                    }
+                }
+            }
+            // With nothing queued before the next boundary and nothing moving, skip ahead.
+            if !moving.iter().any(|m| *m) {
+                let next_event = self
+                    .queue
+                    .peek()
+                    .map_or(t, |Reverse((nt, _, _))| *nt)
+                    .min(t);
+                if next_event > self.next_boundary {
+                    let skip = (next_event - self.next_boundary) / c;
+                    self.next_boundary += skip * c;
+                    self.cycles += skip as u64;
+                }
+            }
+        }
+    }
+
+    fn perform(&mut self, r: usize) {
+        let Next::Event(e) = self.vms[r].next_event() else {
+            return;
+        };
+        self.vms[r].perform();
+        self.account(r, &e);
+        self.route(r, &e);
+        for (t, pos, m) in self.vms[r].take_warnings() {
+            self.record(t, Some(r), "warning", format!("\"{m}\""), Some(pos));
+            let issue = self.issue("slowdown", m, Some(r), Some(pos));
+            self.warnings.push(issue);
+        }
+        if self.outcome.is_none() {
+            self.requeue(r);
+        }
+    }
+
+    fn account(&mut self, r: usize, e: &Event) {
+        match &e.kind {
+            EventKind::MotionStart { .. } => {
+                self.stats[r].motions += 1;
+                self.moving_since[r] = Some(e.time);
+            }
+            EventKind::MotionEnd => {
+                if let Some(s) = self.moving_since[r].take() {
+                    self.stats[r].moving_ns += e.time - s;
+                }
+            }
+            EventKind::WaitUntil { .. } | EventKind::WaitSignal { .. } | EventKind::Join => {
+                self.waiting_since[r] = Some(e.time)
+            }
+            EventKind::WaitEnd { .. } => {
+                if let Some(s) = self.waiting_since[r].take() {
+                    self.stats[r].waiting_ns += e.time - s;
+                }
+            }
+            EventKind::End | EventKind::Error { .. } => self.stats[r].end_time_ns = e.time,
+            EventKind::RemoteEnd { .. } => self.stats[r].end_time_ns = e.time,
+            _ => {}
+        }
+    }
+
+    fn route(&mut self, r: usize, e: &Event) {
+        let t = e.time;
+        let m = self.vms[r].module();
+        let details = match &e.kind {
+            EventKind::MotionStart {
+                command,
+                duration_ns,
+            } => format!("{command} duration={duration_ns}"),
+            EventKind::Delay { duration_ns } => format!("duration={duration_ns}"),
+            EventKind::Set { global, value, ty } => format!(
+                "{}={}",
+                m.str(m.globals[*global as usize].name),
+                format_value(*value, *ty)
+            ),
+            EventKind::WaitUntil { cond, deadline } => {
+                let names: Vec<&str> = m.conds[*cond as usize]
+                    .globals
+                    .iter()
+                    .map(|g| m.str(m.globals[*g as usize].name))
+                    .collect();
+                format!(
+                    "condition({}){}",
+                    names.join(","),
+                    deadline.map_or(String::new(), |d| format!(" deadline={d}"))
+                )
+            }
+            EventKind::WaitSignal { name, deadline } => format!(
+                "signal={}{}",
+                m.str(*name),
+                deadline.map_or(String::new(), |d| format!(" deadline={d}"))
+            ),
+            EventKind::WaitEnd { timed_out } => {
+                (if *timed_out { "timeout" } else { "released" }).into()
+            }
+            EventKind::Signal { site } => {
+                let s = &m.signals_sent[*site as usize];
+                format!("{}.{}", m.str(s.robot), m.str(s.name))
+            }
+            EventKind::Grip { site } | EventKind::Release { site } => {
+                m.str(m.parts[*site as usize].part).to_string()
+            }
+            EventKind::Log { text } => format!("{text:?}"),
+            EventKind::Error { message } => format!("{message:?}"),
+            EventKind::EnableWhen { handler }
+            | EventKind::WhenFire { handler }
+            | EventKind::WhenEnd { handler } => m
+                .str(m.procs[m.handlers[*handler as usize].target as usize].name)
+                .to_string(),
+            EventKind::DisableWhen { proc } => m.str(m.procs[*proc as usize].name).to_string(),
+            EventKind::RemoteCall { site, .. } => {
+                let s = &m.remotes[*site as usize];
+                format!("{}.{}", m.str(s.robot), m.str(s.proc))
+            }
+            EventKind::RemoteStart { proc } | EventKind::RemoteEnd { proc } => {
+                m.str(m.procs[*proc as usize].name).to_string()
+            }
+            _ => String::new(),
+        };
+        self.record(t, Some(r), e.kind.name(), details, Some(e.pos));
+        match &e.kind {
+            EventKind::Set { global, value, .. } => self.on_set(r, *global, *value, t, e.pos),
+            EventKind::WaitUntil { cond, .. } => {
+                let m = self.vms[r].module();
+                let globals: Vec<u32> = m.conds[*cond as usize].globals.clone();
+                for g in globals {
+                    let cg = self.cell.linked.robots[r].globals[g as usize] as usize;
+                    self.check_race(cg, r, t, e.pos, false);
+                    self.last_read[cg] = Some((t, r, e.pos));
+                }
+            }
+            EventKind::Signal { site } => {
+                let target = self.cell.linked.robots[r].signals[*site as usize] as usize;
+                let name = {
+                    let m = self.vms[r].module();
+                    m.str(m.signals_sent[*site as usize].name).to_string()
+                };
+                if self.vms[target].deliver_signal(&name, t) {
+                    self.requeue(target);
+                }
+            }
+            EventKind::RemoteCall { site, req, args } => {
+                let (target, proc) = self.cell.linked.robots[r].remotes[*site as usize];
+                let target = target as usize;
+                self.vms[target].request_remote(proc, args.clone(), t);
+                self.serving[target].push_back((r, *req));
+                if self.queued_at[target].is_none() {
+                    self.requeue(target);
+                }
+            }
+            EventKind::RemoteEnd { .. } => {
+                if let Some((caller, req)) = self.serving[r].pop_front() {
+                    self.vms[caller].remote_done(req, t);
+                    self.requeue(caller);
+                }
+            }
+            EventKind::Grip { site } => {
+                let part = self.cell.linked.robots[r].parts[*site as usize] as usize;
+                self.collider.grip(part, r, &self.vms[r], &self.cell, t);
+            }
+            EventKind::Release { site } => {
+                let part = self.cell.linked.robots[r].parts[*site as usize] as usize;
+                self.collider.release(part, &self.vms, &self.cell, t);
+            }
+            EventKind::Error { message } => {
+                let issue = self.issue("runtime", message.clone(), Some(r), Some(e.pos));
+                self.errors.push(issue);
+                self.outcome = Some(Outcome::Error);
+            }
+            _ => {}
+        }
+    }
+
+    fn check_race(&mut self, cg: usize, r: usize, t: i64, pos: SrcPos, is_set: bool) {
+        let others = [
+            self.last_set[cg],
+            if is_set { self.last_read[cg] } else { None },
+        ];
+        for (ot, or, opos) in others.into_iter().flatten() {
+            if ot == t && or != r {
+                let name = &self.cell.linked.globals[cg].name;
+                let a = &self.cell.robots[or].name;
+                let b = &self.cell.robots[r].name;
+                let m = format!(
+                    "race on `{name}` at {}: {a} ({}:{}) and {b} ({}:{}) touch it at the same instant; the outcome depends on their order",
+                    fmt_quantity(t as f64 / 1e9, vworks_vm::Dim::TIME),
+                    self.files[or],
+                    opos,
+                    self.files[r],
+                    pos
+                );
+                self.record(t, Some(r), "warning", format!("{m:?}"), Some(pos));
+                let issue = self.issue("race", m, Some(r), Some(pos));
+                self.warnings.push(issue);
+            }
+        }
+    }
+
+    fn on_set(&mut self, r: usize, g: u32, value: u64, t: i64, pos: SrcPos) {
+        let cg = self.cell.linked.robots[r].globals[g as usize] as usize;
+        self.check_race(cg, r, t, pos, true);
+        self.last_set[cg] = Some((t, r, pos));
+        self.globals[cg].0 = value;
+        for q in 0..self.vms.len() {
+            let Some(mg) = self.to_module[q][cg] else {
+                continue;
+            };
+            self.vms[q].set_global(mg, value);
+            if self.vms[q].wait_globals().contains(&mg) {
+                self.push(t, Entry::CheckWait(q, cg as u32));
+            }
+            if self.vms[q].when_globals().any(|x| x == mg) {
+                self.push(t, Entry::CheckWhen(q, cg as u32));
+            }
+        }
+    }
+
+    /// The queue ran dry: everyone ended, or a deadlock.
+    fn end_without_events(&mut self) {
+        let blocked: Vec<usize> = (0..self.vms.len())
+            .filter(|r| matches!(self.vms[*r].next_event(), Next::Blocked))
+            .collect();
+        if blocked.is_empty() {
+            self.outcome = Some(Outcome::Completed);
+            return;
+        }
+        let mut parts = Vec::new();
+        for r in &blocked {
+            let (what, pos) = self.vms[*r]
+                .waiting_for()
+                .unwrap_or_else(|| ("something".into(), SrcPos::default()));
+            parts.push(format!(
+                "{} waits for {what} ({}:{pos})",
+                self.cell.robots[*r].name, self.files[*r]
+            ));
+        }
+        let m = format!("deadlock: {}", parts.join("; "));
+        self.record(self.time, None, "error", format!("{m:?}"), None);
+        let issue = self.issue("deadlock", m, None, None);
+        self.errors.push(issue);
+        self.outcome = Some(Outcome::Deadlock);
+    }
+
+    fn finish(mut self) -> RunResult {
+        let end = self.time;
+        for r in 0..self.vms.len() {
+            if let Some(s) = self.moving_since[r].take() {
+                self.stats[r].moving_ns += end - s;
+            }
+            if let Some(s) = self.waiting_since[r].take() {
+                self.stats[r].waiting_ns += end - s;
+            }
+            let st = &mut self.stats[r];
+            st.ended = match self.vms[r].next_event() {
+                Next::Idle => "ended".into(),
+                Next::Done => "error".into(),
+                Next::Blocked => "waiting".into(),
+                Next::Event(_) => "running".into(),
+            };
+            if st.end_time_ns == 0 || st.ended != "ended" {
+                st.end_time_ns = if st.ended == "ended" {
+                    st.end_time_ns
+                } else {
+                    end
+                };
+            }
+            st.idle_ns = (end - st.moving_ns - st.waiting_ns).max(0);
+        }
+        let globals = self
+            .cell
+            .linked
+            .globals
+            .iter()
+            .zip(&self.globals)
+            .map(|(g, (v, ty))| {
+                let _ = ConstValue::Int(0);
+                (g.name.clone(), format_value(*v, *ty))
+            })
+            .collect();
+        RunResult {
+            outcome: self.outcome.unwrap_or(Outcome::Completed),
+            end_time_ns: end,
+            robots: self.stats,
+            collisions: self.collisions,
+            warnings: self.warnings,
+            errors: self.errors,
+            globals,
+            trace: self.trace,
+            cycles: self.cycles,
+            queries: self.collider.queries,
+        }
+    }
+}
+
+impl TraceEvent {
+    /// The trace line: `time_ns robot kind details file:line:col`, `-` for empty fields.
+    pub fn line(&self, cell: &Cell) -> String {
+        let robot = self
+            .robot
+            .map_or("-".to_string(), |r| cell.robots[r].name.clone());
+        let details = if self.details.is_empty() {
+            "-".to_string()
+        } else {
+            self.details.clone()
+        };
+        let pos = self.pos.as_ref().map_or("-".to_string(), |(f, p)| {
+            let rel = std::path::Path::new(f.as_ref())
+                .file_name()
+                .map_or(f.to_string(), |n| n.to_string_lossy().into_owned());
+            format!("{rel}:{}:{}", p.line, p.col)
+        });
+        format!("{} {robot} {} {details} {pos}", self.time, self.kind)
+    }
+}

@@ -1,0 +1,609 @@
+//! Workcell files (TOML): robots, devices, parts and settings, loaded into a [`Cell`]
+//! ready to simulate — models loaded, programs compiled and linked, shapes built.
+//!
+//! Plain numbers are SI (m, rad, s); strings carry units exactly as in WSL (`"4ms"`,
+//! `"250mm/s"`, `"90deg"`). Paths are relative to the workcell file. Every problem is a
+//! [`CellError`] naming the file, the key and what to do.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use parry3d::shape::SharedShape;
+use serde::Deserialize;
+use vworks_model::math::Iso;
+use vworks_model::model::Geometry;
+use vworks_model::urdf::{LoadOptions, load_file};
+use vworks_model::{RobotModel, builtin};
+use vworks_vm::{Dim, Module};
+use vworks_wslc::link::{CellSpec, Linked, RobotSpec, link};
+use vworks_wslc::{Diagnostic, Sources};
+
+/// Why a workcell could not be loaded.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum CellError {
+    /// A file could not be read.
+    #[error("cannot read `{file}`: {reason}")]
+    Read {
+        /// The file.
+        file: String,
+        /// Why.
+        reason: String,
+    },
+    /// The workcell file is wrong at a key.
+    #[error("{file}: {key}: {message}")]
+    Invalid {
+        /// The workcell file.
+        file: String,
+        /// Where in it, e.g. `robot[0].default_speed`.
+        key: String,
+        /// What is wrong and what to do.
+        message: String,
+    },
+    /// A robot model failed to load.
+    #[error("{file}: robot `{robot}`: {source}")]
+    Model {
+        /// The workcell file.
+        file: String,
+        /// The robot.
+        robot: String,
+        /// The model error (it names the URDF file and element).
+        source: vworks_model::ModelError,
+    },
+    /// Programs did not compile or link: every diagnostic, rendered with its source.
+    #[error("{rendered}")]
+    Program {
+        /// The diagnostics.
+        diagnostics: Vec<Diagnostic>,
+        /// The same, rendered with source lines.
+        rendered: String,
+    },
+}
+
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+struct PoseFile {
+    xyz: Option<Vec<toml::Value>>,
+    rpy: Option<Vec<toml::Value>>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct RobotFile {
+    name: String,
+    model: Option<String>,
+    urdf: Option<String>,
+    tool_link: Option<String>,
+    #[serde(default)]
+    package_path: Vec<String>,
+    base: Option<PoseFile>,
+    tool: Option<PoseFile>,
+    program: Option<String>,
+    entry: Option<String>,
+    serve_only: Option<bool>,
+    default_speed: Option<toml::Value>,
+    home: Option<Vec<toml::Value>>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct BodyFile {
+    name: String,
+    #[serde(rename = "box")]
+    box_: Option<Vec<toml::Value>>,
+    cylinder: Option<Vec<toml::Value>>,
+    sphere: Option<toml::Value>,
+    mesh: Option<String>,
+    scale: Option<f64>,
+    pose: Option<PoseFile>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct CellFile {
+    name: Option<String>,
+    cycle: Option<toml::Value>,
+    clearance: Option<toml::Value>,
+    on_collision: Option<String>,
+    #[serde(default)]
+    robot: Vec<RobotFile>,
+    #[serde(default)]
+    device: Vec<BodyFile>,
+    #[serde(default)]
+    part: Vec<BodyFile>,
+    #[serde(default)]
+    allow_collision: Vec<Vec<String>>,
+}
+
+/// A robot of the cell.
+#[derive(Debug, Clone)]
+pub struct Robot {
+    /// Its name.
+    pub name: String,
+    /// Its model.
+    pub model: Arc<RobotModel>,
+    /// Base frame in the cell.
+    pub base: Iso,
+    /// TCP in the tool-link frame.
+    pub tool: Iso,
+    /// Its compiled program.
+    pub module: Arc<Module>,
+    /// The program file.
+    pub program: String,
+    /// Entry procedure (`None`: serve-only).
+    pub entry: Option<u32>,
+    /// Speed of `move_l`/`move_c` without `speed` (m/s).
+    pub default_speed: f64,
+    /// Joints at the start.
+    pub home: Vec<f64>,
+}
+
+/// A static or movable body: a device or a part.
+#[derive(Debug, Clone)]
+pub struct Body {
+    /// Its name.
+    pub name: String,
+    /// What it is.
+    pub geometry: Geometry,
+    /// Its parry shape.
+    pub shape: SharedShape,
+    /// Shape pose in the body frame (cylinders turned onto z).
+    pub local: Iso,
+    /// Body pose in the cell.
+    pub pose: Iso,
+}
+
+/// A loaded workcell.
+#[derive(Debug, Clone)]
+pub struct Cell {
+    /// Its name.
+    pub name: String,
+    /// The workcell file.
+    pub file: PathBuf,
+    /// Cycle period (ns).
+    pub cycle_ns: i64,
+    /// Near-miss distance (m).
+    pub clearance: f64,
+    /// Stop at the first collision.
+    pub stop_on_collision: bool,
+    /// Robots, in file order.
+    pub robots: Vec<Robot>,
+    /// Static bodies.
+    pub devices: Vec<Body>,
+    /// Movable bodies.
+    pub parts: Vec<Body>,
+    /// Pairs allowed to touch: body names (`r1.link_6`, `r1` for all its links, `part1`).
+    pub allowed: Vec<(String, String)>,
+    /// The linked programs.
+    pub linked: Linked,
+    /// Every file the run depends on: (path, text) for programs and the workcell.
+    pub sources: Vec<(String, String)>,
+}
+
+struct Ctx<'a> {
+    file: &'a str,
+}
+
+impl Ctx<'_> {
+    fn bad(&self, key: &str, message: impl Into<String>) -> CellError {
+        CellError::Invalid {
+            file: self.file.to_string(),
+            key: key.to_string(),
+            message: message.into(),
+        }
+    }
+
+    /// A quantity of dimension `dim`: a number (SI) or a string with a unit.
+    fn quantity(&self, v: &toml::Value, dim: Dim, key: &str) -> Result<f64, CellError> {
+        let unit_hint = || match dim {
+            Dim::LENGTH => "\"250mm\" or 0.25 (metres)",
+            Dim::ANGLE => "\"90deg\" or 1.5708 (radians)",
+            Dim::TIME => "\"4ms\" or 0.004 (seconds)",
+            Dim::SPEED => "\"250mm/s\" or 0.25 (m/s)",
+            _ => "a number",
+        };
+        match v {
+            toml::Value::Integer(i) => Ok(*i as f64),
+            toml::Value::Float(x) if x.is_finite() => Ok(*x),
+            toml::Value::String(s) => {
+                let mut diags = Vec::new();
+                let toks = vworks_wslc::lexer::lex(s.trim(), &mut diags);
+                use vworks_wslc::lexer::TokKind;
+                let kinds: Vec<&TokKind> = toks
+                    .iter()
+                    .map(|t| &t.kind)
+                    .filter(|k| **k != TokKind::Eof)
+                    .collect();
+                let (neg, kinds) = match kinds.as_slice() {
+                    [TokKind::P(vworks_wslc::lexer::Punct::Minus), rest @ ..] => {
+                        (-1.0, rest.to_vec())
+                    }
+                    other => (1.0, other.to_vec()),
+                };
+                match (diags.is_empty(), kinds.as_slice()) {
+                    (true, [TokKind::Quantity(x, d)]) if *d == dim => Ok(neg * x),
+                    (true, [TokKind::Quantity(_, d)]) => Err(self.bad(
+                        key,
+                        format!(
+                            "`{s}` is {}, but {key} is {}; write {}",
+                            d.described(),
+                            dim.described(),
+                            unit_hint()
+                        ),
+                    )),
+                    (true, [TokKind::Int(i)]) => Ok(neg * *i as f64),
+                    (true, [TokKind::Num(x)]) => Ok(neg * x),
+                    _ => Err(self.bad(
+                        key,
+                        format!("`{s}` is not a quantity; write {}", unit_hint()),
+                    )),
+                }
+            }
+            other => Err(self.bad(
+                key,
+                format!("expected {}, found {}", unit_hint(), other.type_str()),
+            )),
+        }
+    }
+
+    fn pose(&self, p: Option<&PoseFile>, key: &str) -> Result<Iso, CellError> {
+        let Some(p) = p else { return Ok(Iso::IDENTITY) };
+        let vec3 =
+            |v: &Option<Vec<toml::Value>>, dim: Dim, sub: &str| -> Result<[f64; 3], CellError> {
+                let Some(v) = v else { return Ok([0.0; 3]) };
+                if v.len() != 3 {
+                    return Err(self.bad(
+                        &format!("{key}.{sub}"),
+                        format!("needs 3 values, found {}", v.len()),
+                    ));
+                }
+                let mut out = [0.0; 3];
+                for (i, x) in v.iter().enumerate() {
+                    out[i] = self.quantity(x, dim, &format!("{key}.{sub}[{i}]"))?;
+                }
+                Ok(out)
+            };
+        Ok(Iso::from_xyz_rpy(
+            vec3(&p.xyz, Dim::LENGTH, "xyz")?,
+            vec3(&p.rpy, Dim::ANGLE, "rpy")?,
+        ))
+    }
+
+    fn body(&self, b: &BodyFile, key: &str, dir: &Path) -> Result<Body, CellError> {
+        let given = [
+            b.box_.is_some(),
+            b.cylinder.is_some(),
+            b.sphere.is_some(),
+            b.mesh.is_some(),
+        ]
+        .iter()
+        .filter(|x| **x)
+        .count();
+        if given != 1 {
+            return Err(self.bad(
+                key,
+                format!(
+                    "`{}` needs exactly one shape: box, cylinder, sphere or mesh",
+                    b.name
+                ),
+            ));
+        }
+        let len = |v: &toml::Value, k: &str| -> Result<f64, CellError> {
+            let x = self.quantity(v, Dim::LENGTH, k)?;
+            if x > 0.0 {
+                Ok(x)
+            } else {
+                Err(self.bad(k, "must be greater than zero"))
+            }
+        };
+        let geometry = if let Some(bx) = &b.box_ {
+            if bx.len() != 3 {
+                return Err(self.bad(&format!("{key}.box"), "needs 3 sizes: [x, y, z]"));
+            }
+            let mut half = [0.0; 3];
+            for (i, v) in bx.iter().enumerate() {
+                half[i] = len(v, &format!("{key}.box[{i}]"))? / 2.0;
+            }
+            Geometry::Box { half }
+        } else if let Some(c) = &b.cylinder {
+            if c.len() != 2 {
+                return Err(self.bad(&format!("{key}.cylinder"), "needs [radius, length]"));
+            }
+            Geometry::Cylinder {
+                radius: len(&c[0], &format!("{key}.cylinder[0]"))?,
+                length: len(&c[1], &format!("{key}.cylinder[1]"))?,
+            }
+        } else if let Some(r) = &b.sphere {
+            Geometry::Sphere {
+                radius: len(r, &format!("{key}.sphere"))?,
+            }
+        } else {
+            let mesh = b.mesh.as_deref().unwrap_or_default();
+            let path = dir.join(mesh);
+            let bytes = std::fs::read(&path).map_err(|e| {
+                self.bad(
+                    &format!("{key}.mesh"),
+                    format!("cannot read `{}`: {e}", path.display()),
+                )
+            })?;
+            let s = b.scale.unwrap_or(1.0);
+            let points = vworks_model::mesh::read_vertices(&bytes, mesh, [s; 3]).map_err(|e| {
+                self.bad(&format!("{key}.mesh"), format!("`{}`: {e}", path.display()))
+            })?;
+            Geometry::Hull {
+                source: path.display().to_string(),
+                points,
+            }
+        };
+        let shaped = vworks_model::urdf::build_shape(geometry, Iso::IDENTITY, self.file, key)
+            .map_err(|e| self.bad(key, e.to_string()))?;
+        let local = match shaped.geometry {
+            Geometry::Cylinder { .. } => {
+                Iso::from_xyz_rpy([0.0; 3], [std::f64::consts::FRAC_PI_2, 0.0, 0.0])
+            }
+            _ => Iso::IDENTITY,
+        };
+        Ok(Body {
+            name: b.name.clone(),
+            geometry: shaped.geometry,
+            shape: shaped.shape,
+            local,
+            pose: self.pose(b.pose.as_ref(), &format!("{key}.pose"))?,
+        })
+    }
+}
+
+/// Loads a workcell file: models, programs (compiled and linked), shapes.
+pub fn load(path: &Path) -> Result<Cell, CellError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| CellError::Read {
+        file: file.clone(),
+        reason: e.to_string(),
+    })?;
+    let cx = Ctx { file: &file };
+    let cf: CellFile = toml::from_str(&text).map_err(|e| {
+        let msg = e.message().to_string();
+        let place = e.span().map(|s| {
+            let line = text[..s.start.min(text.len())].matches('\n').count() + 1;
+            format!("line {line}")
+        });
+        cx.bad(&place.unwrap_or_else(|| "file".into()), msg)
+    })?;
+    let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let cycle = match &cf.cycle {
+        Some(v) => cx.quantity(v, Dim::TIME, "cycle")?,
+        None => 0.004,
+    };
+    if !(1e-4..=0.1).contains(&cycle) {
+        return Err(cx.bad(
+            "cycle",
+            format!("{cycle} s is outside the allowed 0.1 ms to 100 ms; write e.g. \"4ms\""),
+        ));
+    }
+    let clearance = match &cf.clearance {
+        Some(v) => cx.quantity(v, Dim::LENGTH, "clearance")?,
+        None => 0.0,
+    };
+    if clearance < 0.0 {
+        return Err(cx.bad("clearance", "cannot be negative"));
+    }
+    let stop_on_collision = match cf.on_collision.as_deref() {
+        None | Some("stop") => true,
+        Some("continue") => false,
+        Some(other) => {
+            return Err(cx.bad(
+                "on_collision",
+                format!("`{other}` is not a choice; write \"stop\" or \"continue\""),
+            ));
+        }
+    };
+    if cf.robot.is_empty() {
+        return Err(cx.bad("robot", "the cell has no robot; add a [[robot]] table"));
+    }
+    let mut names: Vec<&str> = Vec::new();
+    for (k, n) in cf
+        .robot
+        .iter()
+        .map(|r| ("robot", r.name.as_str()))
+        .chain(cf.device.iter().map(|d| ("device", d.name.as_str())))
+        .chain(cf.part.iter().map(|p| ("part", p.name.as_str())))
+    {
+        if names.contains(&n) {
+            return Err(cx.bad(
+                k,
+                format!(
+                    "the name `{n}` is used twice; robots, devices and parts need unique names"
+                ),
+            ));
+        }
+        names.push(n);
+    }
+
+    let mut sources = vec![(file.clone(), text.clone())];
+    let mut robots = Vec::new();
+    let mut modules: Vec<(String, Arc<Module>)> = Vec::new();
+    let mut diagnostics = Vec::new();
+    let mut render_sources = Sources::new();
+    for (i, r) in cf.robot.iter().enumerate() {
+        let key = format!("robot[{i}] `{}`", r.name);
+        let model = match (&r.model, &r.urdf) {
+            (Some(m), None) => {
+                builtin::load(m).map_err(|e| cx.bad(&format!("{key}.model"), e.to_string()))?
+            }
+            (None, Some(u)) => {
+                let opts = LoadOptions {
+                    tool_link: r.tool_link.clone(),
+                    package_paths: r.package_path.iter().map(|p| dir.join(p)).collect(),
+                };
+                load_file(&dir.join(u), &opts).map_err(|e| CellError::Model {
+                    file: file.clone(),
+                    robot: r.name.clone(),
+                    source: e,
+                })?
+            }
+            _ => return Err(cx.bad(
+                &key,
+                "give either `model` (a built-in robot) or `urdf` (a file), not both or neither",
+            )),
+        };
+        let serve_only = r.serve_only.unwrap_or(false);
+        let Some(program) = &r.program else {
+            return Err(cx.bad(
+                &format!("{key}.program"),
+                "every robot needs a program file (`program = \"r1.wsl\"`)",
+            ));
+        };
+        let ppath = dir.join(program);
+        let pname = ppath.display().to_string();
+        let module = match modules.iter().find(|(p, _)| *p == pname) {
+            Some((_, m)) => Arc::clone(m),
+            None => {
+                let src = std::fs::read_to_string(&ppath).map_err(|e| {
+                    cx.bad(
+                        &format!("{key}.program"),
+                        format!("cannot read `{pname}`: {e}"),
+                    )
+                })?;
+                render_sources.add(&pname, &src);
+                sources.push((pname.clone(), src.clone()));
+                match vworks_wslc::compile(&pname, &src) {
+                    Ok(out) => {
+                        let m = Arc::new(out.module);
+                        modules.push((pname.clone(), Arc::clone(&m)));
+                        m
+                    }
+                    Err(e) => {
+                        diagnostics.extend(e.diagnostics);
+                        continue;
+                    }
+                }
+            }
+        };
+        let home = match &r.home {
+            None => vec![0.0; model.dof()],
+            Some(v) => {
+                if v.len() != model.dof() {
+                    return Err(cx.bad(
+                        &format!("{key}.home"),
+                        format!(
+                            "has {} values but the robot has {} axes",
+                            v.len(),
+                            model.dof()
+                        ),
+                    ));
+                }
+                let mut h = Vec::new();
+                for (k, x) in v.iter().enumerate() {
+                    let dim = if (model.linear_axes() >> k) & 1 == 1 {
+                        Dim::LENGTH
+                    } else {
+                        Dim::ANGLE
+                    };
+                    h.push(cx.quantity(x, dim, &format!("{key}.home[{k}]"))?);
+                }
+                h
+            }
+        };
+        let default_speed = match &r.default_speed {
+            Some(v) => cx.quantity(v, Dim::SPEED, &format!("{key}.default_speed"))?,
+            None => 0.25,
+        };
+        let entry_name = r.entry.clone().unwrap_or_else(|| "main".into());
+        let entry = if serve_only {
+            None
+        } else {
+            module.proc_index(&entry_name)
+        };
+        robots.push((
+            Robot {
+                name: r.name.clone(),
+                base: cx.pose(r.base.as_ref(), &format!("{key}.base"))?,
+                tool: cx.pose(r.tool.as_ref(), &format!("{key}.tool"))?,
+                model: Arc::new(model),
+                module,
+                program: pname,
+                entry,
+                default_speed,
+                home,
+            },
+            entry_name,
+            serve_only,
+        ));
+    }
+    if !diagnostics.is_empty() {
+        let rendered = vworks_wslc::render(&diagnostics, &render_sources, false);
+        return Err(CellError::Program {
+            diagnostics,
+            rendered,
+        });
+    }
+    let devices = cf
+        .device
+        .iter()
+        .enumerate()
+        .map(|(i, d)| cx.body(d, &format!("device[{i}] `{}`", d.name), &dir))
+        .collect::<Result<Vec<_>, _>>()?;
+    let parts = cf
+        .part
+        .iter()
+        .enumerate()
+        .map(|(i, p)| cx.body(p, &format!("part[{i}] `{}`", p.name), &dir))
+        .collect::<Result<Vec<_>, _>>()?;
+    let part_names: Vec<&str> = parts.iter().map(|p| p.name.as_str()).collect();
+    let spec = CellSpec {
+        robots: robots
+            .iter()
+            .map(|(r, entry, serve)| RobotSpec {
+                name: &r.name,
+                module: &r.module,
+                axes: r.model.dof(),
+                linear_axes: r.model.linear_axes(),
+                entry: Some(entry.as_str()),
+                serve_only: *serve,
+            })
+            .collect(),
+        parts: part_names,
+    };
+    let linked = link(&spec).map_err(|e| CellError::Program {
+        rendered: vworks_wslc::render(&e.diagnostics, &render_sources, false),
+        diagnostics: e.diagnostics,
+    })?;
+    let mut allowed = Vec::new();
+    for (i, pair) in cf.allow_collision.iter().enumerate() {
+        let [a, b] = pair.as_slice() else {
+            return Err(cx.bad(
+                &format!("allow_collision[{i}]"),
+                "each entry is a pair: [\"r1.link_6\", \"part1\"]",
+            ));
+        };
+        for n in [a, b] {
+            let (owner, link) = n.split_once('.').unwrap_or((n.as_str(), ""));
+            let known = robots.iter().any(|(r, _, _)| {
+                r.name == owner && (link.is_empty() || r.model.link_index(link).is_some())
+            }) || (link.is_empty()
+                && (cf.device.iter().any(|d| d.name == owner)
+                    || cf.part.iter().any(|p| p.name == owner)));
+            if !known {
+                return Err(cx.bad(&format!("allow_collision[{i}]"), format!("`{n}` is not a body of the cell; name a device, a part, a robot, or a robot's link as ROBOT.LINK")));
+            }
+        }
+        allowed.push((a.clone(), b.clone()));
+    }
+    Ok(Cell {
+        name: cf.name.unwrap_or_else(|| {
+            path.file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default()
+        }),
+        file: path.to_path_buf(),
+        cycle_ns: (cycle * 1e9).round() as i64,
+        clearance,
+        stop_on_collision,
+        robots: robots.into_iter().map(|(r, _, _)| r).collect(),
+        devices,
+        parts,
+        allowed,
+        linked,
+        sources,
+    })
+}
