@@ -94,7 +94,18 @@ fn matches(name: &str, owner: Owner, cell: &Cell, pattern: &str) -> bool {
     if name == pattern {
         return true;
     }
-    matches!(owner, Owner::Link { robot, .. } if cell.robots[robot].name == pattern)
+    match owner {
+        Owner::Link { robot, link } => {
+            let r = &cell.robots[robot];
+            match pattern.split_once('.') {
+                None => r.name == pattern,
+                Some((rn, ln)) => {
+                    rn == r.name && crate::workcell::same_link(&r.model.links[link].name, ln)
+                }
+            }
+        }
+        _ => false,
+    }
 }
 
 impl Collider {

@@ -48,7 +48,7 @@ pub enum CellError {
         /// The robot.
         robot: String,
         /// The model error (it names the URDF file and element).
-        source: vworks_model::ModelError,
+        source: Box<vworks_model::ModelError>,
     },
     /// Programs did not compile or link: every diagnostic, rendered with its source.
     #[error("{rendered}")]
@@ -83,6 +83,9 @@ struct RobotFile {
     serve_only: Option<bool>,
     default_speed: Option<toml::Value>,
     home: Option<Vec<toml::Value>>,
+    /// Allowed pairs may follow any table (TOML puts a key after `[[robot]]` into it).
+    #[serde(default)]
+    allow_collision: Vec<Vec<String>>,
 }
 
 #[derive(Deserialize, Debug)]
@@ -96,6 +99,8 @@ struct BodyFile {
     mesh: Option<String>,
     scale: Option<f64>,
     pose: Option<PoseFile>,
+    #[serde(default)]
+    allow_collision: Vec<Vec<String>>,
 }
 
 #[derive(Deserialize, Debug)]
@@ -353,6 +358,17 @@ impl Ctx<'_> {
     }
 }
 
+/// Link names match ignoring `_` and case: `link6` names `link_6`.
+pub fn same_link(a: &str, b: &str) -> bool {
+    let norm = |s: &str| {
+        s.chars()
+            .filter(|c| *c != '_')
+            .flat_map(char::to_lowercase)
+            .collect::<String>()
+    };
+    a == b || norm(a) == norm(b)
+}
+
 /// Loads a workcell file: models, programs (compiled and linked), shapes.
 pub fn load(path: &Path) -> Result<Cell, CellError> {
     let file = path.display().to_string();
@@ -438,7 +454,7 @@ pub fn load(path: &Path) -> Result<Cell, CellError> {
                 load_file(&dir.join(u), &opts).map_err(|e| CellError::Model {
                     file: file.clone(),
                     robot: r.name.clone(),
-                    source: e,
+                    source: Box::new(e),
                 })?
             }
             _ => return Err(cx.bad(
@@ -569,7 +585,15 @@ pub fn load(path: &Path) -> Result<Cell, CellError> {
         diagnostics: e.diagnostics,
     })?;
     let mut allowed = Vec::new();
-    for (i, pair) in cf.allow_collision.iter().enumerate() {
+    // `allow_collision` at the top, or written after a table (and so inside it in TOML).
+    let all_pairs: Vec<&Vec<String>> = cf
+        .allow_collision
+        .iter()
+        .chain(cf.robot.iter().flat_map(|r| r.allow_collision.iter()))
+        .chain(cf.device.iter().flat_map(|d| d.allow_collision.iter()))
+        .chain(cf.part.iter().flat_map(|p| p.allow_collision.iter()))
+        .collect();
+    for (i, pair) in all_pairs.into_iter().enumerate() {
         let [a, b] = pair.as_slice() else {
             return Err(cx.bad(
                 &format!("allow_collision[{i}]"),
