@@ -148,8 +148,11 @@ pub struct Simulation {
     cell: Arc<Cell>,
     vms: Vec<Vm>,
     files: Vec<Arc<str>>,
-    queue: BinaryHeap<Reverse<(i64, u64, Entry)>>,
+    queue: BinaryHeap<Reverse<(i64, u64, u64, Entry)>>,
     seq: u64,
+    /// Tie-break rank per robot for same-time entries of different robots (all 0 normally:
+    /// first queued, first served). Tests permute it to prove the results do not depend on it.
+    rank: Vec<u64>,
     generation: Vec<u64>,
     queued_at: Vec<Option<i64>>,
     /// Cell globals: value bits and type.
@@ -240,6 +243,7 @@ impl Simulation {
             files,
             queue: BinaryHeap::new(),
             seq: 0,
+            rank: vec![0; n],
             generation: vec![0; n],
             queued_at: vec![None; n],
             last_set: vec![None; globals.len()],
@@ -283,9 +287,30 @@ impl Simulation {
         &self.trace
     }
 
+    /// The program file of robot `r` as messages name it (its file name).
+    fn short(&self, r: usize) -> String {
+        let f = self.files[r].as_ref();
+        std::path::Path::new(f)
+            .file_name()
+            .map_or(f.to_string(), |n| n.to_string_lossy().into_owned())
+    }
+
     fn push(&mut self, time: i64, entry: Entry) {
         self.seq += 1;
-        self.queue.push(Reverse((time, self.seq, entry)));
+        let robot = match entry {
+            Entry::Vm(r, _) | Entry::CheckWait(r, _) | Entry::CheckWhen(r, _) => r,
+        };
+        self.queue
+            .push(Reverse((time, self.rank[robot], self.seq, entry)));
+    }
+
+    /// Breaks ties between robots' same-time entries by `rank` (a permutation) instead of
+    /// queueing order. Each robot's own entries keep their order. For testing that no
+    /// result depends on tie order.
+    pub fn set_tie_ranks(&mut self, rank: Vec<u64>) {
+        if rank.len() == self.rank.len() {
+            self.rank = rank;
+        }
     }
 
     /// (Re)queues robot `r`'s next event; the previous entry becomes stale.
@@ -353,7 +378,7 @@ impl Simulation {
         if self.outcome.is_some() {
             return false;
         }
-        let Some(Reverse((t, _, entry))) = self.queue.pop() else {
+        let Some(Reverse((t, _, _, entry))) = self.queue.pop() else {
             self.end_without_events();
             return false;
         };
@@ -444,7 +469,7 @@ impl Simulation {
                 let next_event = self
                     .queue
                     .peek()
-                    .map_or(t, |Reverse((nt, _, _))| *nt)
+                    .map_or(t, |Reverse((nt, _, _, _))| *nt)
                     .min(t);
                 if next_event > self.next_boundary {
                     let skip = (next_event - self.next_boundary) / c;
@@ -622,9 +647,9 @@ impl Simulation {
                 let m = format!(
                     "race on `{name}` at {}: {a} ({}:{}) and {b} ({}:{}) touch it at the same instant; the outcome depends on their order",
                     fmt_quantity(t as f64 / 1e9, vworks_vm::Dim::TIME),
-                    self.files[or],
+                    self.short(or),
                     opos,
-                    self.files[r],
+                    self.short(r),
                     pos
                 );
                 self.record(t, Some(r), "warning", format!("{m:?}"), Some(pos));
@@ -669,7 +694,8 @@ impl Simulation {
                 .unwrap_or_else(|| ("something".into(), SrcPos::default()));
             parts.push(format!(
                 "{} waits for {what} ({}:{pos})",
-                self.cell.robots[*r].name, self.files[*r]
+                self.cell.robots[*r].name,
+                self.short(*r)
             ));
         }
         let m = format!("deadlock: {}", parts.join("; "));

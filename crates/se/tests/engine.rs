@@ -1,0 +1,163 @@
+//! The engine on the example workcells: golden event traces, determinism, robot-order
+//! invariance, tie-order independence, and the paper's figure-3 ordering.
+
+#![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)] // tests fail by panicking
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use expect_test::expect_file;
+use proptest::prelude::*;
+use vworks_se::engine::{Outcome, RunResult, Simulation};
+use vworks_se::workcell::{Cell, load};
+
+const EXAMPLES: &[(&str, Outcome)] = &[
+    ("handoff", Outcome::Completed),
+    ("weldline", Outcome::Completed),
+    ("monitor", Outcome::Completed),
+    ("crash", Outcome::Collision),
+    ("deadlock", Outcome::Deadlock),
+    ("track", Outcome::Completed),
+];
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn cell(name: &str) -> Arc<Cell> {
+    Arc::new(
+        load(&root().join("workcells").join(name).join("cell.toml"))
+            .unwrap_or_else(|e| panic!("{name}: {e}")),
+    )
+}
+
+fn trace(cell: &Cell, r: &RunResult) -> String {
+    let mut s: String = r.trace.iter().map(|e| e.line(cell) + "\n").collect();
+    s.push_str(&format!(
+        "# outcome {} at {} ns\n",
+        r.outcome.name(),
+        r.end_time_ns
+    ));
+    s
+}
+
+/// Per robot name: its events as (time, kind, details).
+fn per_robot(cell: &Cell, r: &RunResult) -> BTreeMap<String, Vec<(i64, String, String)>> {
+    let mut m: BTreeMap<String, Vec<(i64, String, String)>> = BTreeMap::new();
+    for e in &r.trace {
+        if let Some(i) = e.robot
+            && !matches!(e.kind, "check_wait" | "check_when")
+        {
+            m.entry(cell.robots[i].name.clone()).or_default().push((
+                e.time,
+                e.kind.to_string(),
+                e.details.clone(),
+            ));
+        }
+    }
+    m
+}
+
+#[test]
+fn golden_traces_of_every_example() {
+    for (name, outcome) in EXAMPLES {
+        let c = cell(name);
+        let r = Simulation::new(Arc::clone(&c)).run(None);
+        assert_eq!(
+            r.outcome, *outcome,
+            "{name}: {:?} {:?}",
+            r.errors, r.collisions
+        );
+        expect_file![root().join("tests/golden").join(format!("{name}.trace"))]
+            .assert_eq(&trace(&c, &r));
+    }
+}
+
+#[test]
+fn two_runs_give_identical_traces() {
+    for (name, _) in EXAMPLES {
+        let c = cell(name);
+        let a = trace(&c, &Simulation::new(Arc::clone(&c)).run(None));
+        let b = trace(&c, &Simulation::new(Arc::clone(&c)).run(None));
+        assert_eq!(a, b, "{name}");
+    }
+}
+
+/// The cell file with its [[robot]] tables in reverse order, next to the original.
+fn reversed_copy(name: &str) -> PathBuf {
+    let dir = root().join("workcells").join(name);
+    let text = std::fs::read_to_string(dir.join("cell.toml")).unwrap();
+    let mut head = String::new();
+    let mut robots: Vec<String> = Vec::new();
+    let mut tail = String::new();
+    let mut section = 0; // 0 head, 1 robots, 2 rest
+    for line in text.lines() {
+        if line.starts_with("[[robot]]") {
+            section = 1;
+            robots.push(String::new());
+        } else if line.starts_with("[[") {
+            section = 2;
+        }
+        let target = match section {
+            0 => &mut head,
+            1 => robots.last_mut().unwrap(),
+            _ => &mut tail,
+        };
+        target.push_str(line);
+        target.push('\n');
+    }
+    robots.reverse();
+    let out = dir.join(format!(".reversed-{}.toml", std::process::id()));
+    std::fs::write(&out, format!("{head}{}{tail}", robots.concat())).unwrap();
+    out
+}
+
+#[test]
+fn robot_order_does_not_change_any_event_time() {
+    for (name, _) in EXAMPLES {
+        let c = cell(name);
+        let a = Simulation::new(Arc::clone(&c)).run(None);
+        let path = reversed_copy(name);
+        let rc = load(Path::new(&path));
+        let _ = std::fs::remove_file(&path);
+        let rc = Arc::new(rc.unwrap());
+        assert_eq!(
+            rc.robots.first().map(|r| &r.name),
+            c.robots.last().map(|r| &r.name)
+        );
+        let b = Simulation::new(Arc::clone(&rc)).run(None);
+        assert_eq!(per_robot(&c, &a), per_robot(&rc, &b), "{name}");
+        assert_eq!(a.end_time_ns, b.end_time_ns, "{name}");
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 12, ..ProptestConfig::default() })]
+
+    #[test]
+    fn tie_order_between_robots_does_not_change_results(seed in any::<u64>()) {
+        for (name, _) in EXAMPLES {
+            let c = cell(name);
+            let base = Simulation::new(Arc::clone(&c)).run(None);
+            if base.warnings.iter().any(|w| w.kind == "race") {
+                continue;
+            }
+            // A permutation of the robots from the seed.
+            let n = c.robots.len();
+            let mut rank: Vec<u64> = (0..n as u64).collect();
+            let mut s = seed | 1;
+            for i in (1..n).rev() {
+                s ^= s << 13;
+                s ^= s >> 7;
+                s ^= s << 17;
+                rank.swap(i, (s % (i as u64 + 1)) as usize);
+            }
+            let mut sim = Simulation::new(Arc::clone(&c));
+            sim.set_tie_ranks(rank);
+            let shuffled = sim.run(None);
+            prop_assert_eq!(per_robot(&c, &base), per_robot(&c, &shuffled), "{}", name);
+            prop_assert_eq!(base.outcome, shuffled.outcome);
+        }
+    }
+}
