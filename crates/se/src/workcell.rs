@@ -603,7 +603,8 @@ pub fn load(path: &Path) -> Result<Cell, CellError> {
         for n in [a, b] {
             let (owner, link) = n.split_once('.').unwrap_or((n.as_str(), ""));
             let known = robots.iter().any(|(r, _, _)| {
-                r.name == owner && (link.is_empty() || r.model.link_index(link).is_some())
+                r.name == owner
+                    && (link.is_empty() || r.model.links.iter().any(|l| same_link(&l.name, link)))
             }) || (link.is_empty()
                 && (cf.device.iter().any(|d| d.name == owner)
                     || cf.part.iter().any(|p| p.name == owner)));

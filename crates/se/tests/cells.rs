@@ -1,0 +1,313 @@
+//! Small cells written by the tests: the paper's figure-3 order, races, workcell errors,
+//! and the contract's workcell example as written.
+
+#![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)] // tests fail by panicking
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use vworks_se::engine::{Outcome, RunResult, Simulation};
+use vworks_se::workcell::{Cell, CellError, load};
+
+/// Writes the files into a fresh directory and returns the path of `cell.toml`.
+fn write_cell(name: &str, files: &[(&str, &str)]) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("vworks-se-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    for (f, text) in files {
+        std::fs::write(dir.join(f), text).unwrap();
+    }
+    dir.join("cell.toml")
+}
+
+fn run(path: &PathBuf) -> (Arc<Cell>, RunResult) {
+    let cell = Arc::new(load(path).unwrap_or_else(|e| panic!("{e}")));
+    let r = Simulation::new(Arc::clone(&cell)).run(None);
+    (cell, r)
+}
+
+const TWO_ROBOTS: &str = r#"
+cycle = "4ms"
+[[robot]]
+name = "a"
+model = "turntable"
+program = "a.wsl"
+[[robot]]
+name = "b"
+model = "turntable"
+base = { xyz = ["2m", "0m", "0m"] }
+program = "b.wsl"
+"#;
+
+#[test]
+fn a_set_queues_check_when_behind_events_already_due() {
+    let path = write_cell(
+        "fig3",
+        &[
+            ("cell.toml", TWO_ROBOTS),
+            ("a.wsl", "global g = 0;\nproc main() { delay 1s; g = 1; }\n"),
+            (
+                "b.wsl",
+                "global g = 0;\nproc tick() { log \"tick\"; }\nproc on() { log \"on\"; }\nproc main() {\n    when every 1s do tick();\n    when g == 1 do on();\n    delay 2s;\n}\n",
+            ),
+        ],
+    );
+    let (cell, r) = run(&path);
+    assert_eq!(r.outcome, Outcome::Completed);
+    let at_1s: Vec<String> = r
+        .trace
+        .iter()
+        .filter(|e| e.time == 1_000_000_000)
+        .map(|e| {
+            format!(
+                "{} {} {}",
+                e.robot.map_or("-".into(), |i| cell.robots[i].name.clone()),
+                e.kind,
+                e.details
+            )
+        })
+        .collect();
+    // A's set comes after B's handler was already due and running: B's own due events (its
+    // log) run first, then the check_when the set queued, then the edge fires.
+    assert_eq!(
+        at_1s,
+        [
+            "a delay_end ",
+            "b when_fire tick",
+            "a set g=1",
+            "b log \"tick\"",
+            "b check_when g",
+            "a end ",
+            "b when_end tick",
+            "b when_fire on",
+            "b log \"on\"",
+            "b when_end on",
+        ]
+    );
+}
+
+#[test]
+fn two_robots_setting_a_global_at_one_instant_is_a_race() {
+    let path = write_cell(
+        "race",
+        &[
+            ("cell.toml", TWO_ROBOTS),
+            (
+                "a.wsl",
+                "global g = 0;\nproc main() {\n    delay 1s;\n    g = 1;\n}\n",
+            ),
+            (
+                "b.wsl",
+                "global g = 0;\nproc main() {\n    delay 1s;\n    g = 2;\n}\n",
+            ),
+        ],
+    );
+    let (_, r) = run(&path);
+    let race: Vec<_> = r.warnings.iter().filter(|w| w.kind == "race").collect();
+    assert_eq!(race.len(), 1, "{:?}", r.warnings);
+    assert!(
+        race[0].message.contains("a (a.wsl:4:5) and b (b.wsl:4:5)"),
+        "{}",
+        race[0].message
+    );
+}
+
+#[test]
+fn wait_and_set_at_one_instant_is_a_race() {
+    let path = write_cell(
+        "race2",
+        &[
+            ("cell.toml", TWO_ROBOTS),
+            (
+                "a.wsl",
+                "global g = 0;\nproc main() {\n    delay 1s;\n    g = 1;\n}\n",
+            ),
+            (
+                "b.wsl",
+                "global g = 0;\nproc main() {\n    delay 1s;\n    wait_until g == 0 timeout 1s;\n}\n",
+            ),
+        ],
+    );
+    let (_, r) = run(&path);
+    assert!(
+        r.warnings
+            .iter()
+            .any(|w| w.kind == "race" && w.message.contains("`g`")),
+        "{:?}",
+        r.warnings
+    );
+}
+
+#[test]
+fn the_contracts_workcell_example_loads_as_written() {
+    let spec = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/spec/engine.md");
+    let Ok(text) = std::fs::read_to_string(&spec) else {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "CI must have ../shared/spec/engine.md"
+        );
+        return;
+    };
+    let toml = text
+        .split("```toml\n")
+        .nth(1)
+        .and_then(|s| s.split("```").next())
+        .unwrap();
+    let path = write_cell(
+        "spec",
+        &[
+            ("cell.toml", toml),
+            (
+                "r1.wsl",
+                "proc main() { move_j joints(0deg, -30deg, 30deg, 0deg, 60deg, 0deg); grip part1; release part1; }\n",
+            ),
+        ],
+    );
+    let cell = load(&path).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(cell.name, "handoff");
+    assert_eq!(cell.cycle_ns, 4_000_000);
+    assert!((cell.clearance - 0.005).abs() < 1e-12);
+    assert_eq!(
+        cell.allowed,
+        [("r1.link6".to_string(), "part1".to_string())]
+    );
+    assert!((cell.robots[0].default_speed - 0.25).abs() < 1e-12);
+}
+
+#[test]
+fn workcell_mistakes_name_the_file_the_key_and_what_to_do() {
+    let robot = "[[robot]]\nname = \"r1\"\nmodel = \"irb120\"\nprogram = \"r1.wsl\"\n";
+    let cases: &[(&str, &str, &[&str])] = &[
+        (
+            "cycle = \"4xs\"\n",
+            robot,
+            &["cycle", "not a quantity", "\"4ms\""],
+        ),
+        ("cycle = \"4mm\"\n", robot, &["cycle", "a length", "a time"]),
+        (
+            "cycle = \"1s\"\n",
+            robot,
+            &["cycle", "outside the allowed 0.1 ms to 100 ms"],
+        ),
+        (
+            "on_collision = \"explode\"\n",
+            robot,
+            &["on_collision", "\"stop\" or \"continue\""],
+        ),
+        (
+            "",
+            "[[robot]]\nname = \"r1\"\nmodle = \"irb120\"\n",
+            &["unknown field `modle`"],
+        ),
+        (
+            "",
+            "[[robot]]\nname = \"r1\"\nmodel = \"irb9999\"\nprogram = \"r1.wsl\"\n",
+            &["robot[0] `r1`.model", "irb9999", "irb120"],
+        ),
+        (
+            "",
+            "[[robot]]\nname = \"r1\"\nmodel = \"irb120\"\nprogram = \"missing.wsl\"\n",
+            &["program", "cannot read", "missing.wsl"],
+        ),
+        (
+            "",
+            "[[robot]]\nname = \"r1\"\nmodel = \"irb120\"\n",
+            &["program", "needs a program"],
+        ),
+        (
+            "",
+            "[[robot]]\nname = \"r1\"\nmodel = \"irb120\"\nprogram = \"r1.wsl\"\ndefault_speed = \"90deg\"\n",
+            &["default_speed", "an angle", "a speed"],
+        ),
+        (
+            "",
+            "[[robot]]\nname = \"r1\"\nmodel = \"irb120\"\nprogram = \"r1.wsl\"\nhome = [\"0deg\"]\n",
+            &["home", "1 values", "6 axes"],
+        ),
+        (
+            "",
+            &format!("{robot}[[device]]\nname = \"t\"\nbox = [\"1m\", \"1m\"]\n"),
+            &["device[0] `t`.box", "3 sizes"],
+        ),
+        (
+            "",
+            &format!("{robot}[[device]]\nname = \"t\"\n"),
+            &["exactly one shape"],
+        ),
+        (
+            "",
+            &format!("{robot}[[device]]\nname = \"r1\"\nsphere = \"1m\"\n"),
+            &["`r1` is used twice"],
+        ),
+        (
+            "allow_collision = [[\"r1.link_99\", \"table\"]]\n",
+            robot,
+            &["allow_collision[0]", "r1.link_99", "not a body"],
+        ),
+        ("", "", &["no robot"]),
+    ];
+    for (i, (head, body, needles)) in cases.iter().enumerate() {
+        let path = write_cell(
+            &format!("bad{i}"),
+            &[
+                ("cell.toml", &format!("{head}{body}")),
+                ("r1.wsl", "proc main() { }\n"),
+            ],
+        );
+        let e = match load(&path) {
+            Ok(_) => panic!("case {i} should fail:\n{head}{body}"),
+            Err(e) => e.to_string(),
+        };
+        assert!(
+            e.contains("cell.toml"),
+            "case {i}: the message must name the file: {e}"
+        );
+        for n in *needles {
+            assert!(e.contains(n), "case {i}: expected {n:?} in: {e}");
+        }
+    }
+}
+
+#[test]
+fn program_errors_are_rendered_with_their_source() {
+    let path = write_cell(
+        "prog",
+        &[
+            (
+                "cell.toml",
+                "[[robot]]\nname = \"r1\"\nmodel = \"irb120\"\nprogram = \"r1.wsl\"\n",
+            ),
+            ("r1.wsl", "proc main() {\n    delay 2;\n}\n"),
+        ],
+    );
+    match load(&path) {
+        Err(CellError::Program { rendered, .. }) => {
+            assert!(
+                rendered.contains("r1.wsl:2:11") && rendered.contains("write 2s"),
+                "{rendered}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    // A link error: the remote robot does not exist.
+    let path = write_cell(
+        "link",
+        &[
+            (
+                "cell.toml",
+                "[[robot]]\nname = \"r1\"\nmodel = \"irb120\"\nprogram = \"r1.wsl\"\n",
+            ),
+            (
+                "r1.wsl",
+                "proc main() {\n    parallel { remote r9.weld(); }\n}\n",
+            ),
+        ],
+    );
+    match load(&path) {
+        Err(CellError::Program { rendered, .. }) => assert!(
+            rendered.contains("E0101") && rendered.contains("no robot `r9`"),
+            "{rendered}"
+        ),
+        other => panic!("{other:?}"),
+    }
+}
