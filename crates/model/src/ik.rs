@@ -177,7 +177,17 @@ impl SphericalWrist {
     /// All solutions (internal angles, before limits) for a tool-link pose; returns how
     /// many were written, or the excess distance when the position is out of reach.
     /// `q4_now` is axis 4's current (internal) angle, kept at a wrist singularity.
-    fn solve(&self, target: &Iso, q4_now: f64, out: &mut [[f64; 6]; 8]) -> Result<usize, f64> {
+    ///
+    /// Each solution's branch is written to `branches`: bit 2 shoulder (front/back), bit 1
+    /// elbow, bit 0 wrist flip. With `only`, just that branch is computed.
+    fn solve(
+        &self,
+        target: &Iso,
+        q4_now: f64,
+        only: Option<u8>,
+        out: &mut [[f64; 6]; 8],
+        branches: &mut [u8; 8],
+    ) -> Result<usize, f64> {
         let t = self.pre_inv.mul(target).mul(&self.post_inv);
         let wc = sub(t.t, mat_vec(&t.r, [self.hand, 0.0, 0.0]));
         let rho = (wc[0] * wc[0] + wc[1] * wc[1]).sqrt();
@@ -190,7 +200,10 @@ impl SphericalWrist {
         let phi = b.atan2(a);
         let mut n = 0;
         let mut worst_excess = f64::INFINITY;
-        for (t1, r) in [(base, rho), (base + PI, -rho)] {
+        for (i1, (t1, r)) in [(base, rho), (base + PI, -rho)].into_iter().enumerate() {
+            if only.is_some_and(|b| usize::from(b >> 2) != i1) {
+                continue;
+            }
             let dx = r - self.shoulder[0];
             let dz = wc[2] - self.shoulder[1];
             let d2 = dx * dx + dz * dz;
@@ -202,7 +215,10 @@ impl SphericalWrist {
                 continue;
             }
             let c = (k / ab).clamp(-1.0, 1.0).acos();
-            for t3 in [phi + c, phi - c] {
+            for (i3, t3) in [phi + c, phi - c].into_iter().enumerate() {
+                if only.is_some_and(|b| usize::from((b >> 1) & 1) != i3) {
+                    continue;
+                }
                 let (s3, c3) = t3.sin_cos();
                 let g = [ux + fx * c3 + fz * s3, uz - fx * s3 + fz * c3];
                 let t2 = dx.atan2(dz) - g[0].atan2(g[1]);
@@ -211,7 +227,10 @@ impl SphericalWrist {
                 let m = mat_mul(&transpose(&r03), &t.r);
                 let c5 = m[0][0].clamp(-1.0, 1.0);
                 let t5a = c5.acos();
-                for t5 in [t5a, -t5a] {
+                for (i5, t5) in [t5a, -t5a].into_iter().enumerate() {
+                    if only.is_some_and(|b| usize::from(b & 1) != i5) {
+                        continue;
+                    }
                     let s5 = t5.sin();
                     let (t4, t6) = if s5.abs() > 1e-9 {
                         (
@@ -229,6 +248,7 @@ impl SphericalWrist {
                     };
                     if n < 8 {
                         out[n] = [t1, t2, t3, t4, t5, t6];
+                        branches[n] = (i1 * 4 + i3 * 2 + i5) as u8;
                         n += 1;
                     }
                 }
@@ -289,15 +309,28 @@ impl RobotModel {
         current: &[f64],
         out: &mut [[f64; 6]; 8],
     ) -> Option<Result<usize, IkError>> {
+        self.analytic_candidates(target, current, out, true)
+    }
+
+    /// The candidates within limits; with `verify`, only those FK confirms.
+    fn analytic_candidates(
+        &self,
+        target: &Iso,
+        current: &[f64],
+        out: &mut [[f64; 6]; 8],
+        verify: bool,
+    ) -> Option<Result<usize, IkError>> {
         let w = self.wrist.as_ref()?;
         let mut raw = [[0.0; 6]; 8];
         let q4_now = w.sign[3] * current.get(3).copied().unwrap_or(0.0);
-        let n = match w.solve(target, q4_now, &mut raw) {
+        let mut branches = [0u8; 8];
+        let n = match w.solve(target, q4_now, None, &mut raw, &mut branches) {
             Ok(n) => n,
             Err(excess) => return Some(Err(self.out_of_reach(target, excess))),
         };
         let mut kept = 0;
-        let mut limit_detail = String::new();
+        // The first limit violation (axis, value), formatted only if nothing is left.
+        let mut limit_hit: Option<(usize, f64)> = None;
         'cand: for s in raw.iter().take(n) {
             let mut q = *s;
             for (i, qi) in q.iter_mut().enumerate() {
@@ -312,23 +345,13 @@ impl RobotModel {
                     v += 2.0 * PI;
                 }
                 if v < j.lower - 1e-9 || v > j.upper + 1e-9 {
-                    if limit_detail.is_empty() {
-                        limit_detail = format!(
-                            "axis {} `{}` would be {:.1}°, limits {:.1}°..{:.1}°",
-                            i + 1,
-                            j.name,
-                            v.to_degrees(),
-                            j.lower.to_degrees(),
-                            j.upper.to_degrees()
-                        );
-                    }
+                    limit_hit.get_or_insert((i, v));
                     continue 'cand;
                 }
                 *qi = v;
             }
             // Guard: the solution must reproduce the pose.
-            let (dp, dr) = pose_error(&self.flange(&q), target);
-            if dp > 1e-7 || dr > 1e-7 {
+            if verify && !self.reproduces(&q, target) {
                 continue;
             }
             out[kept] = q;
@@ -340,14 +363,80 @@ impl RobotModel {
                 x: target.t[0],
                 y: target.t[1],
                 z: target.t[2],
-                detail: if limit_detail.is_empty() {
-                    "no candidate reproduced the pose".into()
-                } else {
-                    limit_detail
+                detail: match limit_hit {
+                    None => "no candidate reproduced the pose".into(),
+                    Some((i, v)) => {
+                        let j = self.axis(i);
+                        format!(
+                            "axis {} `{}` would be {:.1}°, limits {:.1}°..{:.1}°",
+                            i + 1,
+                            j.name,
+                            v.to_degrees(),
+                            j.lower.to_degrees(),
+                            j.upper.to_degrees()
+                        )
+                    }
                 },
             }));
         }
         Some(Ok(kept))
+    }
+
+    /// The analytic branch (shoulder, elbow, wrist) of the solution nearest `current` for a
+    /// tool-link pose: fixed for the length of a straight or circular move.
+    pub fn ik_branch(&self, target: &Iso, current: &[f64]) -> Option<u8> {
+        let w = self.wrist.as_ref()?;
+        let mut raw = [[0.0; 6]; 8];
+        let mut branches = [0u8; 8];
+        let q4 = w.sign[3] * current.get(3).copied().unwrap_or(0.0);
+        let n = w.solve(target, q4, None, &mut raw, &mut branches).ok()?;
+        let wrapped = |a: f64, b: f64| {
+            let d = (a - b).rem_euclid(2.0 * PI);
+            d.min(2.0 * PI - d)
+        };
+        let dist = |s: &[f64; 6]| {
+            s.iter()
+                .zip(current)
+                .map(|(a, b)| wrapped(*a, *b))
+                .fold(0.0, f64::max)
+        };
+        (0..n)
+            .min_by(|a, b| dist(&raw[*a]).total_cmp(&dist(&raw[*b])))
+            .map(|i| branches[i])
+    }
+
+    /// Analytic IK restricted to one branch (see [`RobotModel::ik_branch`]), each joint
+    /// shifted by whole turns toward `current`: one solution, no search. For sampling a
+    /// Cartesian motion.
+    pub fn ik_in_branch(
+        &self,
+        target: &Iso,
+        current: &[f64],
+        branch: u8,
+        q: &mut [f64],
+    ) -> Result<(), IkError> {
+        let Some(w) = self.wrist.as_ref() else {
+            return self.ik(target, current, q);
+        };
+        let mut raw = [[0.0; 6]; 8];
+        let mut branches = [0u8; 8];
+        let q4 = w.sign[3] * current.get(3).copied().unwrap_or(0.0);
+        let n = w
+            .solve(target, q4, Some(branch), &mut raw, &mut branches)
+            .map_err(|excess| self.out_of_reach(target, excess))?;
+        if n == 0 {
+            return Err(self.out_of_reach(target, 0.0));
+        }
+        for (i, v) in raw[0].iter().enumerate() {
+            let cur = current.get(i).copied().unwrap_or(0.0);
+            q[i] = *v + (2.0 * PI) * ((cur - v) / (2.0 * PI)).round();
+        }
+        Ok(())
+    }
+
+    fn reproduces(&self, q: &[f64; 6], target: &Iso) -> bool {
+        let (dp, dr) = pose_error(&self.flange(q), target);
+        dp <= 1e-7 && dr <= 1e-7
     }
 
     fn out_of_reach(&self, target: &Iso, excess: f64) -> IkError {
@@ -364,7 +453,7 @@ impl RobotModel {
     /// spherical wrist, else numeric seeded from `current`. Writes the solution to `q`.
     pub fn ik(&self, target: &Iso, current: &[f64], q: &mut [f64]) -> Result<(), IkError> {
         let mut sols = [[0.0; 6]; 8];
-        if let Some(r) = self.ik_analytic_all(target, current, &mut sols) {
+        if let Some(r) = self.analytic_candidates(target, current, &mut sols, false) {
             let n = r?;
             let dist = |s: &[f64; 6]| {
                 s.iter()
@@ -372,12 +461,20 @@ impl RobotModel {
                     .map(|(a, b)| (a - b).abs())
                     .fold(0.0, f64::max)
             };
-            let best = sols[..n]
-                .iter()
-                .min_by(|a, b| dist(a).total_cmp(&dist(b)))
-                .unwrap_or(&sols[0]);
-            q[..6].copy_from_slice(best);
-            return Ok(());
+            let cands = &mut sols[..n];
+            cands.sort_by(|a, b| dist(a).total_cmp(&dist(b)));
+            // Verify by FK, nearest first (normally the first passes).
+            if let Some(best) = cands.iter().find(|c| self.reproduces(c, target)) {
+                q[..6].copy_from_slice(best);
+                return Ok(());
+            }
+            return Err(IkError::JointLimits {
+                robot: self.name.clone(),
+                x: target.t[0],
+                y: target.t[1],
+                z: target.t[2],
+                detail: "no candidate reproduced the pose".into(),
+            });
         }
         self.ik_numeric(target, current, q)
     }

@@ -60,6 +60,13 @@ struct BodyRef {
     shape: SharedShape,
     /// Shape pose in the owner's frame (link frame, or body frame).
     local: Pose,
+    /// Bounding sphere radius about the shape's local origin (for the broadphase).
+    radius: f32,
+}
+
+fn bounding_radius(shape: &SharedShape) -> f32 {
+    let a = shape.compute_local_aabb();
+    a.mins.abs().max(a.maxs.abs()).length()
 }
 
 /// The collision world of a cell.
@@ -76,6 +83,8 @@ pub struct Collider {
     /// Per part: pose in the cell when not held.
     part_pose: Vec<Iso>,
     frames: Vec<Vec<Iso>>,
+    /// Per robot: its link poses must be recomputed (it moved since they were).
+    stale: Vec<bool>,
     dirty: bool,
     /// Narrow-phase queries made so far.
     pub queries: u64,
@@ -120,6 +129,7 @@ impl Collider {
                         name: format!("{}.{}", robot.name, link.name),
                         shape: s.shape.clone(),
                         local: s.local_pose,
+                        radius: bounding_radius(&s.shape),
                     });
                 }
             }
@@ -130,6 +140,7 @@ impl Collider {
                 name: d.name.clone(),
                 shape: d.shape.clone(),
                 local: d.local.to_pose(),
+                radius: bounding_radius(&d.shape),
             });
         }
         for (i, p) in cell.parts.iter().enumerate() {
@@ -138,6 +149,7 @@ impl Collider {
                 name: p.name.clone(),
                 shape: p.shape.clone(),
                 local: p.local.to_pose(),
+                radius: bounding_radius(&p.shape),
             });
         }
         // Links of one robot that touch at its zero configuration touch by design (the
@@ -208,6 +220,7 @@ impl Collider {
                 .iter()
                 .map(|r| r.model.frames_buffer())
                 .collect(),
+            stale: vec![true; cell.robots.len()],
             dirty: true,
             queries: 0,
             bodies,
@@ -256,9 +269,18 @@ impl Collider {
         if !self.dirty && !moving.iter().any(|m| *m) {
             return Vec::new();
         }
-        self.dirty = false;
-        // Link frames in the cell.
+        let all = std::mem::replace(&mut self.dirty, false);
+        // Link frames in the cell, for robots that moved since the last check.
+        let mut update = [false; 64];
         for (r, robot) in cell.robots.iter().enumerate() {
+            let u = all || moving[r] || self.stale[r];
+            self.stale[r] = moving[r];
+            if r < update.len() {
+                update[r] = u;
+            }
+            if !u && r < update.len() {
+                continue;
+            }
             let q = vms[r].joints_at(t);
             robot
                 .model
@@ -267,24 +289,40 @@ impl Collider {
                 *f = robot.base.mul(f);
             }
         }
+        let updated = |r: usize| r >= update.len() || update[r];
         let margin = cell.clearance as f32;
         for (i, b) in self.bodies.iter().enumerate() {
             let owner_pose = match b.owner {
-                Owner::Link { robot, link } => self.frames[robot][link].to_pose(),
-                Owner::Device => cell
+                Owner::Link { robot, link } if updated(robot) => self.frames[robot][link].to_pose(),
+                Owner::Device if all => cell
                     .devices
                     .iter()
                     .find(|d| d.name == b.name)
                     .map_or(Pose::IDENTITY, |d| d.pose.to_pose()),
                 Owner::Part(p) => match self.held[p] {
-                    Some((r, offset)) => self.frames[r][cell.robots[r].model.tool_link]
+                    Some((r, offset)) if updated(r) || all => self.frames[r]
+                        [cell.robots[r].model.tool_link]
                         .mul(&offset)
                         .to_pose(),
-                    None => self.part_pose[p].to_pose(),
+                    None if all => self.part_pose[p].to_pose(),
+                    _ => continue,
                 },
+                _ => continue,
             };
             self.poses[i] = owner_pose * b.local;
-            self.aabbs[i] = b.shape.compute_aabb(&self.poses[i]).loosened(margin);
+            // The broadphase box: exact where parry computes it in closed form (capsules,
+            // balls, boxes), else the bounding sphere (cylinders, hulls: their exact boxes
+            // need support-map searches).
+            self.aabbs[i] = if b.shape.as_capsule().is_some()
+                || b.shape.as_ball().is_some()
+                || b.shape.as_cuboid().is_some()
+            {
+                b.shape.compute_aabb(&self.poses[i]).loosened(margin)
+            } else {
+                let c = self.poses[i].translation;
+                let r = parry3d::math::Vector::splat(b.radius + margin);
+                Aabb::new(c - r, c + r)
+            };
         }
         // Sort and sweep along x.
         let aabbs = &self.aabbs;

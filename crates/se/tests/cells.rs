@@ -20,7 +20,7 @@ fn write_cell(name: &str, files: &[(&str, &str)]) -> PathBuf {
     dir.join("cell.toml")
 }
 
-fn run(path: &PathBuf) -> (Arc<Cell>, RunResult) {
+fn run(path: &std::path::Path) -> (Arc<Cell>, RunResult) {
     let cell = Arc::new(load(path).unwrap_or_else(|e| panic!("{e}")));
     let r = Simulation::new(Arc::clone(&cell)).run(None);
     (cell, r)

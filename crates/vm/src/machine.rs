@@ -272,6 +272,8 @@ enum Trajectory {
         to: Iso,
         profile: Profile,
         end_joints: [f64; MAX_AXES],
+        /// The analytic IK branch the motion stays on (spherical-wrist arms).
+        branch: Option<u8>,
     },
 }
 
@@ -591,6 +593,7 @@ impl Vm {
                 to,
                 profile,
                 end_joints,
+                branch,
             } => {
                 if dt >= profile.t_total {
                     return *end_joints;
@@ -603,13 +606,16 @@ impl Vm {
                 let tcp = cartesian_at(path, from, to, s);
                 let flange = tcp.mul(&self.cfg.tool.inverse());
                 let mut q = [0.0; MAX_AXES];
-                // Seeded from the start joints: the nearest branch is the one the move is on.
+                // On the motion's branch (one analytic solution), or seeded from the start
+                // joints (numeric IK) — either way the configuration the move started in.
                 let n = self.model.dof();
-                if self
-                    .model
-                    .ik(&flange, &self.rest[..n], &mut q[..n])
-                    .is_err()
-                {
+                let solved = match branch {
+                    Some(b) => self
+                        .model
+                        .ik_in_branch(&flange, &self.rest[..n], *b, &mut q[..n]),
+                    None => self.model.ik(&flange, &self.rest[..n], &mut q[..n]),
+                };
+                if solved.is_err() {
                     return self.rest;
                 }
                 q
@@ -1115,6 +1121,7 @@ impl Vm {
                 to: goal,
                 profile: Profile::new(0.0, 1.0, 1.0),
                 end_joints: from,
+                branch: None,
             };
             return Ok((traj, 0));
         }
@@ -1153,6 +1160,9 @@ impl Vm {
         }
         let profile = Profile::new(1.0, vs, as_);
         let dur = profile.duration_ns();
+        let branch = self
+            .model
+            .ik_branch(&start.mul(&self.cfg.tool.inverse()), &from[..n]);
         Ok((
             Trajectory::Cartesian {
                 path,
@@ -1160,6 +1170,7 @@ impl Vm {
                 to: goal,
                 profile,
                 end_joints: prev,
+                branch,
             },
             dur,
         ))
