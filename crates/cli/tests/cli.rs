@@ -123,3 +123,92 @@ fn bad_inputs_are_errors_with_the_file_named() {
     assert!(text(&out.stderr).contains("not built"));
     assert!(!d.join("bad.wslb").exists());
 }
+
+fn workcell(name: &str) -> String {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../workcells")
+        .join(name)
+        .join("cell.toml")
+        .display()
+        .to_string()
+}
+
+#[test]
+fn run_prints_a_summary_and_exits_by_outcome() {
+    let out = vworks(&["run", &workcell("handoff")]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let s = text(&out.stdout);
+    assert!(s.starts_with("cell handoff: completed at 63.418 s"), "{s}");
+    assert!(
+        s.contains("r1") && s.contains("ended at") && s.contains("globals: handed=3"),
+        "{s}"
+    );
+    // A collision stop and a deadlock exit with 1.
+    assert_eq!(vworks(&["run", &workcell("crash")]).status.code(), Some(1));
+    let out = vworks(&["run", &workcell("deadlock")]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        text(&out.stdout).contains("r1 waits for the signal `r2_ready`"),
+        "{}",
+        text(&out.stdout)
+    );
+}
+
+#[test]
+fn run_json_has_the_contracts_fields() {
+    let out = vworks(&["run", &workcell("crash"), "--json"]);
+    assert_eq!(out.status.code(), Some(1));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout)
+        .unwrap_or_else(|e| panic!("{e}: {}", text(&out.stdout)));
+    assert_eq!(v["outcome"], "collision");
+    assert!(v["end_time_ns"].as_i64().unwrap_or(0) > 0);
+    for key in [
+        "name",
+        "moving_ns",
+        "waiting_ns",
+        "idle_ns",
+        "handler_ns",
+        "motions",
+        "end_time_ns",
+    ] {
+        assert!(v["robots"][0].get(key).is_some(), "robots[0].{key}");
+    }
+    for key in ["time_ns", "a", "b", "depth_m"] {
+        assert!(v["collisions"][0].get(key).is_some(), "collisions[0].{key}");
+    }
+    assert!(v["warnings"].is_array() && v["errors"].is_array() && v["globals"].is_object());
+    let out = vworks(&["run", &workcell("deadlock"), "--json"]);
+    let v: serde_json::Value =
+        serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(v["outcome"], "deadlock");
+    for key in ["kind", "message", "robot", "file", "line", "col"] {
+        assert!(v["errors"][0].get(key).is_some(), "errors[0].{key}");
+    }
+    assert_eq!(v["globals"]["gate_open"], "false");
+}
+
+#[test]
+fn run_until_and_trace() {
+    let out = vworks(&["run", &workcell("handoff"), "--until", "2s", "--trace"]);
+    assert_eq!(out.status.code(), Some(0));
+    let s = text(&out.stdout);
+    assert!(
+        s.lines()
+            .next()
+            .is_some_and(|l| l.starts_with("0 r1 motion_start move_j")),
+        "{s}"
+    );
+    assert!(s.lines().all(|l| {
+        l.split(' ')
+            .next()
+            .and_then(|t| t.parse::<i64>().ok())
+            .is_some_and(|t| t <= 2_000_000_000)
+    }));
+    let out = vworks(&["run", &workcell("handoff"), "--until", "2 parsecs"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        text(&out.stderr).contains("not a time"),
+        "{}",
+        text(&out.stderr)
+    );
+}

@@ -311,3 +311,64 @@ fn program_errors_are_rendered_with_their_source() {
         other => panic!("{other:?}"),
     }
 }
+
+#[test]
+fn with_continue_a_collision_starts_and_ends_and_a_held_part_moves_with_the_tool() {
+    // The turntable's robot-less cousin: a track carriage carries nothing, but a part the
+    // robot grips sweeps through a post and out again.
+    let cell = r#"
+cycle = "4ms"
+on_collision = "continue"
+[[robot]]
+name = "r1"
+model = "irb120"
+program = "r1.wsl"
+tool = { xyz = ["0mm", "0mm", "100mm"] }
+home = ["0deg", "-30deg", "30deg", "0deg", "60deg", "0deg"]
+[[device]]
+name = "post"
+box = ["20mm", "20mm", "250mm"]
+pose = { xyz = ["420mm", "0mm", "125mm"] }
+[[part]]
+name = "block"
+box = ["40mm", "40mm", "40mm"]
+pose = { xyz = ["400mm", "-200mm", "180mm"] }
+allow_collision = [["r1.tool0", "block"], ["r1.link_6", "block"]]
+"#;
+    let prog = "const p = pose(400mm, -200mm, 200mm, 180deg, 0deg, 0deg);\nproc main() {\n    move_l p speed 200mm/s;\n    grip block;\n    move_l offset(p, 0mm, 400mm, 0mm) speed 200mm/s;\n    release block;\n}\n";
+    let path = write_cell("cont", &[("cell.toml", cell), ("r1.wsl", prog)]);
+    let (_, r) = run(&path);
+    assert_eq!(r.outcome, Outcome::Completed, "{:?}", r.errors);
+    let kinds: Vec<(&str, &str)> = r
+        .trace
+        .iter()
+        .filter(|e| e.kind.starts_with("collision"))
+        .map(|e| (e.kind, e.details.as_str()))
+        .collect();
+    // Only the carried block (gripped 200 mm away from the post) meets the post: it starts
+    // touching, and stops when it has passed.
+    assert_eq!(kinds.len(), 2, "{kinds:?}");
+    assert_eq!(kinds[0].0, "collision_start");
+    assert!(kinds[0].1.starts_with("post block"), "{kinds:?}");
+    assert_eq!(kinds[1], ("collision_end", "post block"));
+    assert!(r.collisions.iter().all(|c| c.depth > 0.0));
+}
+
+#[test]
+fn until_stops_the_run_at_that_time() {
+    let path = write_cell(
+        "until",
+        &[
+            ("cell.toml", TWO_ROBOTS),
+            ("a.wsl", "proc main() { delay 10s; }\n"),
+            ("b.wsl", "proc main() { move_j joints(180deg); }\n"),
+        ],
+    );
+    let cell = Arc::new(load(&path).unwrap());
+    let r = Simulation::new(Arc::clone(&cell)).run(Some(1_500_000_000));
+    assert_eq!(r.outcome, Outcome::Until);
+    assert_eq!(r.end_time_ns, 1_500_000_000);
+    // b's 180° move at 90°/s takes 2.3 s: at 1.5 s it is still moving.
+    assert_eq!(r.robots[1].moving_ns, 1_500_000_000);
+    assert_eq!(r.robots[1].ended, "running");
+}
