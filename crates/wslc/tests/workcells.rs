@@ -33,7 +33,7 @@ fn handoff_programs_compile_and_link() {
     let linked = link(&cell).unwrap_or_else(|e| panic!("{e}"));
     assert!(linked.warnings.is_empty(), "{:?}", linked.warnings);
     let names: Vec<&str> = linked.globals.iter().map(|g| g.name.as_str()).collect();
-    assert_eq!(names, ["handed", "station_free"]);
+    assert_eq!(names, ["handed"]);
     // r2's condition handler depends on exactly `handed`.
     let c = &r2.conds[0];
     assert_eq!(
