@@ -176,16 +176,17 @@ fn run_cell(path: &Path, until: Option<&str>, json: bool, trace: bool) -> Result
             secs(r.end_time_ns)
         );
         println!(
-            "{:<10} {:>10} {:>10} {:>10} {:>8}  ended",
-            "robot", "moving", "waiting", "idle", "motions"
+            "{:<10} {:>10} {:>10} {:>10} {:>10} {:>8}  ended",
+            "robot", "moving", "waiting", "idle", "handlers", "motions"
         );
         for s in &r.robots {
             println!(
-                "{:<10} {:>10} {:>10} {:>10} {:>8}  {} at {}",
+                "{:<10} {:>10} {:>10} {:>10} {:>10} {:>8}  {} at {}",
                 s.name,
                 secs(s.moving_ns),
                 secs(s.waiting_ns),
                 secs(s.idle_ns),
+                secs(s.handler_ns),
                 s.motions,
                 s.ended,
                 secs(s.end_time_ns)

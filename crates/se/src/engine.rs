@@ -162,6 +162,11 @@ pub struct Simulation {
     /// Per cell global: last set (time, robot, pos) and last condition read at a wait start.
     last_set: Vec<Option<(i64, usize, SrcPos)>>,
     last_read: Vec<Option<(i64, usize, SrcPos)>>,
+    /// The paper's WAIT list: per cell global, the robots whose wait condition reads it.
+    wait_list: Vec<std::collections::BTreeSet<usize>>,
+    /// The paper's WHEN list: per cell global, the (robot, handler procedure) of each
+    /// enabled condition handler reading it.
+    when_list: Vec<std::collections::BTreeSet<(usize, u32)>>,
     /// Remote requests each robot serves, in order: (caller, request number).
     serving: Vec<std::collections::VecDeque<(usize, u64)>>,
     /// Open intervals per robot: motion start, wait start.
@@ -250,6 +255,8 @@ impl Simulation {
             last_read: vec![None; globals.len()],
             globals,
             to_module,
+            wait_list: vec![Default::default(); cell.linked.globals.len()],
+            when_list: vec![Default::default(); cell.linked.globals.len()],
             serving: vec![Default::default(); n],
             moving_since: vec![None; n],
             waiting_since: vec![None; n],
@@ -590,6 +597,34 @@ impl Simulation {
                     let cg = self.cell.linked.robots[r].globals[g as usize] as usize;
                     self.check_race(cg, r, t, e.pos, false);
                     self.last_read[cg] = Some((t, r, e.pos));
+                    self.wait_list[cg].insert(r);
+                }
+            }
+            EventKind::WaitEnd { .. } => {
+                for w in &mut self.wait_list {
+                    w.remove(&r);
+                }
+            }
+            EventKind::EnableWhen { handler } => {
+                let m = self.vms[r].module();
+                let h = &m.handlers[*handler as usize];
+                if let vworks_vm::bytecode::Trigger::Condition(c) = h.trigger {
+                    let target = h.target;
+                    let globals: Vec<u32> = m.conds[c as usize].globals.clone();
+                    for g in globals {
+                        let cg = self.cell.linked.robots[r].globals[g as usize] as usize;
+                        self.when_list[cg].insert((r, target));
+                    }
+                }
+            }
+            EventKind::DisableWhen { proc } => {
+                for w in &mut self.when_list {
+                    w.remove(&(r, *proc));
+                }
+            }
+            EventKind::End => {
+                for w in &mut self.when_list {
+                    w.retain(|(q, _)| *q != r);
                 }
             }
             EventKind::Signal { site } => {
@@ -665,16 +700,20 @@ impl Simulation {
         self.last_set[cg] = Some((t, r, pos));
         self.globals[cg].0 = value;
         for q in 0..self.vms.len() {
-            let Some(mg) = self.to_module[q][cg] else {
-                continue;
-            };
-            self.vms[q].set_global(mg, value);
-            if self.vms[q].wait_globals().contains(&mg) {
-                self.push(t, Entry::CheckWait(q, cg as u32));
+            if let Some(mg) = self.to_module[q][cg] {
+                self.vms[q].set_global(mg, value);
             }
-            if self.vms[q].when_globals().any(|x| x == mg) {
-                self.push(t, Entry::CheckWhen(q, cg as u32));
-            }
+        }
+        // check_wait / check_when for exactly the robots on this global's wait and when
+        // lists, queued behind what is already due (in robot order, for determinism).
+        let waiting: Vec<usize> = self.wait_list[cg].iter().copied().collect();
+        for q in waiting {
+            self.push(t, Entry::CheckWait(q, cg as u32));
+        }
+        let mut watching: Vec<usize> = self.when_list[cg].iter().map(|(q, _)| *q).collect();
+        watching.dedup();
+        for q in watching {
+            self.push(t, Entry::CheckWhen(q, cg as u32));
         }
     }
 
