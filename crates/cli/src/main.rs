@@ -64,6 +64,37 @@ enum Command {
         /// Print the event trace, one line per event.
         #[arg(long)]
         trace: bool,
+        /// Write the run to this MCAP file (events, cycle states, geometry; opens in Foxglove).
+        #[arg(long)]
+        log: Option<PathBuf>,
+        /// Log the state of every N-th cycle only (events are never thinned).
+        #[arg(long, default_value_t = 1)]
+        log_every: u64,
+    },
+    /// Read an MCAP log written by `vworks run --log`.
+    Log {
+        #[command(subcommand)]
+        what: LogCommand,
+    },
+}
+
+#[derive(Subcommand, Debug)]
+enum LogCommand {
+    /// Topics, message counts and the simulated span.
+    Info {
+        /// The .mcap file.
+        file: PathBuf,
+    },
+    /// The event trace, in the same format as `run --trace`.
+    Events {
+        /// The .mcap file.
+        file: PathBuf,
+        /// Only events of this kind (e.g. motion_start).
+        #[arg(long)]
+        kind: Option<String>,
+        /// Only events of this robot.
+        #[arg(long)]
+        robot: Option<String>,
     },
 }
 
@@ -128,7 +159,73 @@ fn secs(ns: i64) -> String {
     format!("{:.3} s", ns as f64 / 1e9)
 }
 
-fn run_cell(path: &Path, until: Option<&str>, json: bool, trace: bool) -> Result<ExitCode, String> {
+fn read_log(what: LogCommand) -> Result<ExitCode, String> {
+    let file = match &what {
+        LogCommand::Info { file } | LogCommand::Events { file, .. } => file.clone(),
+    };
+    let bytes =
+        std::fs::read(&file).map_err(|e| format!("cannot read `{}`: {e}", file.display()))?;
+    let stream = mcap::MessageStream::new(&bytes)
+        .map_err(|e| format!("{}: not a valid MCAP file: {e}", file.display()))?;
+    let mut counts: std::collections::BTreeMap<String, u64> = std::collections::BTreeMap::new();
+    let (mut first, mut last) = (u64::MAX, 0u64);
+    for m in stream {
+        let m = m.map_err(|e| format!("{}: damaged MCAP data: {e}", file.display()))?;
+        *counts.entry(m.channel.topic.clone()).or_default() += 1;
+        first = first.min(m.log_time);
+        last = last.max(m.log_time);
+        if let LogCommand::Events { kind, robot, .. } = &what
+            && m.channel.topic == "/events"
+        {
+            let v: serde_json::Value = serde_json::from_slice(&m.data)
+                .map_err(|e| format!("{}: an event is not JSON: {e}", file.display()))?;
+            let k = v["kind"].as_str().unwrap_or("?");
+            let r = v["robot"].as_str();
+            if kind.as_deref().is_some_and(|want| want != k)
+                || robot.as_deref().is_some_and(|want| Some(want) != r)
+            {
+                continue;
+            }
+            let details = v["details"]
+                .as_str()
+                .filter(|d| !d.is_empty())
+                .unwrap_or("-");
+            let pos = match v["file"].as_str() {
+                Some(f) => {
+                    let name = Path::new(f)
+                        .file_name()
+                        .map_or(f.to_string(), |n| n.to_string_lossy().into_owned());
+                    format!("{name}:{}:{}", v["line"], v["col"])
+                }
+                None => "-".into(),
+            };
+            println!("{} {} {k} {details} {pos}", v["time_ns"], r.unwrap_or("-"));
+        }
+    }
+    if let LogCommand::Info { .. } = what {
+        println!("{}", file.display());
+        for (topic, n) in &counts {
+            println!("  {topic:<10} {n:>8} messages");
+        }
+        if first <= last {
+            println!(
+                "  simulated span {} .. {}",
+                secs(first as i64),
+                secs(last as i64)
+            );
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn run_cell(
+    path: &Path,
+    until: Option<&str>,
+    json: bool,
+    trace: bool,
+    log: Option<&Path>,
+    log_every: u64,
+) -> Result<ExitCode, String> {
     let until = until.map(parse_time).transpose()?;
     let cell = match vworks_se::workcell::load(path) {
         Ok(c) => std::sync::Arc::new(c),
@@ -139,7 +236,17 @@ fn run_cell(path: &Path, until: Option<&str>, json: bool, trace: bool) -> Result
         Err(e) => return Err(e.to_string()),
     };
     let started = std::time::Instant::now();
-    let r = vworks_se::engine::Simulation::new(std::sync::Arc::clone(&cell)).run(until);
+    let mut sim = vworks_se::engine::Simulation::new(std::sync::Arc::clone(&cell));
+    if let Some(path) = log {
+        sim = sim.with_log(
+            vworks_se::mcaplog::McapLog::create(path, &cell, log_every)
+                .map_err(|e| e.to_string())?,
+        );
+    }
+    let r = sim.run(until);
+    if let Some(e) = &r.log_error {
+        eprintln!("error: {e}");
+    }
     let wall = started.elapsed().as_secs_f64();
     if trace {
         for e in &r.trace {
@@ -279,7 +386,17 @@ fn run(cmd: Command, color: bool) -> Result<ExitCode, String> {
             until,
             json,
             trace,
-        } => run_cell(&cell, until.as_deref(), json, trace),
+            log,
+            log_every,
+        } => run_cell(
+            &cell,
+            until.as_deref(),
+            json,
+            trace,
+            log.as_deref(),
+            log_every,
+        ),
+        Command::Log { what } => read_log(what),
         Command::Disasm { file } => {
             let bytes = std::fs::read(&file)
                 .map_err(|e| format!("cannot read `{}`: {e}", file.display()))?;

@@ -254,6 +254,16 @@ impl Collider {
         self.dirty = true;
     }
 
+    /// The pose of every part given the robots' link frames in the cell (`frames[r]`).
+    pub fn part_poses(&self, cell: &Cell, frames: &[Vec<Iso>]) -> Vec<Iso> {
+        (0..cell.parts.len())
+            .map(|p| match self.held[p] {
+                Some((r, offset)) => frames[r][cell.robots[r].model.tool_link].mul(&offset),
+                None => self.part_pose[p],
+            })
+            .collect()
+    }
+
     fn current_part_pose(&self, p: usize, _cell: &Cell, _t: i64, _vm: Option<&Vm>) -> Iso {
         self.part_pose[p]
     }

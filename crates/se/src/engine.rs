@@ -15,7 +15,7 @@
 //! next event changes (a wait released, a request arrived), the old entry is skipped.
 
 use std::cmp::Reverse;
-use std::collections::BinaryHeap;
+use std::collections::{BTreeMap, BinaryHeap};
 use std::sync::Arc;
 
 use vworks_vm::bytecode::SrcPos;
@@ -130,6 +130,10 @@ pub struct RunResult {
     pub cycles: u64,
     /// Narrow-phase queries made.
     pub queries: u64,
+    /// Messages written to the MCAP log per topic (empty without a log).
+    pub log_counts: BTreeMap<&'static str, u64>,
+    /// Why the log could not be written completely, if it could not.
+    pub log_error: Option<String>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -182,6 +186,9 @@ pub struct Simulation {
     collisions: Vec<Contact>,
     outcome: Option<Outcome>,
     cycles: u64,
+    /// The MCAP log, if one is written, and the first error writing it.
+    log: Option<crate::mcaplog::McapLog>,
+    log_error: Option<String>,
 }
 
 fn format_value(v: u64, ty: Type) -> String {
@@ -270,8 +277,16 @@ impl Simulation {
             collisions: Vec::new(),
             outcome: None,
             cycles: 0,
+            log: None,
+            log_error: None,
             cell,
         }
+    }
+
+    /// Writes the run to an MCAP log (see [`crate::mcaplog`]).
+    pub fn with_log(mut self, log: crate::mcaplog::McapLog) -> Simulation {
+        self.log = Some(log);
+        self
     }
 
     /// The simulated time.
@@ -350,6 +365,34 @@ impl Simulation {
             details,
             pos,
         });
+        if let (Some(log), Some(e)) = (self.log.as_mut(), self.trace.last())
+            && let Err(err) = log.event(&self.cell, e)
+        {
+            self.log_error.get_or_insert(err.to_string());
+            self.log = None;
+        }
+    }
+
+    /// Logs the state at boundary `b` (only when a log is written).
+    fn log_cycle(&mut self, b: i64) {
+        let Some(log) = self.log.as_mut() else { return };
+        let mut joints = Vec::with_capacity(self.vms.len());
+        let mut frames = Vec::with_capacity(self.vms.len());
+        for (r, robot) in self.cell.robots.iter().enumerate() {
+            let q = self.vms[r].joints_at(b);
+            let n = robot.model.dof();
+            let mut f = robot.model.fk(&q[..n]);
+            for x in f.iter_mut() {
+                *x = robot.base.mul(x);
+            }
+            joints.push(q[..n].to_vec());
+            frames.push(f);
+        }
+        let parts = self.collider.part_poses(&self.cell, &frames);
+        if let Err(err) = log.cycle(&self.cell, b, &joints, &frames, &parts) {
+            self.log_error.get_or_insert(err.to_string());
+            self.log = None;
+        }
     }
 
     fn issue(
@@ -436,6 +479,7 @@ impl Simulation {
             self.next_boundary += c;
             self.cycles += 1;
             let moving: Vec<bool> = self.vms.iter().map(|v| v.moving_at(b)).collect();
+            self.log_cycle(b);
             let events = self.collider.check(&self.cell, &self.vms, b, &moving);
             for ev in events {
                 match ev {
@@ -472,7 +516,8 @@ impl Simulation {
                 }
             }
             // With nothing queued before the next boundary and nothing moving, skip ahead.
-            if !moving.iter().any(|m| *m) {
+            // (Not when a log records every boundary.)
+            if self.log.is_none() && !moving.iter().any(|m| *m) {
                 let next_event = self
                     .queue
                     .peek()
@@ -780,7 +825,18 @@ impl Simulation {
                 (g.name.clone(), format_value(*v, *ty))
             })
             .collect();
+        let mut log_counts = BTreeMap::new();
+        if let Some(log) = self.log.take() {
+            match log.finish() {
+                Ok(c) => log_counts = c,
+                Err(e) => {
+                    self.log_error.get_or_insert(e.to_string());
+                }
+            }
+        }
         RunResult {
+            log_counts,
+            log_error: self.log_error,
             outcome: self.outcome.unwrap_or(Outcome::Completed),
             end_time_ns: end,
             robots: self.stats,

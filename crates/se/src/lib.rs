@@ -5,6 +5,7 @@
 //! - [`engine`]: the event queue, the wait and when lists (through each VM), cycle
 //!   boundaries, races, deadlocks, statistics: [`engine::Simulation`].
 //! - [`collide`]: collision checks at cycle boundaries (parry3d).
+//! - [`mcaplog`]: the MCAP log of a run, playable in Foxglove.
 //!
 //! ```no_run
 //! let cell = std::sync::Arc::new(vworks_se::workcell::load("workcells/handoff/cell.toml".as_ref()).unwrap());
@@ -14,6 +15,7 @@
 
 pub mod collide;
 pub mod engine;
+pub mod mcaplog;
 pub mod workcell;
 
 pub use vworks_wslc::link;

@@ -1,0 +1,437 @@
+//! The MCAP log of a run: every event, every cycle's state, and the cell's geometry, so
+//! one file replays the whole run in Foxglove without plugins.
+//!
+//! Topics (all JSON-encoded, chunked and zstd-compressed; see `docs/log.md`):
+//! - `/events` (`vworks.Event`): one message per event — time, robot, kind, details,
+//!   source position — the same content as a trace line.
+//! - `/state` (`vworks.CycleState`): per cycle boundary (every `every`-th), every robot's
+//!   joints and TCP.
+//! - `/tf` (`foxglove.FrameTransforms`): per logged boundary, every link, device and part
+//!   frame in the `world` frame.
+//! - `/scene` (`foxglove.SceneUpdate`): the bodies' geometry attached to those frames, at
+//!   the start and whenever a body's collision colour changes (red while touching).
+//! - `/log` (`foxglove.Log`): `log` output, warnings and errors.
+//!
+//! The workcell file and every program source are attachments; `vworks` metadata holds
+//! the version, the cell name and the cycle. The file is finished (summary, CRCs) when
+//! [`McapLog::finish`] runs, which the engine does for every outcome.
+
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::Path;
+
+use vworks_model::math::Iso;
+use vworks_model::model::Geometry;
+
+use crate::engine::TraceEvent;
+use crate::workcell::Cell;
+
+/// Why the log could not be written.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum LogError {
+    /// The file could not be created or written.
+    #[error("cannot write the log `{file}`: {reason}")]
+    Io {
+        /// The file.
+        file: String,
+        /// Why.
+        reason: String,
+    },
+}
+
+const EVENT_SCHEMA: &str = r#"{"title":"vworks.Event","type":"object","properties":{"time_ns":{"type":"integer"},"robot":{"type":["string","null"]},"kind":{"type":"string"},"details":{"type":"string"},"file":{"type":["string","null"]},"line":{"type":"integer"},"col":{"type":"integer"}}}"#;
+const STATE_SCHEMA: &str = r#"{"title":"vworks.CycleState","type":"object","properties":{"time_ns":{"type":"integer"},"cycle":{"type":"integer"},"robots":{"type":"array","items":{"type":"object","properties":{"name":{"type":"string"},"joints":{"type":"array","items":{"type":"number"}},"tcp":{"type":"object","properties":{"position":{"type":"object"},"orientation":{"type":"object"}}}}}}}}"#;
+const TIME: &str = r#"{"type":"object","properties":{"sec":{"type":"integer","minimum":0},"nsec":{"type":"integer","minimum":0}}}"#;
+const VEC3: &str = r#"{"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"},"z":{"type":"number"}}}"#;
+const QUAT: &str = r#"{"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"},"z":{"type":"number"},"w":{"type":"number"}}}"#;
+const COLOR: &str = r#"{"type":"object","properties":{"r":{"type":"number"},"g":{"type":"number"},"b":{"type":"number"},"a":{"type":"number"}}}"#;
+
+fn tf_schema() -> String {
+    format!(
+        r#"{{"title":"foxglove.FrameTransforms","type":"object","properties":{{"transforms":{{"type":"array","items":{{"type":"object","properties":{{"timestamp":{TIME},"parent_frame_id":{{"type":"string"}},"child_frame_id":{{"type":"string"}},"translation":{VEC3},"rotation":{QUAT}}}}}}}}}}}"#
+    )
+}
+
+fn scene_schema() -> String {
+    let pose =
+        format!(r#"{{"type":"object","properties":{{"position":{VEC3},"orientation":{QUAT}}}}}"#);
+    let prim = |extra: &str| {
+        format!(
+            r#"{{"type":"array","items":{{"type":"object","properties":{{"pose":{pose},"size":{VEC3},"color":{COLOR}{extra}}}}}}}"#
+        )
+    };
+    format!(
+        r#"{{"title":"foxglove.SceneUpdate","type":"object","properties":{{"deletions":{{"type":"array"}},"entities":{{"type":"array","items":{{"type":"object","properties":{{"timestamp":{TIME},"frame_id":{{"type":"string"}},"id":{{"type":"string"}},"lifetime":{TIME},"frame_locked":{{"type":"boolean"}},"metadata":{{"type":"array"}},"arrows":{{"type":"array"}},"cubes":{},"spheres":{},"cylinders":{},"lines":{{"type":"array"}},"triangles":{{"type":"array"}},"texts":{{"type":"array"}},"models":{{"type":"array"}}}}}}}}}}}}"#,
+        prim(""),
+        prim(""),
+        prim(r#","bottom_scale":{"type":"number"},"top_scale":{"type":"number"}"#)
+    )
+}
+
+fn log_schema() -> String {
+    format!(
+        r#"{{"title":"foxglove.Log","type":"object","properties":{{"timestamp":{TIME},"level":{{"type":"integer"}},"message":{{"type":"string"}},"name":{{"type":"string"}},"file":{{"type":"string"}},"line":{{"type":"integer","minimum":0}}}}}}"#
+    )
+}
+
+/// A body of the scene: its frame and primitives.
+struct SceneBody {
+    frame: String,
+    geometry: Geometry,
+    /// Shape pose in the frame (URDF convention: cylinders and capsules along z).
+    local: Iso,
+}
+
+/// The MCAP log being written.
+pub struct McapLog {
+    w: mcap::Writer<BufWriter<File>>,
+    file: String,
+    events: u16,
+    state: u16,
+    tf: u16,
+    scene: u16,
+    log: u16,
+    seq: u32,
+    every: u64,
+    boundary: u64,
+    bodies: Vec<SceneBody>,
+    red: Vec<bool>,
+    buf: Vec<u8>,
+    /// Messages written per topic.
+    pub counts: BTreeMap<&'static str, u64>,
+}
+
+impl std::fmt::Debug for McapLog {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("McapLog")
+            .field("file", &self.file)
+            .field("counts", &self.counts)
+            .finish()
+    }
+}
+
+fn ts(t: i64) -> serde_json::Value {
+    serde_json::json!({"sec": t.max(0) / 1_000_000_000, "nsec": t.max(0) % 1_000_000_000})
+}
+
+fn quat(r: &[[f64; 3]; 3]) -> [f64; 4] {
+    // Shepperd's method.
+    let tr = r[0][0] + r[1][1] + r[2][2];
+    let (x, y, z, w);
+    if tr > 0.0 {
+        let s = (tr + 1.0).sqrt() * 2.0;
+        w = 0.25 * s;
+        x = (r[2][1] - r[1][2]) / s;
+        y = (r[0][2] - r[2][0]) / s;
+        z = (r[1][0] - r[0][1]) / s;
+    } else if r[0][0] > r[1][1] && r[0][0] > r[2][2] {
+        let s = (1.0 + r[0][0] - r[1][1] - r[2][2]).sqrt() * 2.0;
+        w = (r[2][1] - r[1][2]) / s;
+        x = 0.25 * s;
+        y = (r[0][1] + r[1][0]) / s;
+        z = (r[0][2] + r[2][0]) / s;
+    } else if r[1][1] > r[2][2] {
+        let s = (1.0 + r[1][1] - r[0][0] - r[2][2]).sqrt() * 2.0;
+        w = (r[0][2] - r[2][0]) / s;
+        x = (r[0][1] + r[1][0]) / s;
+        y = 0.25 * s;
+        z = (r[1][2] + r[2][1]) / s;
+    } else {
+        let s = (1.0 + r[2][2] - r[0][0] - r[1][1]).sqrt() * 2.0;
+        w = (r[1][0] - r[0][1]) / s;
+        x = (r[0][2] + r[2][0]) / s;
+        y = (r[1][2] + r[2][1]) / s;
+        z = 0.25 * s;
+    }
+    [x, y, z, w]
+}
+
+fn pose_json(p: &Iso) -> serde_json::Value {
+    let q = quat(&p.r);
+    serde_json::json!({"position": {"x": p.t[0], "y": p.t[1], "z": p.t[2]}, "orientation": {"x": q[0], "y": q[1], "z": q[2], "w": q[3]}})
+}
+
+impl McapLog {
+    /// Creates the log for `cell`; `every` thins cycle states (1 = every boundary).
+    pub fn create(path: &Path, cell: &Cell, every: u64) -> Result<McapLog, LogError> {
+        let file = path.display().to_string();
+        let io = |e: &dyn std::fmt::Display| LogError::Io {
+            file: file.clone(),
+            reason: e.to_string(),
+        };
+        let f = File::create(path).map_err(|e| io(&e))?;
+        let mut w = mcap::WriteOptions::new()
+            .compression(Some(mcap::Compression::Zstd))
+            .chunk_size(Some(1 << 20))
+            .profile("")
+            .create(BufWriter::new(f))
+            .map_err(|e| io(&e))?;
+        let none = BTreeMap::new();
+        let channel = |w: &mut mcap::Writer<BufWriter<File>>,
+                       name: &str,
+                       schema: &str,
+                       topic: &str|
+         -> Result<u16, LogError> {
+            let s = w
+                .add_schema(name, "jsonschema", schema.as_bytes())
+                .map_err(|e| io(&e))?;
+            w.add_channel(s, topic, "json", &none).map_err(|e| io(&e))
+        };
+        let events = channel(&mut w, "vworks.Event", EVENT_SCHEMA, "/events")?;
+        let state = channel(&mut w, "vworks.CycleState", STATE_SCHEMA, "/state")?;
+        let tf = channel(&mut w, "foxglove.FrameTransforms", &tf_schema(), "/tf")?;
+        let scene = channel(&mut w, "foxglove.SceneUpdate", &scene_schema(), "/scene")?;
+        let log = channel(&mut w, "foxglove.Log", &log_schema(), "/log")?;
+        let mut meta = BTreeMap::new();
+        meta.insert(
+            "vworks_version".to_string(),
+            env!("CARGO_PKG_VERSION").to_string(),
+        );
+        meta.insert("cell".to_string(), cell.name.clone());
+        meta.insert("cycle_ns".to_string(), cell.cycle_ns.to_string());
+        meta.insert(
+            "robots".to_string(),
+            cell.robots
+                .iter()
+                .map(|r| r.name.as_str())
+                .collect::<Vec<_>>()
+                .join(","),
+        );
+        w.write_metadata(&mcap::records::Metadata {
+            name: "vworks".into(),
+            metadata: meta,
+        })
+        .map_err(|e| io(&e))?;
+        for (name, text) in &cell.sources {
+            let media = if name.ends_with(".toml") {
+                "application/toml"
+            } else {
+                "text/plain"
+            };
+            w.attach(&mcap::Attachment {
+                log_time: 0,
+                create_time: 0,
+                name: name.clone(),
+                media_type: media.into(),
+                data: std::borrow::Cow::Borrowed(text.as_bytes()),
+            })
+            .map_err(|e| io(&e))?;
+        }
+        let mut bodies = Vec::new();
+        for r in &cell.robots {
+            for l in &r.model.links {
+                for s in &l.shapes {
+                    bodies.push(SceneBody {
+                        frame: format!("{}.{}", r.name, l.name),
+                        geometry: s.geometry.clone(),
+                        local: s.origin,
+                    });
+                }
+            }
+        }
+        for d in cell.devices.iter().chain(&cell.parts) {
+            bodies.push(SceneBody {
+                frame: d.name.clone(),
+                geometry: d.geometry.clone(),
+                local: Iso::IDENTITY,
+            });
+        }
+        let red = vec![false; bodies.len()];
+        let mut log = McapLog {
+            w,
+            file,
+            events,
+            state,
+            tf,
+            scene,
+            log,
+            seq: 0,
+            every: every.max(1),
+            boundary: 0,
+            bodies,
+            red,
+            buf: Vec::with_capacity(4096),
+            counts: BTreeMap::new(),
+        };
+        log.write_scene(0, None)?;
+        Ok(log)
+    }
+
+    fn write(
+        &mut self,
+        channel: u16,
+        topic: &'static str,
+        t: i64,
+        value: &serde_json::Value,
+    ) -> Result<(), LogError> {
+        self.buf.clear();
+        serde_json::to_writer(&mut self.buf, value).map_err(|e| LogError::Io {
+            file: self.file.clone(),
+            reason: e.to_string(),
+        })?;
+        self.seq = self.seq.wrapping_add(1);
+        let header = mcap::records::MessageHeader {
+            channel_id: channel,
+            sequence: self.seq,
+            log_time: t.max(0) as u64,
+            publish_time: t.max(0) as u64,
+        };
+        self.w
+            .write_to_known_channel(&header, &self.buf)
+            .map_err(|e| LogError::Io {
+                file: self.file.clone(),
+                reason: e.to_string(),
+            })?;
+        *self.counts.entry(topic).or_default() += 1;
+        Ok(())
+    }
+
+    /// Publishes the geometry; with `only`, just the bodies whose frame is one of those.
+    fn write_scene(&mut self, t: i64, only: Option<&[&str]>) -> Result<(), LogError> {
+        let mut entities = Vec::new();
+        for (i, b) in self.bodies.iter().enumerate() {
+            if only.is_some_and(|o| !o.contains(&b.frame.as_str())) {
+                continue;
+            }
+            let color = if self.red[i] {
+                serde_json::json!({"r": 0.9, "g": 0.1, "b": 0.1, "a": 1.0})
+            } else {
+                serde_json::json!({"r": 0.6, "g": 0.65, "b": 0.7, "a": 1.0})
+            };
+            let (mut cubes, mut spheres, mut cylinders) = (Vec::new(), Vec::new(), Vec::new());
+            let local = b.local;
+            match &b.geometry {
+                Geometry::Box { half } => cubes.push(serde_json::json!({"pose": pose_json(&local), "size": {"x": 2.0 * half[0], "y": 2.0 * half[1], "z": 2.0 * half[2]}, "color": color})),
+                Geometry::Sphere { radius } => spheres.push(serde_json::json!({"pose": pose_json(&local), "size": {"x": 2.0 * radius, "y": 2.0 * radius, "z": 2.0 * radius}, "color": color})),
+                Geometry::Cylinder { radius, length } => cylinders.push(serde_json::json!({"pose": pose_json(&local), "size": {"x": 2.0 * radius, "y": 2.0 * radius, "z": length}, "bottom_scale": 1.0, "top_scale": 1.0, "color": color})),
+                Geometry::Capsule { radius, length } => {
+                    cylinders.push(serde_json::json!({"pose": pose_json(&local), "size": {"x": 2.0 * radius, "y": 2.0 * radius, "z": length}, "bottom_scale": 1.0, "top_scale": 1.0, "color": color}));
+                    for end in [-0.5, 0.5] {
+                        let c = local.mul(&Iso { r: vworks_model::math::I3, t: [0.0, 0.0, end * length] });
+                        spheres.push(serde_json::json!({"pose": pose_json(&c), "size": {"x": 2.0 * radius, "y": 2.0 * radius, "z": 2.0 * radius}, "color": color}));
+                    }
+                }
+                Geometry::Hull { points, .. } => {
+                    // The hull's bounding box stands in for the mesh.
+                    let mut lo = [f64::INFINITY; 3];
+                    let mut hi = [f64::NEG_INFINITY; 3];
+                    for p in points {
+                        for k in 0..3 {
+                            lo[k] = lo[k].min(p[k]);
+                            hi[k] = hi[k].max(p[k]);
+                        }
+                    }
+                    let c = local.mul(&Iso { r: vworks_model::math::I3, t: [(lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0, (lo[2] + hi[2]) / 2.0] });
+                    cubes.push(serde_json::json!({"pose": pose_json(&c), "size": {"x": hi[0] - lo[0], "y": hi[1] - lo[1], "z": hi[2] - lo[2]}, "color": color}));
+                }
+            }
+            entities.push(serde_json::json!({
+                "timestamp": ts(t), "frame_id": b.frame, "id": format!("{}#{i}", b.frame),
+                "lifetime": {"sec": 0, "nsec": 0}, "frame_locked": true, "metadata": [],
+                "arrows": [], "cubes": cubes, "spheres": spheres, "cylinders": cylinders,
+                "lines": [], "triangles": [], "texts": [], "models": [],
+            }));
+        }
+        self.write(
+            self.scene,
+            "/scene",
+            t,
+            &serde_json::json!({"deletions": [], "entities": entities}),
+        )
+    }
+
+    /// Logs an event (and, for `log`, `warning` and `error`, a Foxglove log message); on
+    /// `collision_start`/`collision_end` the two bodies change colour.
+    pub fn event(&mut self, cell: &Cell, e: &TraceEvent) -> Result<(), LogError> {
+        let robot = e.robot.map(|r| cell.robots[r].name.clone());
+        let (file, line, col) = e
+            .pos
+            .as_ref()
+            .map_or((None, 0, 0), |(f, p)| (Some(f.to_string()), p.line, p.col));
+        let v = serde_json::json!({"time_ns": e.time, "robot": robot, "kind": e.kind, "details": e.details, "file": file, "line": line, "col": col});
+        self.write(self.events, "/events", e.time, &v)?;
+        let level = match e.kind {
+            "log" => Some(2),
+            "warning" => Some(3),
+            "error" => Some(4),
+            _ => None,
+        };
+        if let Some(level) = level {
+            let v = serde_json::json!({"timestamp": ts(e.time), "level": level, "message": e.details.trim_matches('"'), "name": robot.unwrap_or_else(|| "cell".into()), "file": file.unwrap_or_default(), "line": line});
+            self.write(self.log, "/log", e.time, &v)?;
+        }
+        if matches!(e.kind, "collision_start" | "collision_end") {
+            let mut names = e.details.split(' ');
+            let (a, b) = (
+                names.next().unwrap_or_default().to_string(),
+                names.next().unwrap_or_default().to_string(),
+            );
+            let on = e.kind == "collision_start";
+            for (i, body) in self.bodies.iter().enumerate() {
+                if body.frame == a || body.frame == b {
+                    self.red[i] = on;
+                }
+            }
+            self.write_scene(e.time, Some(&[a.as_str(), b.as_str()]))?;
+        }
+        Ok(())
+    }
+
+    /// Logs a cycle boundary (every `every`-th): state and frames. `frames[r]` holds robot
+    /// r's link frames in the cell, `parts` the parts' poses.
+    pub fn cycle(
+        &mut self,
+        cell: &Cell,
+        t: i64,
+        joints: &[Vec<f64>],
+        frames: &[Vec<Iso>],
+        parts: &[Iso],
+    ) -> Result<(), LogError> {
+        let k = self.boundary;
+        self.boundary += 1;
+        if k % self.every != 0 {
+            return Ok(());
+        }
+        let mut robots = Vec::with_capacity(cell.robots.len());
+        let mut transforms = Vec::new();
+        for (r, robot) in cell.robots.iter().enumerate() {
+            let tcp = frames[r][robot.model.tool_link].mul(&robot.tool);
+            robots.push(serde_json::json!({"name": robot.name, "joints": joints[r], "tcp": pose_json(&tcp)}));
+            for (l, link) in robot.model.links.iter().enumerate() {
+                let p = pose_json(&frames[r][l]);
+                transforms.push(serde_json::json!({"timestamp": ts(t), "parent_frame_id": "world", "child_frame_id": format!("{}.{}", robot.name, link.name), "translation": p["position"], "rotation": p["orientation"]}));
+            }
+        }
+        for d in &cell.devices {
+            let p = pose_json(&d.pose);
+            transforms.push(serde_json::json!({"timestamp": ts(t), "parent_frame_id": "world", "child_frame_id": d.name, "translation": p["position"], "rotation": p["orientation"]}));
+        }
+        for (i, part) in cell.parts.iter().enumerate() {
+            let p = pose_json(&parts[i]);
+            transforms.push(serde_json::json!({"timestamp": ts(t), "parent_frame_id": "world", "child_frame_id": part.name, "translation": p["position"], "rotation": p["orientation"]}));
+        }
+        self.write(
+            self.state,
+            "/state",
+            t,
+            &serde_json::json!({"time_ns": t, "cycle": k, "robots": robots}),
+        )?;
+        self.write(
+            self.tf,
+            "/tf",
+            t,
+            &serde_json::json!({"transforms": transforms}),
+        )
+    }
+
+    /// Finishes the file: summary, indexes, CRCs. Returns the counts per topic.
+    pub fn finish(mut self) -> Result<BTreeMap<&'static str, u64>, LogError> {
+        self.w.finish().map_err(|e| LogError::Io {
+            file: self.file.clone(),
+            reason: e.to_string(),
+        })?;
+        Ok(self.counts)
+    }
+}

@@ -1,0 +1,169 @@
+//! MCAP logs read back with the `mcap` crate's reader: valid and complete after every
+//! outcome, per-topic counts equal the run's own, events equal the trace, thinning works.
+
+#![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)] // tests fail by panicking
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use vworks_se::engine::{Outcome, RunResult, Simulation};
+use vworks_se::mcaplog::McapLog;
+use vworks_se::workcell::{Cell, load};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn run_logged(
+    cell: &Arc<Cell>,
+    every: u64,
+    until: Option<i64>,
+    name: &str,
+) -> (RunResult, Vec<u8>) {
+    let path = std::env::temp_dir().join(format!("vworks-log-{name}-{}.mcap", std::process::id()));
+    let log = McapLog::create(&path, cell, every).unwrap();
+    let r = Simulation::new(Arc::clone(cell)).with_log(log).run(until);
+    assert!(r.log_error.is_none(), "{:?}", r.log_error);
+    let bytes = std::fs::read(&path).unwrap();
+    let _ = std::fs::remove_file(&path);
+    (r, bytes)
+}
+
+/// Reads every message (checking chunk CRCs) and the summary; returns per-topic counts
+/// and the event lines.
+fn read_back(bytes: &[u8]) -> (BTreeMap<String, u64>, Vec<String>) {
+    let mut counts = BTreeMap::new();
+    let mut events = Vec::new();
+    for m in mcap::MessageStream::new(bytes).unwrap() {
+        let m = m.unwrap();
+        *counts.entry(m.channel.topic.clone()).or_default() += 1;
+        let schema = m.channel.schema.as_ref().unwrap();
+        assert_eq!(schema.encoding, "jsonschema");
+        let _: serde_json::Value = serde_json::from_slice(&schema.data)
+            .unwrap_or_else(|e| panic!("schema {} is not JSON: {e}", schema.name));
+        let v: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
+        if m.channel.topic == "/events" {
+            let pos = match v["file"].as_str() {
+                Some(f) => format!(
+                    "{}:{}:{}",
+                    std::path::Path::new(f)
+                        .file_name()
+                        .unwrap()
+                        .to_string_lossy(),
+                    v["line"],
+                    v["col"]
+                ),
+                None => "-".into(),
+            };
+            let details = v["details"]
+                .as_str()
+                .filter(|d| !d.is_empty())
+                .unwrap_or("-");
+            events.push(format!(
+                "{} {} {} {details} {pos}",
+                v["time_ns"],
+                v["robot"].as_str().unwrap_or("-"),
+                v["kind"].as_str().unwrap()
+            ));
+        }
+    }
+    let summary = mcap::Summary::read(bytes)
+        .unwrap()
+        .expect("a finished file has a summary");
+    assert_eq!(summary.channels.len(), 5);
+    (counts, events)
+}
+
+fn check(cell: &Arc<Cell>, r: &RunResult, bytes: &[u8]) {
+    let (counts, events) = read_back(bytes);
+    let own: BTreeMap<String, u64> = r
+        .log_counts
+        .iter()
+        .map(|(k, v)| (k.to_string(), *v))
+        .collect();
+    assert_eq!(counts, own, "per-topic counts");
+    let trace: Vec<String> = r.trace.iter().map(|e| e.line(cell)).collect();
+    assert_eq!(events, trace, "the log's events are the trace");
+}
+
+#[test]
+fn logs_are_complete_after_every_outcome() {
+    for (name, want) in [
+        ("monitor", Outcome::Completed),
+        ("crash", Outcome::Collision),
+        ("deadlock", Outcome::Deadlock),
+    ] {
+        let cell = Arc::new(load(&root().join("workcells").join(name).join("cell.toml")).unwrap());
+        let (r, bytes) = run_logged(&cell, 1, None, name);
+        assert_eq!(r.outcome, want);
+        check(&cell, &r, &bytes);
+        // Every processed boundary has a state and a transform message.
+        let (counts, _) = read_back(&bytes);
+        assert_eq!(counts["/state"], r.cycles, "{name}");
+        assert_eq!(counts["/tf"], r.cycles, "{name}");
+    }
+    // --until.
+    let cell = Arc::new(load(&root().join("workcells/handoff/cell.toml")).unwrap());
+    let (r, bytes) = run_logged(&cell, 1, Some(5_000_000_000), "until");
+    assert_eq!(r.outcome, Outcome::Until);
+    check(&cell, &r, &bytes);
+}
+
+#[test]
+fn a_runtime_error_leaves_a_valid_log() {
+    let dir = std::env::temp_dir().join(format!("vworks-log-err-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("cell.toml"),
+        "[[robot]]\nname = \"r1\"\nmodel = \"irb120\"\nprogram = \"r1.wsl\"\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("r1.wsl"),
+        "proc main() {\n    delay 0.1s;\n    fail \"gripper empty\";\n}\n",
+    )
+    .unwrap();
+    let cell = Arc::new(load(&dir.join("cell.toml")).unwrap());
+    let (r, bytes) = run_logged(&cell, 1, None, "error");
+    assert_eq!(r.outcome, Outcome::Error);
+    check(&cell, &r, &bytes);
+    let (counts, events) = read_back(&bytes);
+    assert!(
+        events.last().unwrap().contains("error \"gripper empty\""),
+        "{events:?}"
+    );
+    assert_eq!(counts["/log"], 1);
+}
+
+#[test]
+fn thinning_keeps_every_event_and_every_nth_state() {
+    let cell = Arc::new(load(&root().join("workcells/monitor/cell.toml")).unwrap());
+    let (r, bytes) = run_logged(&cell, 10, None, "thin");
+    check(&cell, &r, &bytes);
+    let (counts, _) = read_back(&bytes);
+    assert_eq!(counts["/state"], r.cycles.div_ceil(10));
+    assert_eq!(counts["/events"], r.trace.len() as u64);
+}
+
+#[test]
+fn the_cell_and_its_programs_are_attached() {
+    let cell = Arc::new(load(&root().join("workcells/handoff/cell.toml")).unwrap());
+    let (_, bytes) = run_logged(&cell, 100, Some(1_000_000_000), "attach");
+    let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+    let names: Vec<String> = summary
+        .attachment_indexes
+        .iter()
+        .map(|a| {
+            std::path::Path::new(&a.name)
+                .file_name()
+                .unwrap()
+                .to_string_lossy()
+                .into_owned()
+        })
+        .collect();
+    assert_eq!(names, ["cell.toml", "r1.wsl", "r2.wsl"]);
+    let meta = &summary.metadata_indexes;
+    assert_eq!(meta.len(), 1);
+    assert_eq!(meta[0].name, "vworks");
+}
