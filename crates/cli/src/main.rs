@@ -236,7 +236,11 @@ fn run_cell(
         Err(e) => return Err(e.to_string()),
     };
     let started = std::time::Instant::now();
-    let mut sim = vworks_se::engine::Simulation::new(std::sync::Arc::clone(&cell));
+    // Ctrl-C ends the run between two events, so the summary prints and the log is finished.
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let flag = std::sync::Arc::clone(&stop);
+    let _ = ctrlc::set_handler(move || flag.store(true, std::sync::atomic::Ordering::Relaxed));
+    let mut sim = vworks_se::engine::Simulation::new(std::sync::Arc::clone(&cell)).with_stop(stop);
     if let Some(path) = log {
         sim = sim.with_log(
             vworks_se::mcaplog::McapLog::create(path, &cell, log_every)
@@ -334,6 +338,7 @@ fn run_cell(
         vworks_se::engine::Outcome::Completed | vworks_se::engine::Outcome::Until => {
             ExitCode::SUCCESS
         }
+        vworks_se::engine::Outcome::Interrupted => ExitCode::from(130),
         _ => ExitCode::FAILURE,
     })
 }

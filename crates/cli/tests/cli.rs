@@ -212,3 +212,42 @@ fn run_until_and_trace() {
         text(&out.stderr)
     );
 }
+
+#[test]
+fn ctrl_c_finishes_the_log() {
+    let d = temp_dir("sigint");
+    let log = d.join("run.mcap");
+    let child = Command::new(env!("CARGO_BIN_EXE_vworks"))
+        .args([
+            "run",
+            &workcell("handoff"),
+            "--log",
+            log.to_str().unwrap_or_default(),
+        ])
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap_or_else(|e| panic!("{e}"));
+    // Long enough to be running (a logged handoff takes seconds in a test build).
+    std::thread::sleep(std::time::Duration::from_millis(400));
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!(status.success());
+    let out = child.wait_with_output().unwrap_or_else(|e| panic!("{e}"));
+    let s = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(130), "{s}");
+    assert!(s.contains("interrupted at"), "{s}");
+    // The file is finished: a summary, and every message readable.
+    let bytes = std::fs::read(&log).unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        mcap::Summary::read(&bytes)
+            .unwrap_or_else(|e| panic!("{e}"))
+            .is_some()
+    );
+    let n = mcap::MessageStream::new(&bytes)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .filter(|m| m.is_ok())
+        .count();
+    assert!(n > 0);
+}

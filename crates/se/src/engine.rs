@@ -17,6 +17,7 @@
 use std::cmp::Reverse;
 use std::collections::{BTreeMap, BinaryHeap};
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use vworks_vm::bytecode::SrcPos;
 use vworks_vm::machine::{Event, EventKind, Next, Vm, VmConfig};
@@ -39,6 +40,8 @@ pub enum Outcome {
     Error,
     /// The `until` time was reached.
     Until,
+    /// Stopped from outside (Ctrl-C) through [`Simulation::with_stop`].
+    Interrupted,
 }
 
 impl Outcome {
@@ -50,6 +53,7 @@ impl Outcome {
             Outcome::Deadlock => "deadlock",
             Outcome::Error => "error",
             Outcome::Until => "until",
+            Outcome::Interrupted => "interrupted",
         }
     }
 }
@@ -189,6 +193,8 @@ pub struct Simulation {
     /// The MCAP log, if one is written, and the first error writing it.
     log: Option<crate::mcaplog::McapLog>,
     log_error: Option<String>,
+    /// Set from outside to stop the run between two events.
+    stop: Option<Arc<AtomicBool>>,
 }
 
 fn format_value(v: u64, ty: Type) -> String {
@@ -279,6 +285,7 @@ impl Simulation {
             cycles: 0,
             log: None,
             log_error: None,
+            stop: None,
             cell,
         }
     }
@@ -286,6 +293,12 @@ impl Simulation {
     /// Writes the run to an MCAP log (see [`crate::mcaplog`]).
     pub fn with_log(mut self, log: crate::mcaplog::McapLog) -> Simulation {
         self.log = Some(log);
+        self
+    }
+
+    /// Stops the run (outcome `interrupted`, log finished) when `flag` becomes true.
+    pub fn with_stop(mut self, flag: Arc<AtomicBool>) -> Simulation {
+        self.stop = Some(flag);
         self
     }
 
@@ -426,6 +439,14 @@ impl Simulation {
     /// Handles the next queue entry. Returns false when the run is over.
     pub fn step(&mut self, until: Option<i64>) -> bool {
         if self.outcome.is_some() {
+            return false;
+        }
+        if self
+            .stop
+            .as_ref()
+            .is_some_and(|f| f.load(Ordering::Relaxed))
+        {
+            self.outcome = Some(Outcome::Interrupted);
             return false;
         }
         let Some(Reverse((t, _, _, entry))) = self.queue.pop() else {

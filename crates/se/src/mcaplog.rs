@@ -391,7 +391,7 @@ impl McapLog {
     ) -> Result<(), LogError> {
         let k = self.boundary;
         self.boundary += 1;
-        if k % self.every != 0 {
+        if !k.is_multiple_of(self.every) {
             return Ok(());
         }
         let mut robots = Vec::with_capacity(cell.robots.len());
