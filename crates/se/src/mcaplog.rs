@@ -8,12 +8,14 @@
 //!   joints and TCP.
 //! - `/tf` (`foxglove.FrameTransforms`): per logged boundary, every link, device and part
 //!   frame in the `world` frame.
-//! - `/scene` (`foxglove.SceneUpdate`): the bodies' geometry attached to those frames, at
-//!   the start and whenever a body's collision colour changes (red while touching).
+//! - `/scene` (`foxglove.SceneUpdate`): the bodies' geometry attached to those frames
+//!   (boxes as cubes, capsules as a cylinder and two spheres, meshes as their convex
+//!   hull's triangles), at the start and whenever a body's collision colour changes (red
+//!   while touching).
 //! - `/log` (`foxglove.Log`): `log` output, warnings and errors.
 //!
-//! The workcell file and every program source are attachments; `vworks` metadata holds
-//! the version, the cell name and the cycle. The file is finished (summary, CRCs) when
+//! The workcell file, every program source, every URDF and every mesh are attachments;
+//! `vworks` metadata holds the version, the cell name, the cycle and the seed. The file is finished (summary, CRCs) when
 //! [`McapLog::finish`] runs, which the engine does for every outcome.
 
 use std::collections::BTreeMap;
@@ -82,6 +84,31 @@ struct SceneBody {
     geometry: Geometry,
     /// Shape pose in the frame (URDF convention: cylinders and capsules along z).
     local: Iso,
+    /// For a hull: its triangles, three corners each (empty if the hull is degenerate).
+    hull: Vec<[f64; 3]>,
+}
+
+/// The convex hull of `points` as a triangle list (three corners per triangle).
+fn hull_triangles(geometry: &Geometry) -> Vec<[f64; 3]> {
+    let Geometry::Hull { points, .. } = geometry else {
+        return Vec::new();
+    };
+    let pts: Vec<parry3d::math::Vector3> = points
+        .iter()
+        .map(|p| parry3d::math::Vector3::new(p[0] as f32, p[1] as f32, p[2] as f32))
+        .collect();
+    let Ok((vertices, faces)) = parry3d::transformation::try_convex_hull(&pts) else {
+        return Vec::new();
+    };
+    let mut out = Vec::with_capacity(faces.len() * 3);
+    for face in faces {
+        for k in face {
+            if let Some(v) = vertices.get(k as usize) {
+                out.push([f64::from(v.x), f64::from(v.y), f64::from(v.z)]);
+            }
+        }
+    }
+    out
 }
 
 /// The MCAP log being written.
@@ -191,6 +218,10 @@ impl McapLog {
         );
         meta.insert("cell".to_string(), cell.name.clone());
         meta.insert("cycle_ns".to_string(), cell.cycle_ns.to_string());
+        meta.insert("workcell_file".to_string(), cell.file.display().to_string());
+        meta.insert("clearance_m".to_string(), cell.clearance.to_string());
+        // The engine draws no random numbers: the same inputs give the same run.
+        meta.insert("seed".to_string(), "none (deterministic)".to_string());
         meta.insert(
             "robots".to_string(),
             cell.robots
@@ -219,12 +250,33 @@ impl McapLog {
             })
             .map_err(|e| io(&e))?;
         }
+        for (name, bytes) in &cell.files {
+            let lower = name.to_ascii_lowercase();
+            let media = if lower.ends_with(".urdf") || lower.ends_with(".xml") {
+                "application/xml"
+            } else if lower.ends_with(".stl") {
+                "model/stl"
+            } else if lower.ends_with(".obj") {
+                "model/obj"
+            } else {
+                "application/octet-stream"
+            };
+            w.attach(&mcap::Attachment {
+                log_time: 0,
+                create_time: 0,
+                name: name.clone(),
+                media_type: media.into(),
+                data: std::borrow::Cow::Borrowed(bytes),
+            })
+            .map_err(|e| io(&e))?;
+        }
         let mut bodies = Vec::new();
         for r in &cell.robots {
             for l in &r.model.links {
                 for s in &l.shapes {
                     bodies.push(SceneBody {
                         frame: format!("{}.{}", r.name, l.name),
+                        hull: hull_triangles(&s.geometry),
                         geometry: s.geometry.clone(),
                         local: s.origin,
                     });
@@ -234,6 +286,7 @@ impl McapLog {
         for d in cell.devices.iter().chain(&cell.parts) {
             bodies.push(SceneBody {
                 frame: d.name.clone(),
+                hull: hull_triangles(&d.geometry),
                 geometry: d.geometry.clone(),
                 local: Iso::IDENTITY,
             });
@@ -301,6 +354,7 @@ impl McapLog {
                 serde_json::json!({"r": 0.6, "g": 0.65, "b": 0.7, "a": 1.0})
             };
             let (mut cubes, mut spheres, mut cylinders) = (Vec::new(), Vec::new(), Vec::new());
+            let mut triangles = Vec::new();
             let local = b.local;
             match &b.geometry {
                 Geometry::Box { half } => cubes.push(serde_json::json!({"pose": pose_json(&local), "size": {"x": 2.0 * half[0], "y": 2.0 * half[1], "z": 2.0 * half[2]}, "color": color})),
@@ -313,8 +367,16 @@ impl McapLog {
                         spheres.push(serde_json::json!({"pose": pose_json(&c), "size": {"x": 2.0 * radius, "y": 2.0 * radius, "z": 2.0 * radius}, "color": color}));
                     }
                 }
+                Geometry::Hull { .. } if !b.hull.is_empty() => {
+                    let points: Vec<serde_json::Value> = b
+                        .hull
+                        .iter()
+                        .map(|p| serde_json::json!({"x": p[0], "y": p[1], "z": p[2]}))
+                        .collect();
+                    triangles.push(serde_json::json!({"pose": pose_json(&local), "points": points, "color": color, "colors": [], "indices": []}));
+                }
                 Geometry::Hull { points, .. } => {
-                    // The hull's bounding box stands in for the mesh.
+                    // A degenerate hull (flat or a line): its bounding box stands in.
                     let mut lo = [f64::INFINITY; 3];
                     let mut hi = [f64::NEG_INFINITY; 3];
                     for p in points {
@@ -331,7 +393,7 @@ impl McapLog {
                 "timestamp": ts(t), "frame_id": b.frame, "id": format!("{}#{i}", b.frame),
                 "lifetime": {"sec": 0, "nsec": 0}, "frame_locked": true, "metadata": [],
                 "arrows": [], "cubes": cubes, "spheres": spheres, "cylinders": cylinders,
-                "lines": [], "triangles": [], "texts": [], "models": [],
+                "lines": [], "triangles": triangles, "texts": [], "models": [],
             }));
         }
         self.write(

@@ -181,8 +181,10 @@ pub struct Cell {
     pub allowed: Vec<(String, String)>,
     /// The linked programs.
     pub linked: Linked,
-    /// Every file the run depends on: (path, text) for programs and the workcell.
+    /// The workcell file and every program: (path, text).
     pub sources: Vec<(String, String)>,
+    /// Every other file the run read: each URDF and each mesh, (path, bytes), in load order.
+    pub files: Vec<(String, Vec<u8>)>,
 }
 
 struct Ctx<'a> {
@@ -436,6 +438,7 @@ pub fn load(path: &Path) -> Result<Cell, CellError> {
     }
 
     let mut sources = vec![(file.clone(), text.clone())];
+    let mut files: Vec<(String, Vec<u8>)> = Vec::new();
     let mut robots = Vec::new();
     let mut modules: Vec<(String, Arc<Module>)> = Vec::new();
     let mut diagnostics = Vec::new();
@@ -447,6 +450,10 @@ pub fn load(path: &Path) -> Result<Cell, CellError> {
                 builtin::load(m).map_err(|e| cx.bad(&format!("{key}.model"), e.to_string()))?
             }
             (None, Some(u)) => {
+                let upath = dir.join(u);
+                if let Ok(bytes) = std::fs::read(&upath) {
+                    files.push((upath.display().to_string(), bytes));
+                }
                 let opts = LoadOptions {
                     tool_link: r.tool_link.clone(),
                     package_paths: r.package_path.iter().map(|p| dir.join(p)).collect(),
@@ -614,6 +621,20 @@ pub fn load(path: &Path) -> Result<Cell, CellError> {
         }
         allowed.push((a.clone(), b.clone()));
     }
+    // Meshes, for the log's attachments: each hull's file once, in load order.
+    let hulls = robots
+        .iter()
+        .flat_map(|(r, _, _)| r.model.links.iter().flat_map(|l| l.shapes.iter()))
+        .map(|s| &s.geometry)
+        .chain(devices.iter().chain(&parts).map(|b| &b.geometry));
+    for g in hulls {
+        if let Geometry::Hull { source, .. } = g
+            && !files.iter().any(|(f, _)| f == source)
+            && let Ok(bytes) = std::fs::read(source)
+        {
+            files.push((source.clone(), bytes));
+        }
+    }
     Ok(Cell {
         name: cf.name.unwrap_or_else(|| {
             path.file_stem()
@@ -630,5 +651,6 @@ pub fn load(path: &Path) -> Result<Cell, CellError> {
         allowed,
         linked,
         sources,
+        files,
     })
 }

@@ -167,3 +167,71 @@ fn the_cell_and_its_programs_are_attached() {
     assert_eq!(meta.len(), 1);
     assert_eq!(meta[0].name, "vworks");
 }
+
+#[test]
+fn urdfs_and_meshes_are_attached_and_meshes_drawn_as_triangles() {
+    let dir = std::env::temp_dir().join(format!("vworks-log-urdf-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("meshes")).unwrap();
+    let stl = "solid t\n\
+        facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 0.1 0 0\nvertex 0 0.1 0\nendloop\nendfacet\n\
+        facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 0 0.1 0\nvertex 0 0 0.1\nendloop\nendfacet\n\
+        facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 0 0 0.1\nvertex 0.1 0 0\nendloop\nendfacet\n\
+        facet normal 0 0 0\nouter loop\nvertex 0.1 0 0\nvertex 0 0.1 0\nvertex 0 0 0.1\nendloop\nendfacet\n\
+        endsolid t\n";
+    std::fs::write(dir.join("meshes/tip.stl"), stl).unwrap();
+    let urdf = r#"<robot name="arm">
+  <link name="base"><collision><geometry><box size="0.2 0.2 0.1"/></geometry></collision></link>
+  <link name="tip"><collision><geometry><mesh filename="meshes/tip.stl"/></geometry></collision></link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="tip"/>
+    <origin xyz="0 0 0.3"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" velocity="2" effort="1"/></joint>
+</robot>
+"#;
+    std::fs::write(dir.join("arm.urdf"), urdf).unwrap();
+    std::fs::write(
+        dir.join("cell.toml"),
+        "[[robot]]\nname = \"r1\"\nurdf = \"arm.urdf\"\nprogram = \"r1.wsl\"\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("r1.wsl"),
+        "proc main() {\n    move_j joints(30deg);\n}\n",
+    )
+    .unwrap();
+    let cell = Arc::new(load(&dir.join("cell.toml")).unwrap());
+    let (r, bytes) = run_logged(&cell, 1, None, "urdf");
+    assert_eq!(r.outcome, Outcome::Completed);
+    check(&cell, &r, &bytes);
+    let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+    let mut attached = BTreeMap::new();
+    for index in &summary.attachment_indexes {
+        let a = mcap::read::attachment(&bytes, index).unwrap();
+        let name = std::path::Path::new(&a.name)
+            .file_name()
+            .unwrap()
+            .to_string_lossy()
+            .into_owned();
+        attached.insert(name, (a.media_type.clone(), a.data.into_owned()));
+    }
+    let names: Vec<&String> = attached.keys().collect();
+    assert_eq!(names, ["arm.urdf", "cell.toml", "r1.wsl", "tip.stl"]);
+    assert_eq!(attached["arm.urdf"].0, "application/xml");
+    assert_eq!(attached["arm.urdf"].1, urdf.as_bytes());
+    assert_eq!(attached["tip.stl"].0, "model/stl");
+    assert_eq!(attached["tip.stl"].1, stl.as_bytes());
+    // The first scene message draws the mesh's hull: a tetrahedron, 4 triangles.
+    let scene = mcap::MessageStream::new(&bytes)
+        .unwrap()
+        .map(Result::unwrap)
+        .find(|m| m.channel.topic == "/scene")
+        .unwrap();
+    let v: serde_json::Value = serde_json::from_slice(&scene.data).unwrap();
+    let tip = v["entities"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|e| e["frame_id"] == "r1.tip")
+        .unwrap();
+    let points = tip["triangles"][0]["points"].as_array().unwrap();
+    assert_eq!(points.len(), 12, "{tip}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
