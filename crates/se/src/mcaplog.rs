@@ -126,8 +126,90 @@ pub struct McapLog {
     bodies: Vec<SceneBody>,
     red: Vec<bool>,
     buf: Vec<u8>,
-    /// Messages written per topic.
-    pub counts: BTreeMap<&'static str, u64>,
+    /// Messages written per topic, indexed like [`TOPICS`].
+    counts: [u64; 5],
+    /// Frame and robot names, JSON-quoted once.
+    names: Names,
+    /// Every frame's last published pose, in publishing order (robots' links, devices, parts).
+    last_frames: Vec<Iso>,
+    /// When the next `/tf` message carries every frame, not only the moved ones.
+    next_keyframe: i64,
+}
+
+/// Every frame is republished at least this often (simulated time), so a player that
+/// seeks into the middle of a run finds every frame within one second before.
+pub const KEYFRAME_NS: i64 = 1_000_000_000;
+
+/// The topics, in the order of [`McapLog`]'s counters.
+pub const TOPICS: [&str; 5] = ["/events", "/state", "/tf", "/scene", "/log"];
+const EVENTS: usize = 0;
+const STATE: usize = 1;
+const TF: usize = 2;
+const SCENE: usize = 3;
+const LOG: usize = 4;
+
+/// Names as JSON string literals (with quotes), built once when the log is created.
+struct Names {
+    robots: Vec<String>,
+    links: Vec<Vec<String>>,
+    devices: Vec<String>,
+    parts: Vec<String>,
+}
+
+fn quoted(s: &str) -> String {
+    serde_json::Value::from(s).to_string()
+}
+
+fn json_int(b: &mut Vec<u8>, v: i64) {
+    b.extend_from_slice(itoa::Buffer::new().format(v).as_bytes());
+}
+
+/// A JSON number; NaN and infinities (never expected) become `null`.
+fn json_num(b: &mut Vec<u8>, v: f64) {
+    if v.is_finite() {
+        b.extend_from_slice(zmij::Buffer::new().format_finite(v).as_bytes());
+    } else {
+        b.extend_from_slice(b"null");
+    }
+}
+
+fn json_time(b: &mut Vec<u8>, t: i64) {
+    let t = t.max(0);
+    b.extend_from_slice(b"{\"sec\":");
+    json_int(b, t / 1_000_000_000);
+    b.extend_from_slice(b",\"nsec\":");
+    json_int(b, t % 1_000_000_000);
+    b.push(b'}');
+}
+
+/// `"pos":{"x":..,"y":..,"z":..},"rot":{"x":..,"y":..,"z":..,"w":..}` (no braces around).
+fn json_pose_fields(b: &mut Vec<u8>, p: &Iso, pos: &[u8], rot: &[u8]) {
+    let q = quat(&p.r);
+    b.push(b'"');
+    b.extend_from_slice(pos);
+    b.extend_from_slice(b"\":{\"x\":");
+    json_num(b, p.t[0]);
+    b.extend_from_slice(b",\"y\":");
+    json_num(b, p.t[1]);
+    b.extend_from_slice(b",\"z\":");
+    json_num(b, p.t[2]);
+    b.extend_from_slice(b"},\"");
+    b.extend_from_slice(rot);
+    b.extend_from_slice(b"\":{\"x\":");
+    json_num(b, q[0]);
+    b.extend_from_slice(b",\"y\":");
+    json_num(b, q[1]);
+    b.extend_from_slice(b",\"z\":");
+    json_num(b, q[2]);
+    b.extend_from_slice(b",\"w\":");
+    json_num(b, q[3]);
+    b.push(b'}');
+}
+
+fn json_pose(b: &mut Vec<u8>, p: &Iso, pos: &[u8], rot: &[u8]) {
+    b.push(b'{');
+    json_pose_fields(b, p, pos, rot);
+    b.push(b'}');
 }
 
 impl std::fmt::Debug for McapLog {
@@ -191,6 +273,7 @@ impl McapLog {
         let f = File::create(path).map_err(|e| io(&e))?;
         let mut w = mcap::WriteOptions::new()
             .compression(Some(mcap::Compression::Zstd))
+            .compression_level(1)
             .chunk_size(Some(1 << 20))
             .profile("")
             .create(BufWriter::new(f))
@@ -206,11 +289,16 @@ impl McapLog {
                 .map_err(|e| io(&e))?;
             w.add_channel(s, topic, "json", &none).map_err(|e| io(&e))
         };
-        let events = channel(&mut w, "vworks.Event", EVENT_SCHEMA, "/events")?;
-        let state = channel(&mut w, "vworks.CycleState", STATE_SCHEMA, "/state")?;
-        let tf = channel(&mut w, "foxglove.FrameTransforms", &tf_schema(), "/tf")?;
-        let scene = channel(&mut w, "foxglove.SceneUpdate", &scene_schema(), "/scene")?;
-        let log = channel(&mut w, "foxglove.Log", &log_schema(), "/log")?;
+        let events = channel(&mut w, "vworks.Event", EVENT_SCHEMA, TOPICS[EVENTS])?;
+        let state = channel(&mut w, "vworks.CycleState", STATE_SCHEMA, TOPICS[STATE])?;
+        let tf = channel(&mut w, "foxglove.FrameTransforms", &tf_schema(), TOPICS[TF])?;
+        let scene = channel(
+            &mut w,
+            "foxglove.SceneUpdate",
+            &scene_schema(),
+            TOPICS[SCENE],
+        )?;
+        let log = channel(&mut w, "foxglove.Log", &log_schema(), TOPICS[LOG])?;
         let mut meta = BTreeMap::new();
         meta.insert(
             "vworks_version".to_string(),
@@ -306,7 +394,25 @@ impl McapLog {
             bodies,
             red,
             buf: Vec::with_capacity(4096),
-            counts: BTreeMap::new(),
+            counts: [0; 5],
+            last_frames: Vec::new(),
+            next_keyframe: 0,
+            names: Names {
+                robots: cell.robots.iter().map(|r| quoted(&r.name)).collect(),
+                links: cell
+                    .robots
+                    .iter()
+                    .map(|r| {
+                        r.model
+                            .links
+                            .iter()
+                            .map(|l| quoted(&format!("{}.{}", r.name, l.name)))
+                            .collect()
+                    })
+                    .collect(),
+                devices: cell.devices.iter().map(|d| quoted(&d.name)).collect(),
+                parts: cell.parts.iter().map(|p| quoted(&p.name)).collect(),
+            },
         };
         log.write_scene(0, None)?;
         Ok(log)
@@ -315,15 +421,30 @@ impl McapLog {
     fn write(
         &mut self,
         channel: u16,
-        topic: &'static str,
+        topic: usize,
         t: i64,
         value: &serde_json::Value,
     ) -> Result<(), LogError> {
-        self.buf.clear();
-        serde_json::to_writer(&mut self.buf, value).map_err(|e| LogError::Io {
-            file: self.file.clone(),
-            reason: e.to_string(),
-        })?;
+        let mut b = std::mem::take(&mut self.buf);
+        b.clear();
+        let r = serde_json::to_writer(&mut b, value)
+            .map_err(|e| LogError::Io {
+                file: self.file.clone(),
+                reason: e.to_string(),
+            })
+            .and_then(|()| self.write_buf(channel, topic, t, &b));
+        self.buf = b;
+        r
+    }
+
+    /// Writes one encoded message and counts it.
+    fn write_buf(
+        &mut self,
+        channel: u16,
+        topic: usize,
+        t: i64,
+        data: &[u8],
+    ) -> Result<(), LogError> {
         self.seq = self.seq.wrapping_add(1);
         let header = mcap::records::MessageHeader {
             channel_id: channel,
@@ -332,12 +453,12 @@ impl McapLog {
             publish_time: t.max(0) as u64,
         };
         self.w
-            .write_to_known_channel(&header, &self.buf)
+            .write_to_known_channel(&header, data)
             .map_err(|e| LogError::Io {
                 file: self.file.clone(),
                 reason: e.to_string(),
             })?;
-        *self.counts.entry(topic).or_default() += 1;
+        self.counts[topic] += 1;
         Ok(())
     }
 
@@ -398,7 +519,7 @@ impl McapLog {
         }
         self.write(
             self.scene,
-            "/scene",
+            SCENE,
             t,
             &serde_json::json!({"deletions": [], "entities": entities}),
         )
@@ -413,7 +534,7 @@ impl McapLog {
             .as_ref()
             .map_or((None, 0, 0), |(f, p)| (Some(f.to_string()), p.line, p.col));
         let v = serde_json::json!({"time_ns": e.time, "robot": robot, "kind": e.kind, "details": e.details, "file": file, "line": line, "col": col});
-        self.write(self.events, "/events", e.time, &v)?;
+        self.write(self.events, EVENTS, e.time, &v)?;
         let level = match e.kind {
             "log" => Some(2),
             "warning" => Some(3),
@@ -422,7 +543,7 @@ impl McapLog {
         };
         if let Some(level) = level {
             let v = serde_json::json!({"timestamp": ts(e.time), "level": level, "message": e.details.trim_matches('"'), "name": robot.unwrap_or_else(|| "cell".into()), "file": file.unwrap_or_default(), "line": line});
-            self.write(self.log, "/log", e.time, &v)?;
+            self.write(self.log, LOG, e.time, &v)?;
         }
         if matches!(e.kind, "collision_start" | "collision_end") {
             let mut names = e.details.split(' ');
@@ -456,36 +577,85 @@ impl McapLog {
         if !k.is_multiple_of(self.every) {
             return Ok(());
         }
-        let mut robots = Vec::with_capacity(cell.robots.len());
-        let mut transforms = Vec::new();
+        // Written straight into the reused buffer: no allocation per cycle.
+        let mut b = std::mem::take(&mut self.buf);
+        b.clear();
+        b.extend_from_slice(b"{\"time_ns\":");
+        json_int(&mut b, t);
+        b.extend_from_slice(b",\"cycle\":");
+        json_int(&mut b, k as i64);
+        b.extend_from_slice(b",\"robots\":[");
         for (r, robot) in cell.robots.iter().enumerate() {
+            if r > 0 {
+                b.push(b',');
+            }
+            b.extend_from_slice(b"{\"name\":");
+            b.extend_from_slice(self.names.robots[r].as_bytes());
+            b.extend_from_slice(b",\"joints\":[");
+            for (j, q) in joints[r].iter().enumerate() {
+                if j > 0 {
+                    b.push(b',');
+                }
+                json_num(&mut b, *q);
+            }
+            b.extend_from_slice(b"],\"tcp\":");
             let tcp = frames[r][robot.model.tool_link].mul(&robot.tool);
-            robots.push(serde_json::json!({"name": robot.name, "joints": joints[r], "tcp": pose_json(&tcp)}));
-            for (l, link) in robot.model.links.iter().enumerate() {
-                let p = pose_json(&frames[r][l]);
-                transforms.push(serde_json::json!({"timestamp": ts(t), "parent_frame_id": "world", "child_frame_id": format!("{}.{}", robot.name, link.name), "translation": p["position"], "rotation": p["orientation"]}));
+            json_pose(&mut b, &tcp, b"position", b"orientation");
+            b.push(b'}');
+        }
+        b.extend_from_slice(b"]}");
+        let r = self.write_buf(self.state, STATE, t, &b);
+        b.clear();
+        // Frame transforms: every frame at a keyframe, in between only the frames that moved.
+        let keyframe = t >= self.next_keyframe;
+        if keyframe {
+            self.next_keyframe = t + KEYFRAME_NS;
+        }
+        b.extend_from_slice(b"{\"transforms\":[");
+        let mut first = true;
+        let mut slot = 0;
+        let last = &mut self.last_frames;
+        let mut transform = |b: &mut Vec<u8>, name: &str, pose: &Iso| {
+            let i = slot;
+            slot += 1;
+            if !keyframe && last.get(i) == Some(pose) {
+                return;
+            }
+            match last.get_mut(i) {
+                Some(l) => *l = *pose,
+                None => last.push(*pose),
+            }
+            if !first {
+                b.push(b',');
+            }
+            first = false;
+            b.extend_from_slice(b"{\"timestamp\":");
+            json_time(b, t);
+            b.extend_from_slice(b",\"parent_frame_id\":\"world\",\"child_frame_id\":");
+            b.extend_from_slice(name.as_bytes());
+            b.push(b',');
+            json_pose_fields(b, pose, b"translation", b"rotation");
+            b.push(b'}');
+        };
+        for (r, names) in self.names.links.iter().enumerate() {
+            for (l, name) in names.iter().enumerate() {
+                transform(&mut b, name, &frames[r][l]);
             }
         }
-        for d in &cell.devices {
-            let p = pose_json(&d.pose);
-            transforms.push(serde_json::json!({"timestamp": ts(t), "parent_frame_id": "world", "child_frame_id": d.name, "translation": p["position"], "rotation": p["orientation"]}));
+        for (d, name) in cell.devices.iter().zip(&self.names.devices) {
+            transform(&mut b, name, &d.pose);
         }
-        for (i, part) in cell.parts.iter().enumerate() {
-            let p = pose_json(&parts[i]);
-            transforms.push(serde_json::json!({"timestamp": ts(t), "parent_frame_id": "world", "child_frame_id": part.name, "translation": p["position"], "rotation": p["orientation"]}));
+        for (p, name) in parts.iter().zip(&self.names.parts) {
+            transform(&mut b, name, p);
         }
-        self.write(
-            self.state,
-            "/state",
-            t,
-            &serde_json::json!({"time_ns": t, "cycle": k, "robots": robots}),
-        )?;
-        self.write(
-            self.tf,
-            "/tf",
-            t,
-            &serde_json::json!({"transforms": transforms}),
-        )
+        b.extend_from_slice(b"]}");
+        let r2 = if first {
+            Ok(()) // nothing moved
+        } else {
+            self.write_buf(self.tf, TF, t, &b)
+        };
+        self.buf = b;
+        r.and(r2)
     }
 
     /// Finishes the file: summary, indexes, CRCs. Returns the counts per topic.
@@ -494,6 +664,6 @@ impl McapLog {
             file: self.file.clone(),
             reason: e.to_string(),
         })?;
-        Ok(self.counts)
+        Ok(TOPICS.iter().copied().zip(self.counts).collect())
     }
 }

@@ -33,7 +33,16 @@ fn run_logged(
 /// Reads every message (checking chunk CRCs) and the summary; returns per-topic counts
 /// and the event lines.
 fn read_back(bytes: &[u8]) -> (BTreeMap<String, u64>, Vec<String>) {
-    let mut counts = BTreeMap::new();
+    let summary = mcap::Summary::read(bytes)
+        .unwrap()
+        .expect("a finished file has a summary");
+    assert_eq!(summary.channels.len(), 5);
+    // Every channel counts, even one with no messages.
+    let mut counts: BTreeMap<String, u64> = summary
+        .channels
+        .values()
+        .map(|c| (c.topic.clone(), 0))
+        .collect();
     let mut events = Vec::new();
     for m in mcap::MessageStream::new(bytes).unwrap() {
         let m = m.unwrap();
@@ -68,10 +77,6 @@ fn read_back(bytes: &[u8]) -> (BTreeMap<String, u64>, Vec<String>) {
             ));
         }
     }
-    let summary = mcap::Summary::read(bytes)
-        .unwrap()
-        .expect("a finished file has a summary");
-    assert_eq!(summary.channels.len(), 5);
     (counts, events)
 }
 
