@@ -23,6 +23,8 @@ use std::fs::File;
 use std::io::BufWriter;
 use std::path::Path;
 
+use foxglove::messages::{FrameTransform, FrameTransforms, Quaternion, Timestamp, Vector3};
+use prost::Message as _;
 use vworks_model::math::Iso;
 use vworks_model::model::Geometry;
 
@@ -134,6 +136,47 @@ pub struct McapLog {
     last_frames: Vec<Iso>,
     /// When the next `/tf` message carries every frame, not only the moved ones.
     next_keyframe: i64,
+    tf_encoding: TfEncoding,
+    /// One protobuf transform per frame (names filled once), updated in place.
+    tf_frames: Vec<FrameTransform>,
+}
+
+/// How `/tf` is encoded. Both are Foxglove's `FrameTransforms`; `docs/log.md` has the
+/// measurements behind the default.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum TfEncoding {
+    /// Protobuf, with the schema from the `foxglove` crate (the default: smaller, faster).
+    #[default]
+    Protobuf,
+    /// JSON with a JSON schema written here.
+    Json,
+}
+
+/// Options for [`McapLog::create_with`].
+#[derive(Clone, Copy, Debug)]
+#[non_exhaustive]
+pub struct LogOptions {
+    /// Log every `every`-th cycle boundary's state (1 = all; events are never thinned).
+    pub every: u64,
+    /// The `/tf` encoding.
+    pub tf_encoding: TfEncoding,
+}
+
+impl Default for LogOptions {
+    fn default() -> LogOptions {
+        LogOptions {
+            every: 1,
+            tf_encoding: TfEncoding::Protobuf,
+        }
+    }
+}
+
+impl LogOptions {
+    /// Every `every`-th state, `/tf` encoded as `tf_encoding`.
+    pub fn new(every: u64, tf_encoding: TfEncoding) -> LogOptions {
+        LogOptions { every, tf_encoding }
+    }
 }
 
 /// Every frame is republished at least this often (simulated time), so a player that
@@ -265,6 +308,19 @@ fn pose_json(p: &Iso) -> serde_json::Value {
 impl McapLog {
     /// Creates the log for `cell`; `every` thins cycle states (1 = every boundary).
     pub fn create(path: &Path, cell: &Cell, every: u64) -> Result<McapLog, LogError> {
+        McapLog::create_with(
+            path,
+            cell,
+            LogOptions {
+                every,
+                ..LogOptions::default()
+            },
+        )
+    }
+
+    /// Creates the log for `cell` with these options.
+    pub fn create_with(path: &Path, cell: &Cell, options: LogOptions) -> Result<McapLog, LogError> {
+        let every = options.every;
         let file = path.display().to_string();
         let io = |e: &dyn std::fmt::Display| LogError::Io {
             file: file.clone(),
@@ -291,7 +347,25 @@ impl McapLog {
         };
         let events = channel(&mut w, "vworks.Event", EVENT_SCHEMA, TOPICS[EVENTS])?;
         let state = channel(&mut w, "vworks.CycleState", STATE_SCHEMA, TOPICS[STATE])?;
-        let tf = channel(&mut w, "foxglove.FrameTransforms", &tf_schema(), TOPICS[TF])?;
+        let tf = match options.tf_encoding {
+            TfEncoding::Json => {
+                channel(&mut w, "foxglove.FrameTransforms", &tf_schema(), TOPICS[TF])?
+            }
+            TfEncoding::Protobuf => {
+                let schema =
+                    <FrameTransforms as foxglove::Encode>::get_schema().ok_or_else(|| {
+                        LogError::Io {
+                            file: file.clone(),
+                            reason: "the foxglove crate has no FrameTransforms schema".into(),
+                        }
+                    })?;
+                let s = w
+                    .add_schema(&schema.name, &schema.encoding, &schema.data)
+                    .map_err(|e| io(&e))?;
+                w.add_channel(s, TOPICS[TF], "protobuf", &none)
+                    .map_err(|e| io(&e))?
+            }
+        };
         let scene = channel(
             &mut w,
             "foxglove.SceneUpdate",
@@ -396,6 +470,26 @@ impl McapLog {
             buf: Vec::with_capacity(4096),
             counts: [0; 5],
             last_frames: Vec::new(),
+            tf_encoding: options.tf_encoding,
+            tf_frames: cell
+                .robots
+                .iter()
+                .flat_map(|r| {
+                    r.model
+                        .links
+                        .iter()
+                        .map(|l| format!("{}.{}", r.name, l.name))
+                })
+                .chain(cell.devices.iter().map(|d| d.name.clone()))
+                .chain(cell.parts.iter().map(|p| p.name.clone()))
+                .map(|child| FrameTransform {
+                    timestamp: None,
+                    parent_frame_id: "world".into(),
+                    child_frame_id: child,
+                    translation: None,
+                    rotation: None,
+                })
+                .collect(),
             next_keyframe: 0,
             names: Names {
                 robots: cell.robots.iter().map(|r| quoted(&r.name)).collect(),
@@ -460,6 +554,64 @@ impl McapLog {
             })?;
         self.counts[topic] += 1;
         Ok(())
+    }
+
+    /// `/tf` as protobuf `FrameTransforms`: each moved frame (every frame at a keyframe)
+    /// as one length-delimited `transforms` entry (field 1), appended to `b`.
+    fn tf_protobuf(
+        &mut self,
+        b: &mut Vec<u8>,
+        t: i64,
+        keyframe: bool,
+        frames: &[Vec<Iso>],
+        devices: &[crate::workcell::Body],
+        parts: &[Iso],
+    ) -> Result<(), LogError> {
+        b.clear();
+        let tt = t.max(0);
+        let stamp = Timestamp::new(
+            u32::try_from(tt / 1_000_000_000).unwrap_or(u32::MAX),
+            (tt % 1_000_000_000) as u32,
+        );
+        let poses = frames
+            .iter()
+            .flatten()
+            .chain(devices.iter().map(|d| &d.pose))
+            .chain(parts);
+        for (i, pose) in poses.enumerate() {
+            if !keyframe && self.last_frames.get(i) == Some(pose) {
+                continue;
+            }
+            match self.last_frames.get_mut(i) {
+                Some(l) => *l = *pose,
+                None => self.last_frames.push(*pose),
+            }
+            let Some(msg) = self.tf_frames.get_mut(i) else {
+                continue;
+            };
+            let q = quat(&pose.r);
+            msg.timestamp = Some(stamp);
+            msg.translation = Some(Vector3 {
+                x: pose.t[0],
+                y: pose.t[1],
+                z: pose.t[2],
+            });
+            msg.rotation = Some(Quaternion {
+                x: q[0],
+                y: q[1],
+                z: q[2],
+                w: q[3],
+            });
+            b.push(0x0a); // field 1, length-delimited
+            msg.encode_length_delimited(b).map_err(|e| LogError::Io {
+                file: self.file.clone(),
+                reason: e.to_string(),
+            })?;
+        }
+        if b.is_empty() {
+            return Ok(()); // nothing moved
+        }
+        self.write_buf(self.tf, TF, t, b)
     }
 
     /// Publishes the geometry; with `only`, just the bodies whose frame is one of those.
@@ -610,6 +762,11 @@ impl McapLog {
         let keyframe = t >= self.next_keyframe;
         if keyframe {
             self.next_keyframe = t + KEYFRAME_NS;
+        }
+        if self.tf_encoding == TfEncoding::Protobuf {
+            let r2 = self.tf_protobuf(&mut b, t, keyframe, frames, &cell.devices, parts);
+            self.buf = b;
+            return r.and(r2);
         }
         b.extend_from_slice(b"{\"transforms\":[");
         let mut first = true;

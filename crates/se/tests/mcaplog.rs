@@ -7,8 +7,10 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::Arc;
 
+use foxglove::messages::FrameTransforms;
+use prost::Message as _;
 use vworks_se::engine::{Outcome, RunResult, Simulation};
-use vworks_se::mcaplog::McapLog;
+use vworks_se::mcaplog::{LogOptions, McapLog, TfEncoding};
 use vworks_se::workcell::{Cell, load};
 
 fn root() -> PathBuf {
@@ -48,6 +50,27 @@ fn read_back(bytes: &[u8]) -> (BTreeMap<String, u64>, Vec<String>) {
         let m = m.unwrap();
         *counts.entry(m.channel.topic.clone()).or_default() += 1;
         let schema = m.channel.schema.as_ref().unwrap();
+        if m.channel.message_encoding == "protobuf" {
+            // The schema is a FileDescriptorSet naming the message; the message decodes.
+            assert_eq!(schema.encoding, "protobuf");
+            let set = prost_types::FileDescriptorSet::decode(&schema.data[..])
+                .unwrap_or_else(|e| panic!("schema {} does not parse: {e}", schema.name));
+            assert!(
+                set.file
+                    .iter()
+                    .any(|f| f.message_type.iter().any(|d| Some(format!(
+                        "{}.{}",
+                        f.package(),
+                        d.name()
+                    )) == Some(schema.name.clone()))),
+                "{} is not in its descriptor set",
+                schema.name
+            );
+            assert_eq!(m.channel.topic, "/tf");
+            let tf = FrameTransforms::decode(&m.data[..]).unwrap();
+            assert!(!tf.transforms.is_empty());
+            continue;
+        }
         assert_eq!(schema.encoding, "jsonschema");
         let _: serde_json::Value = serde_json::from_slice(&schema.data)
             .unwrap_or_else(|e| panic!("schema {} is not JSON: {e}", schema.name));
@@ -239,4 +262,78 @@ fn urdfs_and_meshes_are_attached_and_meshes_drawn_as_triangles() {
     let points = tip["triangles"][0]["points"].as_array().unwrap();
     assert_eq!(points.len(), 12, "{tip}");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Every `/tf` transform of a log, as (time, frame, translation, rotation), whichever
+/// encoding it was written in.
+type Transform = (u64, String, [f64; 3], [f64; 4]);
+
+fn transforms(bytes: &[u8]) -> Vec<Transform> {
+    let mut out = Vec::new();
+    for m in mcap::MessageStream::new(bytes).unwrap() {
+        let m = m.unwrap();
+        if m.channel.topic != "/tf" {
+            continue;
+        }
+        if m.channel.message_encoding == "protobuf" {
+            for t in FrameTransforms::decode(&m.data[..]).unwrap().transforms {
+                let (p, q) = (t.translation.unwrap(), t.rotation.unwrap());
+                out.push((
+                    m.log_time,
+                    t.child_frame_id,
+                    [p.x, p.y, p.z],
+                    [q.x, q.y, q.z, q.w],
+                ));
+            }
+        } else {
+            let v: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
+            for t in v["transforms"].as_array().unwrap() {
+                let f = |x: &serde_json::Value| x.as_f64().unwrap();
+                let (p, q) = (&t["translation"], &t["rotation"]);
+                out.push((
+                    m.log_time,
+                    t["child_frame_id"].as_str().unwrap().to_string(),
+                    [f(&p["x"]), f(&p["y"]), f(&p["z"])],
+                    [f(&q["x"]), f(&q["y"]), f(&q["z"]), f(&q["w"])],
+                ));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn protobuf_and_json_frame_transforms_carry_the_same_poses() {
+    let cell = Arc::new(load(&root().join("workcells/track/cell.toml")).unwrap());
+    let mut logs = Vec::new();
+    for (encoding, name) in [(TfEncoding::Protobuf, "pb"), (TfEncoding::Json, "json")] {
+        let path =
+            std::env::temp_dir().join(format!("vworks-log-{name}-{}.mcap", std::process::id()));
+        let log = McapLog::create_with(&path, &cell, LogOptions::new(1, encoding)).unwrap();
+        let r = Simulation::new(Arc::clone(&cell)).with_log(log).run(None);
+        let bytes = std::fs::read(&path).unwrap();
+        let _ = std::fs::remove_file(&path);
+        check(&cell, &r, &bytes);
+        logs.push(transforms(&bytes));
+    }
+    // The writer prints shortest round-trip decimals; serde_json's default parser may land
+    // one ulp away, so values agree to 1e-15 and times and frames exactly.
+    assert!(logs[0].len() > 1000, "{}", logs[0].len());
+    assert_eq!(logs[0].len(), logs[1].len());
+    for (pb, json) in logs[0].iter().zip(&logs[1]) {
+        assert_eq!((pb.0, &pb.1), (json.0, &json.1));
+        let close = pb.2.iter().chain(&pb.3).zip(json.2.iter().chain(&json.3));
+        for (a, b) in close {
+            assert!((a - b).abs() <= 1e-15, "{pb:?} vs {json:?}");
+        }
+    }
+    // Between keyframes only moved frames are sent; at t = 0 every frame is.
+    let frames = cell
+        .robots
+        .iter()
+        .map(|r| r.model.links.len())
+        .sum::<usize>()
+        + cell.devices.len()
+        + cell.parts.len();
+    assert_eq!(logs[0].iter().filter(|t| t.0 == 0).count(), frames);
 }
