@@ -98,6 +98,17 @@ enum LogCommand {
     },
 }
 
+/// `println!` that ends the process quietly when stdout is gone (`vworks log events … | head`)
+/// instead of panicking.
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        if writeln!(std::io::stdout(), $($arg)*).is_err() {
+            std::process::exit(141); // as a shell reports SIGPIPE
+        }
+    }};
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let color =
@@ -199,16 +210,16 @@ fn read_log(what: LogCommand) -> Result<ExitCode, String> {
                 }
                 None => "-".into(),
             };
-            println!("{} {} {k} {details} {pos}", v["time_ns"], r.unwrap_or("-"));
+            out!("{} {} {k} {details} {pos}", v["time_ns"], r.unwrap_or("-"));
         }
     }
     if let LogCommand::Info { .. } = what {
-        println!("{}", file.display());
+        out!("{}", file.display());
         for (topic, n) in &counts {
-            println!("  {topic:<10} {n:>8} messages");
+            out!("  {topic:<10} {n:>8} messages");
         }
         if first <= last {
-            println!(
+            out!(
                 "  simulated span {} .. {}",
                 secs(first as i64),
                 secs(last as i64)
@@ -254,7 +265,7 @@ fn run_cell(
     let wall = started.elapsed().as_secs_f64();
     if trace {
         for e in &r.trace {
-            println!("{}", e.line(&cell));
+            out!("{}", e.line(&cell));
         }
     }
     let issue = |i: &vworks_se::engine::Issue| serde_json::json!({"kind": i.kind, "message": i.message, "robot": i.robot, "file": i.file, "line": i.line, "col": i.col});
@@ -274,24 +285,34 @@ fn run_cell(
             "cycles": r.cycles,
             "collision_queries": r.queries,
             "events": r.trace.len(),
+            "log": log.map(|p| serde_json::json!({
+                "file": p.display().to_string(),
+                "messages": r.log_counts,
+                "error": r.log_error.as_ref().map(ToString::to_string),
+            })),
         });
-        println!(
+        out!(
             "{}",
             serde_json::to_string_pretty(&v).map_err(|e| e.to_string())?
         );
     } else if !trace {
-        println!(
+        out!(
             "cell {}: {} at {}",
             cell.name,
             r.outcome.name(),
             secs(r.end_time_ns)
         );
-        println!(
+        out!(
             "{:<10} {:>10} {:>10} {:>10} {:>10} {:>8}  ended",
-            "robot", "moving", "waiting", "idle", "handlers", "motions"
+            "robot",
+            "moving",
+            "waiting",
+            "idle",
+            "handlers",
+            "motions"
         );
         for s in &r.robots {
-            println!(
+            out!(
                 "{:<10} {:>10} {:>10} {:>10} {:>10} {:>8}  {} at {}",
                 s.name,
                 secs(s.moving_ns),
@@ -304,7 +325,7 @@ fn run_cell(
             );
         }
         for c in &r.collisions {
-            println!(
+            out!(
                 "collision at {}: {} and {} (depth {:.1} mm)",
                 secs(c.time_ns),
                 c.a,
@@ -313,26 +334,34 @@ fn run_cell(
             );
         }
         for w in &r.warnings {
-            println!("warning[{}]: {}", w.kind, w.message);
+            out!("warning[{}]: {}", w.kind, w.message);
         }
         for e in &r.errors {
             let at = e
                 .file
                 .as_ref()
                 .map_or(String::new(), |f| format!(" ({f}:{}:{})", e.line, e.col));
-            println!("error[{}]: {}{at}", e.kind, e.message);
+            out!("error[{}]: {}{at}", e.kind, e.message);
         }
         if !r.globals.is_empty() {
             let g: Vec<String> = r.globals.iter().map(|(k, v)| format!("{k}={v}")).collect();
-            println!("globals: {}", g.join(", "));
+            out!("globals: {}", g.join(", "));
         }
-        println!(
+        out!(
             "{} events, {} cycles, {} collision queries; {:.0}x real time",
             r.trace.len(),
             r.cycles,
             r.queries,
             r.end_time_ns as f64 / 1e9 / wall.max(1e-9)
         );
+        if let Some(p) = log {
+            let counts: Vec<String> = r
+                .log_counts
+                .iter()
+                .map(|(topic, n)| format!("{n} {topic}"))
+                .collect();
+            out!("log {}: {}", p.display(), counts.join(", "));
+        }
     }
     Ok(match r.outcome {
         vworks_se::engine::Outcome::Completed | vworks_se::engine::Outcome::Until => {
@@ -422,7 +451,8 @@ fn run(cmd: Command, color: bool) -> Result<ExitCode, String> {
                 };
                 (m, read(&file).ok())
             };
-            print!("{}", disassemble(&module, source.as_deref()));
+            let listing = disassemble(&module, source.as_deref());
+            out!("{}", listing.trim_end_matches('\n'));
             Ok(ExitCode::SUCCESS)
         }
     }

@@ -251,3 +251,22 @@ fn ctrl_c_finishes_the_log() {
         .count();
     assert!(n > 0);
 }
+
+#[test]
+fn a_closed_stdout_ends_quietly() {
+    // `vworks disasm big.wsl | head -1`: far more output than a pipe holds.
+    let dir = temp_dir("pipe");
+    let body = "    delay 1s;\n".repeat(5000);
+    std::fs::write(dir.join("big.wsl"), format!("proc main() {{\n{body}}}\n")).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_vworks"))
+        .args(["disasm", dir.join("big.wsl").to_str().unwrap()])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = text(&out.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(out.status.code(), Some(141), "{err}");
+}
