@@ -180,8 +180,19 @@ fn read_log(what: LogCommand) -> Result<ExitCode, String> {
         .map_err(|e| format!("{}: not a valid MCAP file: {e}", file.display()))?;
     let mut counts: std::collections::BTreeMap<String, u64> = std::collections::BTreeMap::new();
     let (mut first, mut last) = (u64::MAX, 0u64);
+    // A log cut short (the process was killed) still has every chunk written before the
+    // kill: read up to the damage, report what was read, and say so.
+    let mut damage = None;
+    let mut read = 0u64;
     for m in stream {
-        let m = m.map_err(|e| format!("{}: damaged MCAP data: {e}", file.display()))?;
+        let m = match m {
+            Ok(m) => m,
+            Err(e) => {
+                damage = Some(e.to_string());
+                break;
+            }
+        };
+        read += 1;
         *counts.entry(m.channel.topic.clone()).or_default() += 1;
         first = first.min(m.log_time);
         last = last.max(m.log_time);
@@ -225,6 +236,18 @@ fn read_log(what: LogCommand) -> Result<ExitCode, String> {
                 secs(last as i64)
             );
         }
+        if damage.is_some() {
+            out!("  unfinished: only the messages before the damage are counted");
+        }
+    }
+    if let Some(e) = damage {
+        eprintln!(
+            "warning: {} is unfinished or damaged after {read} messages ({e}); everything before that was read. \
+             The run was probably killed: `mcap recover {} -o fixed.mcap` (the mcap CLI) rebuilds the index, or run the cell again.",
+            file.display(),
+            file.display()
+        );
+        return Ok(ExitCode::FAILURE);
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -270,3 +270,33 @@ fn a_closed_stdout_ends_quietly() {
     assert!(!err.contains("panicked"), "{err}");
     assert_eq!(out.status.code(), Some(141), "{err}");
 }
+
+#[test]
+fn a_log_cut_short_still_gives_what_was_written() {
+    // What a hard kill leaves: the file up to some byte, no summary, no footer.
+    let dir = temp_dir("cut");
+    let log = dir.join("run.mcap");
+    let run = vworks(&["run", &workcell("handoff"), "--log", log.to_str().unwrap()]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let full = std::fs::read(&log).unwrap();
+    let cut = dir.join("cut.mcap");
+    std::fs::write(&cut, &full[..full.len() / 2]).unwrap();
+    let all = vworks(&["log", "events", log.to_str().unwrap()]);
+    let part = vworks(&["log", "events", cut.to_str().unwrap()]);
+    assert_eq!(part.status.code(), Some(1));
+    let warning = text(&part.stderr);
+    assert!(
+        warning.contains("unfinished") && warning.contains("mcap recover"),
+        "{warning}"
+    );
+    let (all, part) = (text(&all.stdout), text(&part.stdout));
+    assert!(
+        all.starts_with(&part),
+        "the events read are the run's first ones"
+    );
+    let n = part.lines().count();
+    assert!(
+        n > 20 && n < all.lines().count(),
+        "{n} events survive the cut"
+    );
+}
