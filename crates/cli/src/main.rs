@@ -176,6 +176,12 @@ fn read_log(what: LogCommand) -> Result<ExitCode, String> {
     };
     let bytes =
         std::fs::read(&file).map_err(|e| format!("cannot read `{}`: {e}", file.display()))?;
+    if !bytes.starts_with(mcap::MAGIC) {
+        return Err(format!(
+            "{}: not an MCAP file (it does not start with the MCAP magic bytes); give a log written by `vworks run --log FILE`",
+            file.display()
+        ));
+    }
     let stream = mcap::MessageStream::new(&bytes)
         .map_err(|e| format!("{}: not a valid MCAP file: {e}", file.display()))?;
     let mut counts: std::collections::BTreeMap<String, u64> = std::collections::BTreeMap::new();

@@ -300,3 +300,15 @@ fn a_log_cut_short_still_gives_what_was_written() {
         "{n} events survive the cut"
     );
 }
+
+#[test]
+fn a_file_that_is_not_a_log_is_an_error() {
+    let dir = temp_dir("notlog");
+    let f = dir.join("notes.mcap");
+    std::fs::write(&f, "hello").unwrap();
+    let out = vworks(&["log", "info", f.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = text(&out.stderr);
+    assert!(err.contains("notes.mcap: not an MCAP file"), "{err}");
+    assert!(text(&out.stdout).is_empty());
+}

@@ -31,7 +31,13 @@ fn log_overhead(c: &mut Criterion) {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
     let cell = Arc::new(load(&root.join("workcells/handoff/cell.toml")).unwrap());
     let path = std::env::temp_dir().join(format!("vworks-bench-{}.mcap", std::process::id()));
-    let plain = mean_secs(10, || {
+    // Under `cargo test` (no `--bench`) criterion runs each function once: skip the report.
+    let runs = if std::env::args().any(|a| a == "--bench") {
+        10
+    } else {
+        1
+    };
+    let plain = mean_secs(runs, || {
         std::hint::black_box(Simulation::new(Arc::clone(&cell)).run(None));
     });
     println!("handoff: {:.1} ms without log", plain * 1e3);
@@ -41,7 +47,7 @@ fn log_overhead(c: &mut Criterion) {
     ];
     for (tf, name) in encodings {
         let mut end = 0;
-        let wall = mean_secs(10, || end = logged(&cell, &path, tf).end_time_ns);
+        let wall = mean_secs(runs, || end = logged(&cell, &path, tf).end_time_ns);
         let mb = std::fs::metadata(&path).unwrap().len() as f64 / 1e6;
         println!(
             "handoff, full log, /tf {name}: {:.1} ms (+{:.0} %, {:.0}x real time); {mb:.2} MB = {:.2} MB per simulated minute",
