@@ -19,6 +19,7 @@ use std::collections::{BTreeMap, BinaryHeap};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
+use vworks_model::math::Iso;
 use vworks_vm::bytecode::SrcPos;
 use vworks_vm::machine::{Event, EventKind, Next, Vm, VmConfig};
 use vworks_vm::types::fmt_quantity;
@@ -193,6 +194,9 @@ pub struct Simulation {
     /// The MCAP log, if one is written, and the first error writing it.
     log: Option<crate::mcaplog::McapLog>,
     log_error: Option<String>,
+    /// Reused per logged boundary: each robot's joints and link frames in `world`.
+    log_joints: Vec<Vec<f64>>,
+    log_frames: Vec<Vec<Iso>>,
     /// Set from outside to stop the run between two events.
     stop: Option<Arc<AtomicBool>>,
 }
@@ -285,6 +289,8 @@ impl Simulation {
             cycles: 0,
             log: None,
             log_error: None,
+            log_joints: Vec::new(),
+            log_frames: Vec::new(),
             stop: None,
             cell,
         }
@@ -293,6 +299,18 @@ impl Simulation {
     /// Writes the run to an MCAP log (see [`crate::mcaplog`]).
     pub fn with_log(mut self, log: crate::mcaplog::McapLog) -> Simulation {
         self.log = Some(log);
+        self.log_joints = self
+            .cell
+            .robots
+            .iter()
+            .map(|r| vec![0.0; r.model.dof()])
+            .collect();
+        self.log_frames = self
+            .cell
+            .robots
+            .iter()
+            .map(|r| r.model.frames_buffer())
+            .collect();
         self
     }
 
@@ -389,20 +407,23 @@ impl Simulation {
     /// Logs the state at boundary `b` (only when a log is written).
     fn log_cycle(&mut self, b: i64) {
         let Some(log) = self.log.as_mut() else { return };
-        let mut joints = Vec::with_capacity(self.vms.len());
-        let mut frames = Vec::with_capacity(self.vms.len());
+        if !log.logs_next_boundary() {
+            log.skip_boundary();
+            return;
+        }
         for (r, robot) in self.cell.robots.iter().enumerate() {
             let q = self.vms[r].joints_at(b);
             let n = robot.model.dof();
-            let mut f = robot.model.fk(&q[..n]);
-            for x in f.iter_mut() {
+            let (joints, frames) = (&mut self.log_joints[r], &mut self.log_frames[r]);
+            joints.copy_from_slice(&q[..n]);
+            robot.model.fk_into(&q[..n], frames);
+            for x in frames.iter_mut() {
                 *x = robot.base.mul(x);
             }
-            joints.push(q[..n].to_vec());
-            frames.push(f);
         }
-        let parts = self.collider.part_poses(&self.cell, &frames);
-        if let Err(err) = log.cycle(&self.cell, b, &joints, &frames, &parts) {
+        let (joints, frames) = (&self.log_joints, &self.log_frames);
+        let parts = self.collider.part_poses(&self.cell, frames);
+        if let Err(err) = log.cycle(&self.cell, b, joints, frames, &parts) {
             self.log_error.get_or_insert(err.to_string());
             self.log = None;
         }

@@ -714,6 +714,16 @@ impl McapLog {
         Ok(())
     }
 
+    /// Whether the next boundary's state is logged (every `every`-th is).
+    pub fn logs_next_boundary(&self) -> bool {
+        self.boundary.is_multiple_of(self.every)
+    }
+
+    /// Counts a boundary that is not logged without computing its state.
+    pub fn skip_boundary(&mut self) {
+        self.boundary += 1;
+    }
+
     /// Logs a cycle boundary (every `every`-th): state and frames. `frames[r]` holds robot
     /// r's link frames in the cell, `parts` the parts' poses.
     pub fn cycle(
