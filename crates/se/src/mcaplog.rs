@@ -90,6 +90,22 @@ struct SceneBody {
     hull: Vec<[f64; 3]>,
 }
 
+/// The media type of an attached file, from its extension (`text`: a program or the
+/// workcell, plain text whatever its name).
+fn media_type(name: &str, text: bool) -> &'static str {
+    let lower = name.to_ascii_lowercase();
+    let ext = lower.rsplit_once('.').map_or("", |(_, e)| e);
+    match ext {
+        "toml" => "application/toml",
+        "wsl" => "text/plain",
+        "urdf" | "xml" => "application/xml",
+        "stl" => "model/stl",
+        "obj" => "model/obj",
+        _ if text => "text/plain",
+        _ => "application/octet-stream",
+    }
+}
+
 /// The convex hull of `points` as a triangle list (three corners per triangle).
 fn hull_triangles(geometry: &Geometry) -> Vec<[f64; 3]> {
     let Geometry::Hull { points, .. } = geometry else {
@@ -397,38 +413,15 @@ impl McapLog {
             metadata: meta,
         })
         .map_err(|e| io(&e))?;
-        for (name, text) in &cell.sources {
-            let media = if name.ends_with(".toml") {
-                "application/toml"
-            } else {
-                "text/plain"
-            };
+        let texts = cell.sources.iter().map(|(n, t)| (n, t.as_bytes(), true));
+        let files = cell.files.iter().map(|(n, b)| (n, b.as_slice(), false));
+        for (name, data, text) in texts.chain(files) {
             w.attach(&mcap::Attachment {
                 log_time: 0,
                 create_time: 0,
                 name: name.clone(),
-                media_type: media.into(),
-                data: std::borrow::Cow::Borrowed(text.as_bytes()),
-            })
-            .map_err(|e| io(&e))?;
-        }
-        for (name, bytes) in &cell.files {
-            let lower = name.to_ascii_lowercase();
-            let media = if lower.ends_with(".urdf") || lower.ends_with(".xml") {
-                "application/xml"
-            } else if lower.ends_with(".stl") {
-                "model/stl"
-            } else if lower.ends_with(".obj") {
-                "model/obj"
-            } else {
-                "application/octet-stream"
-            };
-            w.attach(&mcap::Attachment {
-                log_time: 0,
-                create_time: 0,
-                name: name.clone(),
-                media_type: media.into(),
-                data: std::borrow::Cow::Borrowed(bytes),
+                media_type: media_type(name, text).into(),
+                data: std::borrow::Cow::Borrowed(data),
             })
             .map_err(|e| io(&e))?;
         }
