@@ -83,8 +83,8 @@ pub struct Collider {
     /// Per part: pose in the cell when not held.
     part_pose: Vec<Iso>,
     frames: Vec<Vec<Iso>>,
-    /// Per robot: its link poses must be recomputed (it moved since they were).
-    stale: Vec<bool>,
+    /// Per robot: the joints `frames` were computed for (NaN before the first check).
+    frames_q: Vec<[f64; vworks_vm::MAX_AXES]>,
     dirty: bool,
     /// Narrow-phase queries made so far.
     pub queries: u64,
@@ -220,7 +220,7 @@ impl Collider {
                 .iter()
                 .map(|r| r.model.frames_buffer())
                 .collect(),
-            stale: vec![true; cell.robots.len()],
+            frames_q: vec![[f64::NAN; vworks_vm::MAX_AXES]; cell.robots.len()],
             dirty: true,
             queries: 0,
             bodies,
@@ -254,14 +254,19 @@ impl Collider {
         self.dirty = true;
     }
 
-    /// The pose of every part given the robots' link frames in the cell (`frames[r]`).
-    pub fn part_poses(&self, cell: &Cell, frames: &[Vec<Iso>]) -> Vec<Iso> {
-        (0..cell.parts.len())
-            .map(|p| match self.held[p] {
-                Some((r, offset)) => frames[r][cell.robots[r].model.tool_link].mul(&offset),
-                None => self.part_pose[p],
-            })
-            .collect()
+    /// Every robot's link frames in the cell as of the last [`Collider::check`] (which
+    /// brings all of them up to date: robots it skipped have not moved).
+    pub fn frames(&self) -> &[Vec<Iso>] {
+        &self.frames
+    }
+
+    /// The pose of every part as of the last [`Collider::check`], into `out` (reused).
+    pub fn part_poses_into(&self, cell: &Cell, out: &mut Vec<Iso>) {
+        out.clear();
+        out.extend((0..cell.parts.len()).map(|p| match self.held[p] {
+            Some((r, offset)) => self.frames[r][cell.robots[r].model.tool_link].mul(&offset),
+            None => self.part_pose[p],
+        }));
     }
 
     fn current_part_pose(&self, p: usize, _cell: &Cell, _t: i64, _vm: Option<&Vm>) -> Iso {
@@ -276,22 +281,32 @@ impl Collider {
         t: i64,
         moving: &[bool],
     ) -> Vec<CollisionEvent> {
-        if !self.dirty && !moving.iter().any(|m| *m) {
+        // A robot needs new link frames when its joints differ from those its frames were
+        // computed for: moving now, or moved since the last check (even a motion that
+        // began and ended between two boundaries).
+        let mut update = [false; 64];
+        let mut any = false;
+        for (r, vm) in vms.iter().enumerate() {
+            let changed = moving[r] || vm.joints_at(t) != self.frames_q[r];
+            any |= changed;
+            if r < update.len() {
+                update[r] = changed;
+            }
+        }
+        if !self.dirty && !any {
             return Vec::new();
         }
         let all = std::mem::replace(&mut self.dirty, false);
-        // Link frames in the cell, for robots that moved since the last check.
-        let mut update = [false; 64];
         for (r, robot) in cell.robots.iter().enumerate() {
-            let u = all || moving[r] || self.stale[r];
-            self.stale[r] = moving[r];
+            let u = all || r >= update.len() || update[r];
             if r < update.len() {
                 update[r] = u;
             }
-            if !u && r < update.len() {
+            if !u {
                 continue;
             }
             let q = vms[r].joints_at(t);
+            self.frames_q[r] = q;
             robot
                 .model
                 .fk_into(&q[..robot.model.dof()], &mut self.frames[r]);

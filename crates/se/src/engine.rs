@@ -194,9 +194,9 @@ pub struct Simulation {
     /// The MCAP log, if one is written, and the first error writing it.
     log: Option<crate::mcaplog::McapLog>,
     log_error: Option<String>,
-    /// Reused per logged boundary: each robot's joints and link frames in `world`.
+    /// Reused per logged boundary: each robot's joints, and the parts' poses.
     log_joints: Vec<Vec<f64>>,
-    log_frames: Vec<Vec<Iso>>,
+    log_parts: Vec<Iso>,
     /// Set from outside to stop the run between two events.
     stop: Option<Arc<AtomicBool>>,
 }
@@ -290,7 +290,7 @@ impl Simulation {
             log: None,
             log_error: None,
             log_joints: Vec::new(),
-            log_frames: Vec::new(),
+            log_parts: Vec::new(),
             stop: None,
             cell,
         }
@@ -304,12 +304,6 @@ impl Simulation {
             .robots
             .iter()
             .map(|r| vec![0.0; r.model.dof()])
-            .collect();
-        self.log_frames = self
-            .cell
-            .robots
-            .iter()
-            .map(|r| r.model.frames_buffer())
             .collect();
         self
     }
@@ -404,26 +398,23 @@ impl Simulation {
         }
     }
 
-    /// Logs the state at boundary `b` (only when a log is written).
+    /// Logs the state at boundary `b` (only when a log is written); runs after the
+    /// collision check at `b`, whose link frames it reuses.
     fn log_cycle(&mut self, b: i64) {
         let Some(log) = self.log.as_mut() else { return };
         if !log.logs_next_boundary() {
             log.skip_boundary();
             return;
         }
-        for (r, robot) in self.cell.robots.iter().enumerate() {
+        for (r, joints) in self.log_joints.iter_mut().enumerate() {
             let q = self.vms[r].joints_at(b);
-            let n = robot.model.dof();
-            let (joints, frames) = (&mut self.log_joints[r], &mut self.log_frames[r]);
+            let n = joints.len();
             joints.copy_from_slice(&q[..n]);
-            robot.model.fk_into(&q[..n], frames);
-            for x in frames.iter_mut() {
-                *x = robot.base.mul(x);
-            }
         }
-        let (joints, frames) = (&self.log_joints, &self.log_frames);
-        let parts = self.collider.part_poses(&self.cell, frames);
-        if let Err(err) = log.cycle(&self.cell, b, joints, frames, &parts) {
+        self.collider
+            .part_poses_into(&self.cell, &mut self.log_parts);
+        let frames = self.collider.frames();
+        if let Err(err) = log.cycle(&self.cell, b, &self.log_joints, frames, &self.log_parts) {
             self.log_error.get_or_insert(err.to_string());
             self.log = None;
         }
@@ -521,8 +512,8 @@ impl Simulation {
             self.next_boundary += c;
             self.cycles += 1;
             let moving: Vec<bool> = self.vms.iter().map(|v| v.moving_at(b)).collect();
-            self.log_cycle(b);
             let events = self.collider.check(&self.cell, &self.vms, b, &moving);
+            self.log_cycle(b);
             for ev in events {
                 match ev {
                     crate::collide::CollisionEvent::Start(contact) => {

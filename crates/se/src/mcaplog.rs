@@ -90,6 +90,19 @@ struct SceneBody {
     hull: Vec<[f64; 3]>,
 }
 
+/// Whether frame `i` (in publishing order) goes into this `/tf` message: at a keyframe,
+/// or when it moved since it was last published; records it as published if so.
+fn publish_frame(last: &mut Vec<Iso>, i: usize, pose: &Iso, keyframe: bool) -> bool {
+    if !keyframe && last.get(i) == Some(pose) {
+        return false;
+    }
+    match last.get_mut(i) {
+        Some(l) => *l = *pose,
+        None => last.push(*pose),
+    }
+    true
+}
+
 /// The media type of an attached file, from its extension (`text`: a program or the
 /// workcell, plain text whatever its name).
 fn media_type(name: &str, text: bool) -> &'static str {
@@ -572,12 +585,8 @@ impl McapLog {
             .chain(devices.iter().map(|d| &d.pose))
             .chain(parts);
         for (i, pose) in poses.enumerate() {
-            if !keyframe && self.last_frames.get(i) == Some(pose) {
+            if !publish_frame(&mut self.last_frames, i, pose, keyframe) {
                 continue;
-            }
-            match self.last_frames.get_mut(i) {
-                Some(l) => *l = *pose,
-                None => self.last_frames.push(*pose),
             }
             let Some(msg) = self.tf_frames.get_mut(i) else {
                 continue;
@@ -778,12 +787,8 @@ impl McapLog {
         let mut transform = |b: &mut Vec<u8>, name: &str, pose: &Iso| {
             let i = slot;
             slot += 1;
-            if !keyframe && last.get(i) == Some(pose) {
+            if !publish_frame(last, i, pose, keyframe) {
                 return;
-            }
-            match last.get_mut(i) {
-                Some(l) => *l = *pose,
-                None => last.push(*pose),
             }
             if !first {
                 b.push(b',');

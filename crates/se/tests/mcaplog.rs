@@ -337,3 +337,50 @@ fn protobuf_and_json_frame_transforms_carry_the_same_poses() {
         + cell.parts.len();
     assert_eq!(logs[0].iter().filter(|t| t.0 == 0).count(), frames);
 }
+
+#[test]
+fn frame_transforms_are_the_forward_kinematics_of_the_logged_joints() {
+    // Every /tf pose of a link equals base × FK(the joints /state logged at that time).
+    for name in ["track", "handoff"] {
+        let cell = Arc::new(load(&root().join(format!("workcells/{name}/cell.toml"))).unwrap());
+        let (r, bytes) = run_logged(&cell, 1, Some(20_000_000_000), &format!("fk-{name}"));
+        assert!(r.log_error.is_none());
+        let mut joints_at: BTreeMap<u64, Vec<Vec<f64>>> = BTreeMap::new();
+        for m in mcap::MessageStream::new(&bytes).unwrap() {
+            let m = m.unwrap();
+            if m.channel.topic == "/state" {
+                let v: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
+                let q = v["robots"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|r| {
+                        r["joints"]
+                            .as_array()
+                            .unwrap()
+                            .iter()
+                            .map(|x| x.as_f64().unwrap())
+                            .collect()
+                    })
+                    .collect();
+                joints_at.insert(m.log_time, q);
+            }
+        }
+        let mut checked = 0;
+        for (t, frame, p, _) in transforms(&bytes) {
+            let Some((robot, link)) = frame.split_once('.') else {
+                continue; // a device or a part
+            };
+            let r = cell.robots.iter().position(|x| x.name == robot).unwrap();
+            let model = &cell.robots[r].model;
+            let l = model.links.iter().position(|x| x.name == link).unwrap();
+            let q = &joints_at[&t][r];
+            let want = cell.robots[r].base.mul(&model.fk(q)[l]);
+            for (w, got) in want.t.iter().zip(p) {
+                assert!((w - got).abs() < 1e-9, "{name} {frame} at {t}");
+            }
+            checked += 1;
+        }
+        assert!(checked > 1000, "{checked}");
+    }
+}
