@@ -102,3 +102,56 @@ def test_attachments_and_metadata_replay_the_run():
     assert meta.metadata["cell"] == "handoff"
     assert int(meta.metadata["cycle_ns"]) > 0
     assert meta.metadata["robots"] == "r1,r2"
+
+
+def message_classes(reader):
+    """Message classes built from each protobuf channel's own schema (FileDescriptorSet)."""
+    from google.protobuf import descriptor_pool, message_factory
+
+    classes = {}
+    summary = reader.get_summary()
+    for channel in summary.channels.values():
+        schema = summary.schemas[channel.schema_id]
+        if schema.encoding != "protobuf":
+            continue
+        pool = descriptor_pool.DescriptorPool()
+        for proto in descriptor_pb2.FileDescriptorSet.FromString(schema.data).file:
+            pool.Add(proto)
+        classes[channel.topic] = message_factory.GetMessageClass(pool.FindMessageTypeByName(schema.name))
+    return classes
+
+
+def test_state_and_tf_decode_with_their_own_schemas():
+    import io
+    import math
+
+    result, data = run_logged("handoff", "--until", "3s")
+    reader = make_reader(io.BytesIO(data), validate_crcs=True)
+    classes = message_classes(reader)
+    assert sorted(classes) == ["/state", "/tf"]
+    states = 0
+    parents = {}
+    for _, channel, message in reader.iter_messages(topics=["/state", "/tf"]):
+        decoded = classes[channel.topic].FromString(message.data)
+        if channel.topic == "/state":
+            states += 1
+            assert decoded.time_ns == message.log_time
+            assert decoded.cycle == states - 1
+            assert [r.name for r in decoded.robots] == ["r1", "r2"]
+            for robot in decoded.robots:
+                assert len(robot.joints) == 6
+                o = robot.tcp.orientation
+                assert math.isclose(o.x**2 + o.y**2 + o.z**2 + o.w**2, 1.0, rel_tol=1e-12)
+        else:
+            for t in decoded.transforms:
+                assert t.timestamp.seconds * 10**9 + t.timestamp.nanos == message.log_time
+                assert parents.setdefault(t.child_frame_id, t.parent_frame_id) == t.parent_frame_id
+    assert states == result["log"]["messages"]["/state"]
+    # A tree: every frame reaches `world` through its parents.
+    for frame in parents:
+        seen = set()
+        while frame != "world":
+            assert frame not in seen
+            seen.add(frame)
+            frame = parents[frame]
+    assert parents["r1.base_link"] == "world" and parents["r1.link_1"] == "r1.base_link"

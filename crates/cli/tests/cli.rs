@@ -217,17 +217,29 @@ fn run_until_and_trace() {
 fn ctrl_c_finishes_the_log() {
     let d = temp_dir("sigint");
     let log = d.join("run.mcap");
+    // A cell that would run for hours of simulated time (minutes of wall time), so the
+    // signal surely arrives while it runs.
+    std::fs::write(
+        d.join("cell.toml"),
+        "[[robot]]\nname = \"r1\"\nmodel = \"irb120\"\nprogram = \"r1.wsl\"\n",
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    std::fs::write(
+        d.join("r1.wsl"),
+        "proc main() {\n    var n = 0;\n    while n < 100000 {\n        move_j joints(0deg, 0deg, 0deg, 0deg, 30deg, 0deg);\n        move_j joints(90deg, 0deg, 0deg, 0deg, 30deg, 0deg);\n        n = n + 1;\n    }\n}\n",
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let cell = d.join("cell.toml");
     let child = Command::new(env!("CARGO_BIN_EXE_vworks"))
         .args([
             "run",
-            &workcell("handoff"),
+            cell.to_str().unwrap_or_default(),
             "--log",
             log.to_str().unwrap_or_default(),
         ])
         .stdout(std::process::Stdio::piped())
         .spawn()
         .unwrap_or_else(|e| panic!("{e}"));
-    // Long enough to be running (a logged handoff takes seconds in a test build).
     std::thread::sleep(std::time::Duration::from_millis(400));
     let status = Command::new("kill")
         .args(["-INT", &child.id().to_string()])

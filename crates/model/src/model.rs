@@ -249,6 +249,50 @@ impl RobotModel {
         }
     }
 
+    /// [`RobotModel::fk_into`], and also each joint's own transform: `locals[j]` = the pose
+    /// of joint j's child link in its parent link (origin × the joint's motion), what a
+    /// transform tree publishes. `locals` must have `joints.len()` entries. The link frames
+    /// are bit-identical to `fk_into`'s.
+    pub fn fk_locals_into(&self, q: &[f64], frames: &mut [Iso], locals: &mut [Iso]) {
+        frames[0] = Iso::IDENTITY;
+        for (j, local) in self.joints.iter().zip(locals.iter_mut()) {
+            let parent = frames[j.parent];
+            let at = parent.mul(&j.origin);
+            let v = j.axis_index.and_then(|i| q.get(i).copied()).unwrap_or(0.0);
+            let (world, own) = match j.kind {
+                JointKind::Fixed => (at, j.origin),
+                JointKind::Revolute | JointKind::Continuous => {
+                    let m = j.dir.rotation(v);
+                    (
+                        Iso {
+                            r: mat_mul(&at.r, &m),
+                            t: at.t,
+                        },
+                        Iso {
+                            r: mat_mul(&j.origin.r, &m),
+                            t: j.origin.t,
+                        },
+                    )
+                }
+                JointKind::Prismatic => {
+                    let d = j.dir.vector();
+                    (
+                        Iso {
+                            r: at.r,
+                            t: at.apply_delta(d, v),
+                        },
+                        Iso {
+                            r: j.origin.r,
+                            t: j.origin.apply_delta(d, v),
+                        },
+                    )
+                }
+            };
+            frames[j.child] = world;
+            *local = own;
+        }
+    }
+
     /// A buffer for [`RobotModel::fk_into`].
     pub fn frames_buffer(&self) -> Vec<Iso> {
         vec![Iso::IDENTITY; self.links.len()]

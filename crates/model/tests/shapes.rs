@@ -75,3 +75,36 @@ fn cylinders_stand_on_z_like_urdf() {
         "height {h}, diameter {r}"
     );
 }
+
+#[test]
+fn joint_transforms_compose_to_the_link_frames() {
+    // fk_locals_into: the same link frames as fk_into, bit for bit, and every link frame
+    // is its parent's frame × its joint's own transform (what the log's /tf tree sends).
+    for name in builtin::names() {
+        let m = builtin::load(name).unwrap();
+        for k in 0..50 {
+            let q: Vec<f64> = (0..m.dof())
+                .map(|i| {
+                    let j = &m.joints[m.axes[i]];
+                    let (lo, hi) = (j.lower.max(-3.0), j.upper.min(3.0));
+                    lo + (hi - lo) * (((k * 7 + i * 13) % 17) as f64 / 16.0)
+                })
+                .collect();
+            let frames = m.fk(&q);
+            let mut again = m.frames_buffer();
+            let mut locals = vec![vworks_model::math::Iso::IDENTITY; m.joints.len()];
+            m.fk_locals_into(&q, &mut again, &mut locals);
+            assert_eq!(frames, again, "{name}");
+            for (j, local) in m.joints.iter().zip(&locals) {
+                let composed = frames[j.parent].mul(local);
+                let want = frames[j.child];
+                for (a, b) in composed.t.iter().zip(&want.t) {
+                    assert!((a - b).abs() < 1e-12, "{name} {}", j.name);
+                }
+                for (a, b) in composed.r.iter().flatten().zip(want.r.iter().flatten()) {
+                    assert!((a - b).abs() < 1e-12, "{name} {}", j.name);
+                }
+            }
+        }
+    }
+}

@@ -1,6 +1,6 @@
 //! What the MCAP log costs: the largest bundled example (handoff: 63 simulated seconds,
 //! 15,855 cycle boundaries) run without a log and with the full log (every boundary), with
-//! `/tf` as protobuf (the default) and as JSON. Prints the overhead and the log's size per
+//! `/state` and `/tf` as protobuf (the default) and as JSON. Prints the overhead and the log's size per
 //! simulated minute once, then lets criterion time each.
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // benches fail by panicking
@@ -11,11 +11,11 @@ use std::time::Instant;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use vworks_se::engine::{RunResult, Simulation};
-use vworks_se::mcaplog::{LogOptions, McapLog, TfEncoding};
+use vworks_se::mcaplog::{Encoding, LogOptions, McapLog};
 use vworks_se::workcell::{Cell, load};
 
-fn logged(cell: &Arc<Cell>, path: &Path, tf: TfEncoding) -> RunResult {
-    let log = McapLog::create_with(path, cell, LogOptions::new(1, tf)).unwrap();
+fn logged(cell: &Arc<Cell>, path: &Path, encoding: Encoding) -> RunResult {
+    let log = McapLog::create_with(path, cell, LogOptions::new(1, encoding)).unwrap();
     Simulation::new(Arc::clone(cell)).with_log(log).run(None)
 }
 
@@ -41,16 +41,13 @@ fn log_overhead(c: &mut Criterion) {
         std::hint::black_box(Simulation::new(Arc::clone(&cell)).run(None));
     });
     println!("handoff: {:.1} ms without log", plain * 1e3);
-    let encodings = [
-        (TfEncoding::Protobuf, "protobuf"),
-        (TfEncoding::Json, "json"),
-    ];
+    let encodings = [(Encoding::Protobuf, "protobuf"), (Encoding::Json, "json")];
     for (tf, name) in encodings {
         let mut end = 0;
         let wall = mean_secs(runs, || end = logged(&cell, &path, tf).end_time_ns);
         let mb = std::fs::metadata(&path).unwrap().len() as f64 / 1e6;
         println!(
-            "handoff, full log, /tf {name}: {:.1} ms (+{:.0} %, {:.0}x real time); {mb:.2} MB = {:.2} MB per simulated minute",
+            "handoff, full log, {name}: {:.1} ms (+{:.0} %, {:.0}x real time); {mb:.2} MB = {:.2} MB per simulated minute",
             wall * 1e3,
             (wall / plain - 1.0) * 100.0,
             end as f64 / 1e9 / wall,
@@ -63,7 +60,7 @@ fn log_overhead(c: &mut Criterion) {
         b.iter(|| Simulation::new(Arc::clone(&cell)).run(None))
     });
     for (tf, name) in encodings {
-        g.bench_function(format!("handoff_full_log_tf_{name}"), |b| {
+        g.bench_function(format!("handoff_full_log_{name}"), |b| {
             b.iter(|| logged(&cell, &path, tf))
         });
     }

@@ -85,6 +85,9 @@ pub struct Collider {
     frames: Vec<Vec<Iso>>,
     /// Per robot: the joints `frames` were computed for (NaN before the first check).
     frames_q: Vec<[f64; vworks_vm::MAX_AXES]>,
+    /// Per robot and joint: the joint's own transform (parent link → child link), kept
+    /// only after [`Collider::keep_joint_transforms`] (for the log's transform tree).
+    locals: Vec<Vec<Iso>>,
     dirty: bool,
     /// Narrow-phase queries made so far.
     pub queries: u64,
@@ -221,24 +224,23 @@ impl Collider {
                 .map(|r| r.model.frames_buffer())
                 .collect(),
             frames_q: vec![[f64::NAN; vworks_vm::MAX_AXES]; cell.robots.len()],
+            locals: Vec::new(),
             dirty: true,
             queries: 0,
             bodies,
         }
     }
 
-    fn tool_world(&mut self, cell: &Cell, vm: &Vm, r: usize, t: i64) -> Iso {
+    /// Robot `r`'s tool link in the cell at time `t` (the frames of the last check stay).
+    fn tool_world(cell: &Cell, vm: &Vm, r: usize, t: i64) -> Iso {
         let robot = &cell.robots[r];
         let q = vm.joints_at(t);
-        robot
-            .model
-            .fk_into(&q[..robot.model.dof()], &mut self.frames[r]);
-        robot.base.mul(&self.frames[r][robot.model.tool_link])
+        robot.base.mul(&robot.model.flange(&q[..robot.model.dof()]))
     }
 
     /// Robot `r` grips part `p` at time `t`: from now on the part moves with its tool link.
     pub fn grip(&mut self, p: usize, r: usize, vm: &Vm, cell: &Cell, t: i64) {
-        let tool = self.tool_world(cell, vm, r, t);
+        let tool = Collider::tool_world(cell, vm, r, t);
         let pose = self.current_part_pose(p, cell, t, None);
         self.held[p] = Some((r, tool.inverse().mul(&pose)));
         self.dirty = true;
@@ -247,7 +249,7 @@ impl Collider {
     /// Part `p` is released at time `t` and stays where it is.
     pub fn release(&mut self, p: usize, vms: &[Vm], cell: &Cell, t: i64) {
         if let Some((r, offset)) = self.held[p] {
-            let tool = self.tool_world(cell, &vms[r], r, t);
+            let tool = Collider::tool_world(cell, &vms[r], r, t);
             self.part_pose[p] = tool.mul(&offset);
         }
         self.held[p] = None;
@@ -258,6 +260,28 @@ impl Collider {
     /// brings all of them up to date: robots it skipped have not moved).
     pub fn frames(&self) -> &[Vec<Iso>] {
         &self.frames
+    }
+
+    /// From now on, also keep every joint's own transform (see [`Collider::joint_transforms`]).
+    pub fn keep_joint_transforms(&mut self, cell: &Cell) {
+        self.locals = cell
+            .robots
+            .iter()
+            .map(|r| vec![Iso::IDENTITY; r.model.joints.len()])
+            .collect();
+        self.dirty = true;
+    }
+
+    /// Per robot and joint, the pose of the joint's child link in its parent link as of
+    /// the last [`Collider::check`]; empty unless [`Collider::keep_joint_transforms`] ran.
+    pub fn joint_transforms(&self) -> &[Vec<Iso>] {
+        &self.locals
+    }
+
+    /// Every robot's joints as of the last [`Collider::check`] (the joints its frames are
+    /// the forward kinematics of; `MAX_AXES` slots, the robot's axes first).
+    pub fn joints(&self) -> &[[f64; vworks_vm::MAX_AXES]] {
+        &self.frames_q
     }
 
     /// The pose of every part as of the last [`Collider::check`], into `out` (reused).
@@ -287,7 +311,11 @@ impl Collider {
         let mut update = [false; 64];
         let mut any = false;
         for (r, vm) in vms.iter().enumerate() {
-            let changed = moving[r] || vm.joints_at(t) != self.frames_q[r];
+            let q = vm.joints_at(t); // once per robot and boundary: may be an IK solve
+            let changed = moving[r] || q != self.frames_q[r];
+            if changed {
+                self.frames_q[r] = q;
+            }
             any |= changed;
             if r < update.len() {
                 update[r] = changed;
@@ -305,11 +333,11 @@ impl Collider {
             if !u {
                 continue;
             }
-            let q = vms[r].joints_at(t);
-            self.frames_q[r] = q;
-            robot
-                .model
-                .fk_into(&q[..robot.model.dof()], &mut self.frames[r]);
+            let q = &self.frames_q[r][..robot.model.dof()];
+            match self.locals.get_mut(r) {
+                Some(locals) => robot.model.fk_locals_into(q, &mut self.frames[r], locals),
+                None => robot.model.fk_into(q, &mut self.frames[r]),
+            }
             for f in self.frames[r].iter_mut() {
                 *f = robot.base.mul(f);
             }

@@ -195,7 +195,8 @@ pub struct Simulation {
     log: Option<crate::mcaplog::McapLog>,
     log_error: Option<String>,
     /// Reused per logged boundary: each robot's joints, and the parts' poses.
-    log_joints: Vec<Vec<f64>>,
+    /// Whether each robot moves at the boundary being processed (reused).
+    moving: Vec<bool>,
     log_parts: Vec<Iso>,
     /// Set from outside to stop the run between two events.
     stop: Option<Arc<AtomicBool>>,
@@ -289,7 +290,7 @@ impl Simulation {
             cycles: 0,
             log: None,
             log_error: None,
-            log_joints: Vec::new(),
+            moving: Vec::with_capacity(cell.robots.len()),
             log_parts: Vec::new(),
             stop: None,
             cell,
@@ -299,12 +300,7 @@ impl Simulation {
     /// Writes the run to an MCAP log (see [`crate::mcaplog`]).
     pub fn with_log(mut self, log: crate::mcaplog::McapLog) -> Simulation {
         self.log = Some(log);
-        self.log_joints = self
-            .cell
-            .robots
-            .iter()
-            .map(|r| vec![0.0; r.model.dof()])
-            .collect();
+        self.collider.keep_joint_transforms(&self.cell);
         self
     }
 
@@ -406,15 +402,11 @@ impl Simulation {
             log.skip_boundary();
             return;
         }
-        for (r, joints) in self.log_joints.iter_mut().enumerate() {
-            let q = self.vms[r].joints_at(b);
-            let n = joints.len();
-            joints.copy_from_slice(&q[..n]);
-        }
         self.collider
             .part_poses_into(&self.cell, &mut self.log_parts);
-        let frames = self.collider.frames();
-        if let Err(err) = log.cycle(&self.cell, b, &self.log_joints, frames, &self.log_parts) {
+        let c = &self.collider;
+        let (joints, frames, locals) = (c.joints(), c.frames(), c.joint_transforms());
+        if let Err(err) = log.cycle(&self.cell, b, joints, frames, locals, &self.log_parts) {
             self.log_error.get_or_insert(err.to_string());
             self.log = None;
         }
@@ -511,8 +503,9 @@ impl Simulation {
             let b = self.next_boundary;
             self.next_boundary += c;
             self.cycles += 1;
-            let moving: Vec<bool> = self.vms.iter().map(|v| v.moving_at(b)).collect();
-            let events = self.collider.check(&self.cell, &self.vms, b, &moving);
+            self.moving.clear();
+            self.moving.extend(self.vms.iter().map(|v| v.moving_at(b)));
+            let events = self.collider.check(&self.cell, &self.vms, b, &self.moving);
             self.log_cycle(b);
             for ev in events {
                 match ev {
@@ -550,7 +543,7 @@ impl Simulation {
             }
             // With nothing queued before the next boundary and nothing moving, skip ahead.
             // (Not when a log records every boundary.)
-            if self.log.is_none() && !moving.iter().any(|m| *m) {
+            if self.log.is_none() && !self.moving.iter().any(|m| *m) {
                 let next_event = self
                     .queue
                     .peek()

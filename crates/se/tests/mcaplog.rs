@@ -9,9 +9,32 @@ use std::sync::Arc;
 
 use foxglove::messages::FrameTransforms;
 use prost::Message as _;
+use vworks_model::math::Iso;
 use vworks_se::engine::{Outcome, RunResult, Simulation};
-use vworks_se::mcaplog::{LogOptions, McapLog, TfEncoding};
+use vworks_se::mcaplog::{Encoding, LogOptions, McapLog};
 use vworks_se::workcell::{Cell, load};
+
+/// `vworks.CycleState` as the log's descriptor defines it (the descriptor itself is checked
+/// in the unit tests and, independently, by the Python tests).
+#[derive(Clone, PartialEq, prost::Message)]
+struct CycleState {
+    #[prost(uint64, tag = "1")]
+    time_ns: u64,
+    #[prost(uint64, tag = "2")]
+    cycle: u64,
+    #[prost(message, repeated, tag = "3")]
+    robots: Vec<RobotState>,
+}
+
+#[derive(Clone, PartialEq, prost::Message)]
+struct RobotState {
+    #[prost(string, tag = "1")]
+    name: String,
+    #[prost(double, repeated, tag = "2")]
+    joints: Vec<f64>,
+    #[prost(message, optional, tag = "3")]
+    tcp: Option<foxglove::messages::Pose>,
+}
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -66,9 +89,16 @@ fn read_back(bytes: &[u8]) -> (BTreeMap<String, u64>, Vec<String>) {
                 "{} is not in its descriptor set",
                 schema.name
             );
-            assert_eq!(m.channel.topic, "/tf");
-            let tf = FrameTransforms::decode(&m.data[..]).unwrap();
-            assert!(!tf.transforms.is_empty());
+            match m.channel.topic.as_str() {
+                "/tf" => assert!(
+                    !FrameTransforms::decode(&m.data[..])
+                        .unwrap()
+                        .transforms
+                        .is_empty()
+                ),
+                "/state" => assert!(!CycleState::decode(&m.data[..]).unwrap().robots.is_empty()),
+                other => panic!("{other} is not a protobuf topic"),
+            }
             continue;
         }
         assert_eq!(schema.encoding, "jsonschema");
@@ -264,9 +294,9 @@ fn urdfs_and_meshes_are_attached_and_meshes_drawn_as_triangles() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// Every `/tf` transform of a log, as (time, frame, translation, rotation), whichever
-/// encoding it was written in.
-type Transform = (u64, String, [f64; 3], [f64; 4]);
+/// Every `/tf` transform of a log, as (time, parent, child, translation, rotation),
+/// whichever encoding it was written in.
+type Transform = (u64, String, String, [f64; 3], [f64; 4]);
 
 fn transforms(bytes: &[u8]) -> Vec<Transform> {
     let mut out = Vec::new();
@@ -278,8 +308,12 @@ fn transforms(bytes: &[u8]) -> Vec<Transform> {
         if m.channel.message_encoding == "protobuf" {
             for t in FrameTransforms::decode(&m.data[..]).unwrap().transforms {
                 let (p, q) = (t.translation.unwrap(), t.rotation.unwrap());
+                let stamp = t.timestamp.unwrap();
+                let time = u64::from(stamp.sec()) * 1_000_000_000 + u64::from(stamp.nsec());
+                assert_eq!(time, m.log_time);
                 out.push((
                     m.log_time,
+                    t.parent_frame_id,
                     t.child_frame_id,
                     [p.x, p.y, p.z],
                     [q.x, q.y, q.z, q.w],
@@ -292,6 +326,7 @@ fn transforms(bytes: &[u8]) -> Vec<Transform> {
                 let (p, q) = (&t["translation"], &t["rotation"]);
                 out.push((
                     m.log_time,
+                    t["parent_frame_id"].as_str().unwrap().to_string(),
                     t["child_frame_id"].as_str().unwrap().to_string(),
                     [f(&p["x"]), f(&p["y"]), f(&p["z"])],
                     [f(&q["x"]), f(&q["y"]), f(&q["z"]), f(&q["w"])],
@@ -302,11 +337,84 @@ fn transforms(bytes: &[u8]) -> Vec<Transform> {
     out
 }
 
+/// Every `/state` of a log: time → per robot (name, joints, TCP position, TCP rotation).
+type States = BTreeMap<u64, Vec<(String, Vec<f64>, [f64; 3], [f64; 4])>>;
+
+fn states(bytes: &[u8]) -> States {
+    let mut out = BTreeMap::new();
+    for m in mcap::MessageStream::new(bytes).unwrap() {
+        let m = m.unwrap();
+        if m.channel.topic != "/state" {
+            continue;
+        }
+        let robots = if m.channel.message_encoding == "protobuf" {
+            let s = CycleState::decode(&m.data[..]).unwrap();
+            assert_eq!(s.time_ns, m.log_time);
+            s.robots
+                .into_iter()
+                .map(|r| {
+                    let tcp = r.tcp.unwrap_or_default();
+                    let (p, q) = (
+                        tcp.position.unwrap_or_default(),
+                        tcp.orientation.unwrap_or_default(),
+                    );
+                    (r.name, r.joints, [p.x, p.y, p.z], [q.x, q.y, q.z, q.w])
+                })
+                .collect()
+        } else {
+            let v: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
+            assert_eq!(v["time_ns"].as_u64(), Some(m.log_time));
+            let f = |x: &serde_json::Value| x.as_f64().unwrap();
+            v["robots"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|r| {
+                    let (p, q) = (&r["tcp"]["position"], &r["tcp"]["orientation"]);
+                    (
+                        r["name"].as_str().unwrap().to_string(),
+                        r["joints"].as_array().unwrap().iter().map(f).collect(),
+                        [f(&p["x"]), f(&p["y"]), f(&p["z"])],
+                        [f(&q["x"]), f(&q["y"]), f(&q["z"]), f(&q["w"])],
+                    )
+                })
+                .collect()
+        };
+        out.insert(m.log_time, robots);
+    }
+    out
+}
+
+/// The rigid transform of a translation and a unit quaternion (x, y, z, w).
+fn iso(t: [f64; 3], q: [f64; 4]) -> Iso {
+    let [x, y, z, w] = q;
+    Iso {
+        r: [
+            [
+                1.0 - 2.0 * (y * y + z * z),
+                2.0 * (x * y - z * w),
+                2.0 * (x * z + y * w),
+            ],
+            [
+                2.0 * (x * y + z * w),
+                1.0 - 2.0 * (x * x + z * z),
+                2.0 * (y * z - x * w),
+            ],
+            [
+                2.0 * (x * z - y * w),
+                2.0 * (y * z + x * w),
+                1.0 - 2.0 * (x * x + y * y),
+            ],
+        ],
+        t,
+    }
+}
+
 #[test]
-fn protobuf_and_json_frame_transforms_carry_the_same_poses() {
+fn protobuf_and_json_logs_carry_the_same_states_and_poses() {
     let cell = Arc::new(load(&root().join("workcells/track/cell.toml")).unwrap());
     let mut logs = Vec::new();
-    for (encoding, name) in [(TfEncoding::Protobuf, "pb"), (TfEncoding::Json, "json")] {
+    for (encoding, name) in [(Encoding::Protobuf, "pb"), (Encoding::Json, "json")] {
         let path =
             std::env::temp_dir().join(format!("vworks-log-{name}-{}.mcap", std::process::id()));
         let log = McapLog::create_with(&path, &cell, LogOptions::new(1, encoding)).unwrap();
@@ -314,20 +422,36 @@ fn protobuf_and_json_frame_transforms_carry_the_same_poses() {
         let bytes = std::fs::read(&path).unwrap();
         let _ = std::fs::remove_file(&path);
         check(&cell, &r, &bytes);
-        logs.push(transforms(&bytes));
+        logs.push((transforms(&bytes), states(&bytes)));
     }
-    // The writer prints shortest round-trip decimals; serde_json's default parser may land
-    // one ulp away, so values agree to 1e-15 and times and frames exactly.
-    assert!(logs[0].len() > 1000, "{}", logs[0].len());
-    assert_eq!(logs[0].len(), logs[1].len());
-    for (pb, json) in logs[0].iter().zip(&logs[1]) {
-        assert_eq!((pb.0, &pb.1), (json.0, &json.1));
-        let close = pb.2.iter().chain(&pb.3).zip(json.2.iter().chain(&json.3));
-        for (a, b) in close {
-            assert!((a - b).abs() <= 1e-15, "{pb:?} vs {json:?}");
+    // The JSON writer prints shortest round-trip decimals; serde_json's default parser may
+    // land one ulp away, so values agree to 1e-15 and times and names exactly.
+    let close = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| (x - y).abs() <= 1e-15);
+    let ((tf_pb, state_pb), (tf_json, state_json)) = (&logs[0], &logs[1]);
+    assert!(tf_pb.len() > 1000, "{}", tf_pb.len());
+    assert_eq!(tf_pb.len(), tf_json.len());
+    for (pb, json) in tf_pb.iter().zip(tf_json) {
+        assert_eq!((pb.0, &pb.1, &pb.2), (json.0, &json.1, &json.2));
+        assert!(
+            close(&pb.3, &json.3) && close(&pb.4, &json.4),
+            "{pb:?} vs {json:?}"
+        );
+    }
+    assert!(state_pb.len() > 1000, "{}", state_pb.len());
+    assert_eq!(
+        state_pb.keys().collect::<Vec<_>>(),
+        state_json.keys().collect::<Vec<_>>()
+    );
+    for (pb, json) in state_pb.values().zip(state_json.values()) {
+        for (a, b) in pb.iter().zip(json) {
+            assert_eq!((&a.0, a.1.len()), (&b.0, b.1.len()));
+            assert!(
+                close(&a.1, &b.1) && close(&a.2, &b.2) && close(&a.3, &b.3),
+                "{a:?} vs {b:?}"
+            );
         }
     }
-    // Between keyframes only moved frames are sent; at t = 0 every frame is.
+    // Between keyframes only changed frames are sent; at t = 0 every frame is, each once.
     let frames = cell
         .robots
         .iter()
@@ -335,51 +459,71 @@ fn protobuf_and_json_frame_transforms_carry_the_same_poses() {
         .sum::<usize>()
         + cell.devices.len()
         + cell.parts.len();
-    assert_eq!(logs[0].iter().filter(|t| t.0 == 0).count(), frames);
+    assert_eq!(tf_pb.iter().filter(|t| t.0 == 0).count(), frames);
 }
 
 #[test]
 fn frame_transforms_are_the_forward_kinematics_of_the_logged_joints() {
-    // Every /tf pose of a link equals base × FK(the joints /state logged at that time).
+    // /tf is a tree (world → each robot's root link → its links by joint; devices and parts
+    // under world). Replaying it, every link's pose in the world (its chain of latest
+    // transforms) equals base × FK(the joints /state logged at that time), and /state's
+    // TCP equals base × FK × tool.
     for name in ["track", "handoff"] {
         let cell = Arc::new(load(&root().join(format!("workcells/{name}/cell.toml"))).unwrap());
         let (r, bytes) = run_logged(&cell, 1, Some(20_000_000_000), &format!("fk-{name}"));
         assert!(r.log_error.is_none());
-        let mut joints_at: BTreeMap<u64, Vec<Vec<f64>>> = BTreeMap::new();
-        for m in mcap::MessageStream::new(&bytes).unwrap() {
-            let m = m.unwrap();
-            if m.channel.topic == "/state" {
-                let v: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
-                let q = v["robots"]
-                    .as_array()
-                    .unwrap()
-                    .iter()
-                    .map(|r| {
-                        r["joints"]
-                            .as_array()
-                            .unwrap()
-                            .iter()
-                            .map(|x| x.as_f64().unwrap())
-                            .collect()
-                    })
-                    .collect();
-                joints_at.insert(m.log_time, q);
+        let states = states(&bytes);
+        let mut latest: BTreeMap<String, (String, Iso)> = BTreeMap::new();
+        let world = |latest: &BTreeMap<String, (String, Iso)>, frame: &str| {
+            let mut pose = Iso::IDENTITY;
+            let mut at = frame.to_string();
+            while at != "world" {
+                let (parent, local) = &latest[&at];
+                pose = local.mul(&pose);
+                at = parent.clone();
             }
-        }
+            pose
+        };
+        let all = transforms(&bytes);
         let mut checked = 0;
-        for (t, frame, p, _) in transforms(&bytes) {
-            let Some((robot, link)) = frame.split_once('.') else {
-                continue; // a device or a part
-            };
-            let r = cell.robots.iter().position(|x| x.name == robot).unwrap();
-            let model = &cell.robots[r].model;
-            let l = model.links.iter().position(|x| x.name == link).unwrap();
-            let q = &joints_at[&t][r];
-            let want = cell.robots[r].base.mul(&model.fk(q)[l]);
-            for (w, got) in want.t.iter().zip(p) {
-                assert!((w - got).abs() < 1e-9, "{name} {frame} at {t}");
+        for (i, (t, parent, child, p, q)) in all.iter().enumerate() {
+            latest.insert(child.clone(), (parent.clone(), iso(*p, *q)));
+            // Check once the whole message at `t` has been applied.
+            if all.get(i + 1).is_some_and(|next| next.0 == *t) {
+                continue;
             }
-            checked += 1;
+            for (r, robot) in cell.robots.iter().enumerate() {
+                let (_, q, tcp_p, tcp_q) = &states[t][r];
+                let fk = robot.model.fk(q);
+                for (l, link) in robot.model.links.iter().enumerate() {
+                    let got = world(&latest, &format!("{}.{}", robot.name, link.name));
+                    let want = robot.base.mul(&fk[l]);
+                    for (w, g) in want
+                        .t
+                        .iter()
+                        .chain(want.r.iter().flatten())
+                        .zip(got.t.iter().chain(got.r.iter().flatten()))
+                    {
+                        assert!(
+                            (w - g).abs() < 1e-9,
+                            "{name} {}.{} at {t}",
+                            robot.name,
+                            link.name
+                        );
+                    }
+                    checked += 1;
+                }
+                let tcp = robot.base.mul(&fk[robot.model.tool_link]).mul(&robot.tool);
+                let logged = iso(*tcp_p, *tcp_q);
+                for (w, g) in tcp
+                    .t
+                    .iter()
+                    .chain(tcp.r.iter().flatten())
+                    .zip(logged.t.iter().chain(logged.r.iter().flatten()))
+                {
+                    assert!((w - g).abs() < 1e-9, "{name} {} TCP at {t}", robot.name);
+                }
+            }
         }
         assert!(checked > 1000, "{checked}");
     }
