@@ -249,47 +249,27 @@ impl RobotModel {
         }
     }
 
-    /// [`RobotModel::fk_into`], and also each joint's own transform: `locals[j]` = the pose
-    /// of joint j's child link in its parent link (origin × the joint's motion), what a
-    /// transform tree publishes. `locals` must have `joints.len()` entries. The link frames
-    /// are bit-identical to `fk_into`'s.
-    pub fn fk_locals_into(&self, q: &[f64], frames: &mut [Iso], locals: &mut [Iso]) {
-        frames[0] = Iso::IDENTITY;
-        for (j, local) in self.joints.iter().zip(locals.iter_mut()) {
-            let parent = frames[j.parent];
-            let at = parent.mul(&j.origin);
-            let v = j.axis_index.and_then(|i| q.get(i).copied()).unwrap_or(0.0);
-            let (world, own) = match j.kind {
-                JointKind::Fixed => (at, j.origin),
-                JointKind::Revolute | JointKind::Continuous => {
-                    let m = j.dir.rotation(v);
-                    (
-                        Iso {
-                            r: mat_mul(&at.r, &m),
-                            t: at.t,
-                        },
-                        Iso {
-                            r: mat_mul(&j.origin.r, &m),
-                            t: j.origin.t,
-                        },
-                    )
-                }
-                JointKind::Prismatic => {
-                    let d = j.dir.vector();
-                    (
-                        Iso {
-                            r: at.r,
-                            t: at.apply_delta(d, v),
-                        },
-                        Iso {
-                            r: j.origin.r,
-                            t: j.origin.apply_delta(d, v),
-                        },
-                    )
-                }
-            };
-            frames[j.child] = world;
-            *local = own;
+    /// Joint `j`'s own transform at axis values `q`: the pose of its child link in its
+    /// parent link (origin × the joint's motion; joints off the tool chain at 0). What a
+    /// transform tree publishes per link; composing them from the root gives `fk`.
+    pub fn joint_transform(&self, j: usize, q: &[f64]) -> Iso {
+        let Some(joint) = self.joints.get(j) else {
+            return Iso::IDENTITY;
+        };
+        let v = joint
+            .axis_index
+            .and_then(|i| q.get(i).copied())
+            .unwrap_or(0.0);
+        match joint.kind {
+            JointKind::Fixed => joint.origin,
+            JointKind::Revolute | JointKind::Continuous => Iso {
+                r: mat_mul(&joint.origin.r, &joint.dir.rotation(v)),
+                t: joint.origin.t,
+            },
+            JointKind::Prismatic => Iso {
+                r: joint.origin.r,
+                t: joint.origin.apply_delta(joint.dir.vector(), v),
+            },
         }
     }
 

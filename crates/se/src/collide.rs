@@ -85,9 +85,6 @@ pub struct Collider {
     frames: Vec<Vec<Iso>>,
     /// Per robot: the joints `frames` were computed for (NaN before the first check).
     frames_q: Vec<[f64; vworks_vm::MAX_AXES]>,
-    /// Per robot and joint: the joint's own transform (parent link → child link), kept
-    /// only after [`Collider::keep_joint_transforms`] (for the log's transform tree).
-    locals: Vec<Vec<Iso>>,
     dirty: bool,
     /// Narrow-phase queries made so far.
     pub queries: u64,
@@ -224,7 +221,6 @@ impl Collider {
                 .map(|r| r.model.frames_buffer())
                 .collect(),
             frames_q: vec![[f64::NAN; vworks_vm::MAX_AXES]; cell.robots.len()],
-            locals: Vec::new(),
             dirty: true,
             queries: 0,
             bodies,
@@ -260,22 +256,6 @@ impl Collider {
     /// brings all of them up to date: robots it skipped have not moved).
     pub fn frames(&self) -> &[Vec<Iso>] {
         &self.frames
-    }
-
-    /// From now on, also keep every joint's own transform (see [`Collider::joint_transforms`]).
-    pub fn keep_joint_transforms(&mut self, cell: &Cell) {
-        self.locals = cell
-            .robots
-            .iter()
-            .map(|r| vec![Iso::IDENTITY; r.model.joints.len()])
-            .collect();
-        self.dirty = true;
-    }
-
-    /// Per robot and joint, the pose of the joint's child link in its parent link as of
-    /// the last [`Collider::check`]; empty unless [`Collider::keep_joint_transforms`] ran.
-    pub fn joint_transforms(&self) -> &[Vec<Iso>] {
-        &self.locals
     }
 
     /// Every robot's joints as of the last [`Collider::check`] (the joints its frames are
@@ -334,10 +314,7 @@ impl Collider {
                 continue;
             }
             let q = &self.frames_q[r][..robot.model.dof()];
-            match self.locals.get_mut(r) {
-                Some(locals) => robot.model.fk_locals_into(q, &mut self.frames[r], locals),
-                None => robot.model.fk_into(q, &mut self.frames[r]),
-            }
+            robot.model.fk_into(q, &mut self.frames[r]);
             for f in self.frames[r].iter_mut() {
                 *f = robot.base.mul(f);
             }

@@ -300,7 +300,6 @@ impl Simulation {
     /// Writes the run to an MCAP log (see [`crate::mcaplog`]).
     pub fn with_log(mut self, log: crate::mcaplog::McapLog) -> Simulation {
         self.log = Some(log);
-        self.collider.keep_joint_transforms(&self.cell);
         self
     }
 
@@ -404,9 +403,8 @@ impl Simulation {
         }
         self.collider
             .part_poses_into(&self.cell, &mut self.log_parts);
-        let c = &self.collider;
-        let (joints, frames, locals) = (c.joints(), c.frames(), c.joint_transforms());
-        if let Err(err) = log.cycle(&self.cell, b, joints, frames, locals, &self.log_parts) {
+        let (joints, frames) = (self.collider.joints(), self.collider.frames());
+        if let Err(err) = log.cycle(&self.cell, b, joints, frames, &self.log_parts) {
             self.log_error.get_or_insert(err.to_string());
             self.log = None;
         }

@@ -528,3 +528,22 @@ fn frame_transforms_are_the_forward_kinematics_of_the_logged_joints() {
         assert!(checked > 1000, "{checked}");
     }
 }
+
+#[cfg(target_os = "linux")]
+#[test]
+fn a_log_that_cannot_be_written_names_the_file_and_the_reason() {
+    // /dev/full accepts the open and fails every write with ENOSPC.
+    let cell = Arc::new(load(&root().join("workcells/handoff/cell.toml")).unwrap());
+    let err = McapLog::create(std::path::Path::new("/dev/full"), &cell, 1).unwrap_err();
+    let text = err.to_string();
+    assert!(
+        text.contains("`/dev/full`") && text.contains("No space left on device"),
+        "{text}"
+    );
+    let missing = root().join("no such dir").join("run.mcap");
+    let err = McapLog::create(&missing, &cell, 1).unwrap_err().to_string();
+    assert!(
+        err.contains("no such dir") && err.contains("No such file"),
+        "{err}"
+    );
+}

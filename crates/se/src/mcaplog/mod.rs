@@ -22,6 +22,7 @@
 //! when [`McapLog::finish`] runs, which the engine does for every outcome, or when the
 //! log is dropped.
 
+mod cycles;
 mod json;
 mod proto;
 mod writer;
@@ -63,17 +64,20 @@ struct SceneBody {
     hull: Vec<[f64; 3]>,
 }
 
-/// Whether frame `i` (in publishing order) goes into this `/tf` message: at a keyframe,
-/// or when it moved since it was last published; records it as published if so.
-fn publish_frame(last: &mut Vec<Iso>, i: usize, pose: &Iso, keyframe: bool) -> bool {
-    if !keyframe && last.get(i) == Some(pose) {
-        return false;
+/// An error and its sources, `: `-separated (the MCAP writer's errors wrap the I/O error
+/// that says what actually went wrong, such as a full disk).
+pub(crate) fn error_chain(e: &dyn std::error::Error) -> String {
+    let mut out = e.to_string();
+    let mut source = e.source();
+    while let Some(s) = source {
+        let text = s.to_string();
+        if !out.contains(&text) {
+            out.push_str(": ");
+            out.push_str(&text);
+        }
+        source = s.source();
     }
-    match last.get_mut(i) {
-        Some(l) => *l = *pose,
-        None => last.push(*pose),
-    }
-    true
+    out
 }
 
 /// The MCAP writer's options: chunks of 1 MiB, zstd level 1 (on handoff both faster and
@@ -137,34 +141,16 @@ fn hull_triangles(geometry: &Geometry) -> Vec<[f64; 3]> {
 
 /// The MCAP log being written.
 pub struct McapLog {
-    /// The writer thread's end: messages are encoded into its batch.
+    /// The writer thread's end: records are appended to its batch.
     sink: writer::Sink,
     file: String,
     events: u16,
-    state: u16,
-    tf: u16,
     scene: u16,
     log: u16,
-    /// The last message's sequence number.
-    seq: u32,
     every: u64,
     boundary: u64,
     bodies: Vec<SceneBody>,
     red: Vec<bool>,
-    /// Messages written per topic, indexed like [`TOPICS`].
-    counts: [u64; 5],
-    encoding: Encoding,
-    /// Robot names as written in `/state` (JSON: quoted; protobuf: as they are).
-    robot_names: Vec<String>,
-    /// Per frame of the transform tree, in publishing order (per robot its root link and
-    /// each joint's child link; devices; parts): its parent and child ids, encoded.
-    frame_ids: Vec<Vec<u8>>,
-    /// The last published pose of every device and part, in publishing order.
-    last_frames: Vec<Iso>,
-    /// Per robot, the joints its last published link transforms are for.
-    last_joints: Vec<[f64; vworks_vm::MAX_AXES]>,
-    /// When the next `/tf` message carries every frame, not only the moved ones.
-    next_keyframe: i64,
 }
 
 /// How the per-cycle topics `/state` and `/tf` are encoded. `docs/log.md` has the
@@ -222,7 +208,7 @@ impl std::fmt::Debug for McapLog {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("McapLog")
             .field("file", &self.file)
-            .field("counts", &self.counts)
+            .field("every", &self.every)
             .finish()
     }
 }
@@ -253,9 +239,9 @@ impl McapLog {
     pub fn create_with(path: &Path, cell: &Cell, options: LogOptions) -> Result<McapLog, LogError> {
         let every = options.every;
         let file = path.display().to_string();
-        let io = |e: &dyn std::fmt::Display| LogError::Io {
+        let io = |e: &dyn std::error::Error| LogError::Io {
             file: file.clone(),
-            reason: e.to_string(),
+            reason: error_chain(e),
         };
         let f = File::create(path).map_err(|e| io(&e))?;
         let mut w = write_options()
@@ -387,57 +373,22 @@ impl McapLog {
             });
         }
         let red = vec![false; bodies.len()];
-        // The transform tree, in publishing order: per robot its root link (parent
-        // `world`) and each joint's child link (parent: the joint's parent link); then
-        // devices and parts (parent `world`).
-        let mut edges: Vec<(String, String)> = Vec::new();
-        for r in &cell.robots {
-            let link = |l: usize| format!("{}.{}", r.name, r.model.links[l].name);
-            edges.push(("world".into(), link(0)));
-            edges.extend(
-                r.model
-                    .joints
-                    .iter()
-                    .map(|j| (link(j.parent), link(j.child))),
-            );
-        }
-        let bodies_in_world = cell
-            .devices
-            .iter()
-            .map(|d| &d.name)
-            .chain(cell.parts.iter().map(|p| &p.name));
-        edges.extend(bodies_in_world.map(|n| ("world".to_string(), n.clone())));
-        let (robot_names, frame_ids) = match options.encoding {
-            Encoding::Json => (
-                cell.robots.iter().map(|r| json::quoted(&r.name)).collect(),
-                edges.iter().map(|(p, c)| json::frame_ids(p, c)).collect(),
-            ),
-            Encoding::Protobuf => (
-                cell.robots.iter().map(|r| r.name.clone()).collect(),
-                edges.iter().map(|(p, c)| proto::frame_ids(p, c)).collect(),
-            ),
+        let setup = writer::WriterSetup {
+            mcap: w,
+            cycles: cycles::CycleEncoder::new(cell, options.encoding),
+            channels: [events, state, tf, scene, log],
         };
-        let sink = writer::Sink::spawn(w).map_err(|e| io(&e))?;
+        let sink = writer::Sink::spawn(setup).map_err(|e| io(&e))?;
         let mut log = McapLog {
             sink,
             file,
             events,
-            state,
-            tf,
             scene,
             log,
-            seq: 0,
             every: every.max(1),
             boundary: 0,
             bodies,
             red,
-            counts: [0; 5],
-            encoding: options.encoding,
-            robot_names,
-            frame_ids,
-            last_frames: Vec::new(),
-            last_joints: vec![[f64::NAN; vworks_vm::MAX_AXES]; cell.robots.len()],
-            next_keyframe: 0,
         };
         log.write_scene(0, None)?;
         Ok(log)
@@ -446,20 +397,12 @@ impl McapLog {
     /// Starts a message on `channel` at time `t`: returns where it starts and the buffer
     /// to encode it into; [`McapLog::end`] completes it.
     fn begin(&mut self, channel: u16, t: i64) -> (writer::Started, &mut Vec<u8>) {
-        let seq = self.seq.wrapping_add(1);
-        self.sink.begin(channel, seq, t.max(0) as u64)
+        self.sink.begin(channel, t.max(0) as u64)
     }
 
-    /// Completes the message begun at `start` on topic `topic` and counts it.
-    fn end(&mut self, start: writer::Started, topic: usize) -> Result<(), LogError> {
-        match self.sink.end(start) {
-            Ok(()) => {
-                self.seq = self.seq.wrapping_add(1);
-                self.counts[topic] += 1;
-                Ok(())
-            }
-            Err(reason) => Err(self.failed(reason)),
-        }
+    /// Completes the message begun at `start`.
+    fn end(&mut self, start: writer::Started) -> Result<(), LogError> {
+        self.sink.end(start).map_err(|reason| self.failed(reason))
     }
 
     /// The error to report when the writer failed: the thread's own reason if it has one.
@@ -471,19 +414,13 @@ impl McapLog {
     }
 
     /// Writes one JSON message.
-    fn write(
-        &mut self,
-        channel: u16,
-        topic: usize,
-        t: i64,
-        value: &serde_json::Value,
-    ) -> Result<(), LogError> {
+    fn write(&mut self, channel: u16, t: i64, value: &serde_json::Value) -> Result<(), LogError> {
         let (start, b) = self.begin(channel, t);
         if let Err(e) = serde_json::to_writer(b, value) {
             self.sink.cancel(start);
             return Err(self.failed(e.to_string()));
         }
-        self.end(start, topic)
+        self.end(start)
     }
 
     /// Publishes the geometry; with `only`, just the bodies whose frame is one of those.
@@ -543,7 +480,6 @@ impl McapLog {
         }
         self.write(
             self.scene,
-            SCENE,
             t,
             &serde_json::json!({"deletions": [], "entities": entities}),
         )
@@ -558,7 +494,7 @@ impl McapLog {
             .as_ref()
             .map_or((None, 0, 0), |(f, p)| (Some(f.to_string()), p.line, p.col));
         let v = serde_json::json!({"time_ns": e.time, "robot": robot, "kind": e.kind, "details": e.details, "file": file, "line": line, "col": col});
-        self.write(self.events, EVENTS, e.time, &v)?;
+        self.write(self.events, e.time, &v)?;
         let level = match e.kind {
             "log" => Some(2),
             "warning" => Some(3),
@@ -567,7 +503,7 @@ impl McapLog {
         };
         if let Some(level) = level {
             let v = serde_json::json!({"timestamp": ts(e.time), "level": level, "message": e.details.trim_matches('"'), "name": robot.unwrap_or_else(|| "cell".into()), "file": file.unwrap_or_default(), "line": line});
-            self.write(self.log, LOG, e.time, &v)?;
+            self.write(self.log, e.time, &v)?;
         }
         if matches!(e.kind, "collision_start" | "collision_end") {
             let mut names = e.details.split(' ');
@@ -596,15 +532,15 @@ impl McapLog {
         self.boundary += 1;
     }
 
-    /// Logs a cycle boundary (every `every`-th): state and frames. `frames[r]` holds robot
-    /// r's link frames in the cell, `parts` the parts' poses.
+    /// Logs a cycle boundary (every `every`-th): `joints[r]` holds robot r's axis values,
+    /// `frames[r]` its link frames in the cell, `parts` the parts' poses in the cell. The writer thread builds `/state` and `/tf`
+    /// from them (see [`cycles`]).
     pub(crate) fn cycle(
         &mut self,
         cell: &Cell,
         t: i64,
         joints: &[[f64; vworks_vm::MAX_AXES]],
         frames: &[Vec<Iso>],
-        locals: &[Vec<Iso>],
         parts: &[Iso],
     ) -> Result<(), LogError> {
         let k = self.boundary;
@@ -612,93 +548,18 @@ impl McapLog {
         if !k.is_multiple_of(self.every) {
             return Ok(());
         }
-        // Encoded straight into the writer's batch: no allocation per cycle.
-        let time = t.max(0) as u64;
-        let encoding = self.encoding;
-        let seq = self.seq.wrapping_add(1);
-        let (start, b) = self.sink.begin(self.state, seq, time);
-        match encoding {
-            Encoding::Protobuf => proto::cycle_state_head(b, time, k),
-            Encoding::Json => json::cycle_state_head(b, time, k),
-        }
-        for (r, robot) in cell.robots.iter().enumerate() {
-            let tcp = frames[r][robot.model.tool_link].mul(&robot.tool);
-            let dof = robot.model.dof();
-            let name = &self.robot_names[r];
-            match encoding {
-                Encoding::Protobuf => {
-                    proto::robot_state(b, name.as_bytes(), &joints[r][..dof], &tcp)
-                }
-                Encoding::Json => json::robot_state(b, r == 0, name, &joints[r][..dof], &tcp),
-            }
-        }
-        if encoding == Encoding::Json {
-            json::cycle_state_tail(b);
-        }
-        self.end(start, STATE)?;
-        // Frame transforms: every frame at a keyframe, in between only the frames that moved.
-        let keyframe = t >= self.next_keyframe;
-        if keyframe {
-            self.next_keyframe = t + KEYFRAME_NS;
-        }
-        let seq = self.seq.wrapping_add(1);
-        let (start, b) = self.sink.begin(self.tf, seq, time);
-        if encoding == Encoding::Json {
-            json::transforms_head(b);
-        }
-        let mut sent = 0;
-        let mut emit = |b: &mut Vec<u8>, ids: &[u8], pose: &Iso| {
-            match encoding {
-                Encoding::Protobuf => proto::frame_transform(b, time, ids, pose),
-                Encoding::Json => json::frame_transform(b, sent == 0, time, ids, pose),
-            }
-            sent += 1;
-        };
-        let mut ids = self.frame_ids.iter();
-        for (r, robot) in cell.robots.iter().enumerate() {
-            // The root link's pose in the world is the robot's base: it never changes.
-            let root = ids.next().map(Vec::as_slice).unwrap_or_default();
-            if keyframe {
-                emit(b, root, &robot.base);
-            }
-            let (q, last) = (&joints[r], &mut self.last_joints[r]);
-            let joint_ids = ids.by_ref().take(robot.model.joints.len());
-            if keyframe || q != last {
-                // A joint's transform changes with its axis value only.
-                let moved = |a: Option<usize>| a.is_some_and(|a| q[a] != last[a]);
-                for ((joint, local), id) in robot.model.joints.iter().zip(&locals[r]).zip(joint_ids)
-                {
-                    if keyframe || moved(joint.axis_index) {
-                        emit(b, id, local);
-                    }
-                }
-                *last = *q;
-            } else {
-                joint_ids.for_each(drop);
-            }
-        }
-        let in_world = cell.devices.iter().map(|d| &d.pose).chain(parts);
-        for ((i, pose), id) in in_world.enumerate().zip(ids) {
-            if publish_frame(&mut self.last_frames, i, pose, keyframe) {
-                emit(b, id, pose);
-            }
-        }
-        if sent == 0 {
-            self.sink.cancel(start); // nothing moved
-            return Ok(());
-        }
-        if encoding == Encoding::Json {
-            json::transforms_tail(b);
-        }
-        self.end(start, TF)
+        let payload = |b: &mut Vec<u8>| cycles::append_cycle(b, cell, joints, frames, parts);
+        self.sink
+            .cycle(t.max(0) as u64, k, payload)
+            .map_err(|reason| self.failed(reason))
     }
 
     /// Finishes the file: summary, indexes, CRCs. Returns the counts per topic.
     pub fn finish(mut self) -> Result<BTreeMap<&'static str, u64>, LogError> {
-        self.sink.finish().map_err(|reason| LogError::Io {
+        let counts = self.sink.finish().map_err(|reason| LogError::Io {
             file: self.file.clone(),
             reason,
         })?;
-        Ok(TOPICS.iter().copied().zip(self.counts).collect())
+        Ok(TOPICS.iter().copied().zip(counts).collect())
     }
 }
