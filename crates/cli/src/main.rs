@@ -384,15 +384,25 @@ fn run_cell(
             r.end_time_ns as f64 / 1e9 / wall.max(1e-9)
         );
         if let Some(p) = log {
-            let counts: Vec<String> = r
-                .log_counts
-                .iter()
-                .map(|(topic, n)| format!("{n} {topic}"))
-                .collect();
-            out!("log {}: {}", p.display(), counts.join(", "));
+            if r.log_error.is_some() {
+                out!("log {}: not written (see the error above)", p.display());
+            } else {
+                let counts: Vec<String> = r
+                    .log_counts
+                    .iter()
+                    .map(|(topic, n)| format!("{n} {topic}"))
+                    .collect();
+                out!("log {}: {}", p.display(), counts.join(", "));
+            }
         }
     }
     Ok(match r.outcome {
+        // The run went well but the log asked for is missing or incomplete: an error.
+        vworks_se::engine::Outcome::Completed | vworks_se::engine::Outcome::Until
+            if r.log_error.is_some() =>
+        {
+            ExitCode::FAILURE
+        }
         vworks_se::engine::Outcome::Completed | vworks_se::engine::Outcome::Until => {
             ExitCode::SUCCESS
         }

@@ -324,3 +324,29 @@ fn a_file_that_is_not_a_log_is_an_error() {
     assert!(err.contains("notes.mcap: not an MCAP file"), "{err}");
     assert!(text(&out.stdout).is_empty());
 }
+
+#[cfg(target_os = "linux")]
+#[test]
+fn a_log_that_cannot_be_written_fails_the_run_and_says_why() {
+    let out = vworks(&["run", &workcell("handoff"), "--log", "/dev/full"]);
+    assert_eq!(out.status.code(), Some(1));
+    let (stdout, stderr) = (text(&out.stdout), text(&out.stderr));
+    assert!(stdout.contains("completed at 63.418 s"), "{stdout}");
+    assert!(stdout.contains("log /dev/full: not written"), "{stdout}");
+    assert!(
+        stderr.contains("cannot write the log `/dev/full`") && stderr.contains("No space left"),
+        "{stderr}"
+    );
+    let out = vworks(&[
+        "run",
+        &workcell("handoff"),
+        "--log",
+        "/nonexistent-dir/run.mcap",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        text(&out.stderr).contains("/nonexistent-dir/run.mcap"),
+        "{}",
+        text(&out.stderr)
+    );
+}

@@ -184,11 +184,12 @@ impl CycleEncoder {
             proto::cycle_state_head(state, time, cycle);
         }
         let mut sent = 0;
+        let stamp = proto::Stamp::new(time);
         let mut emit = |b: &mut Vec<u8>, ids: &[u8], pose: &Iso| {
             if json {
                 json::frame_transform(b, sent == 0, time, ids, pose);
             } else {
-                proto::frame_transform(b, time, ids, pose);
+                proto::frame_transform(b, &stamp, ids, pose);
             }
             sent += 1;
         };

@@ -25,17 +25,17 @@
 mod cycles;
 mod json;
 mod proto;
+mod scene;
 mod writer;
 
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::Path;
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 
 use foxglove::messages::FrameTransforms;
 use vworks_model::math::Iso;
-use vworks_model::model::Geometry;
 
 use crate::engine::TraceEvent;
 use crate::workcell::Cell;
@@ -54,16 +54,6 @@ pub enum LogError {
     },
 }
 
-/// A body of the scene: its frame and primitives.
-struct SceneBody {
-    frame: String,
-    geometry: Geometry,
-    /// Shape pose in the frame (URDF convention: cylinders and capsules along z).
-    local: Iso,
-    /// For a hull: its triangles, three corners each (empty if the hull is degenerate).
-    hull: Vec<[f64; 3]>,
-}
-
 /// An error and its sources, `: `-separated (the MCAP writer's errors wrap the I/O error
 /// that says what actually went wrong, such as a full disk).
 pub(crate) fn error_chain(e: &dyn std::error::Error) -> String {
@@ -80,17 +70,25 @@ pub(crate) fn error_chain(e: &dyn std::error::Error) -> String {
     out
 }
 
-/// The MCAP writer's options: chunks of 1 MiB, zstd level 1 (on handoff both faster and
-/// smaller than the default level 3). Built once per process, because
-/// `WriteOptions::new` asks the OS for the number of physical CPUs (it parses `/proc`,
-/// about 0.7 ms here), which a sweep that writes many logs should pay once.
+/// The zstd level of the chunks: −3, one of zstd's fast levels (`zstd --fast=3`; any zstd
+/// reader decompresses it). Compression is the largest part of the writer thread's work,
+/// which runs beside the simulation; on handoff −3 against level 1 costs 8 % more bytes
+/// (3.78 MB against 3.49 MB) and takes about a third off compression time (`docs/log.md`).
+pub const ZSTD_LEVEL: i32 = -3;
+
+/// The MCAP writer's options: chunks of 1 MiB, zstd at [`ZSTD_LEVEL`]. Built once per
+/// process, because `WriteOptions::new` asks the OS for the number of physical CPUs (it
+/// parses `/proc`, about 0.7 ms here), which a sweep that writes many logs should pay once.
 fn write_options() -> mcap::WriteOptions {
     static OPTIONS: OnceLock<mcap::WriteOptions> = OnceLock::new();
     OPTIONS
         .get_or_init(|| {
             mcap::WriteOptions::new()
                 .compression(Some(mcap::Compression::Zstd))
-                .compression_level(1)
+                // The mcap crate takes the level as a u32 and hands `level as i32` to zstd,
+                // so a negative level travels as its two's complement (tested: the chunks'
+                // compressed size shows the level took effect).
+                .compression_level(ZSTD_LEVEL as u32)
                 // Compression runs on the log's own writer thread (see `writer`); zstd's
                 // worker threads would only add locking on top of it.
                 .compression_threads(0)
@@ -116,41 +114,13 @@ fn media_type(name: &str, text: bool) -> &'static str {
     }
 }
 
-/// The convex hull of `points` as a triangle list (three corners per triangle).
-fn hull_triangles(geometry: &Geometry) -> Vec<[f64; 3]> {
-    let Geometry::Hull { points, .. } = geometry else {
-        return Vec::new();
-    };
-    let pts: Vec<parry3d::math::Vector3> = points
-        .iter()
-        .map(|p| parry3d::math::Vector3::new(p[0] as f32, p[1] as f32, p[2] as f32))
-        .collect();
-    let Ok((vertices, faces)) = parry3d::transformation::try_convex_hull(&pts) else {
-        return Vec::new();
-    };
-    let mut out = Vec::with_capacity(faces.len() * 3);
-    for face in faces {
-        for k in face {
-            if let Some(v) = vertices.get(k as usize) {
-                out.push([f64::from(v.x), f64::from(v.y), f64::from(v.z)]);
-            }
-        }
-    }
-    out
-}
-
 /// The MCAP log being written.
 pub struct McapLog {
     /// The writer thread's end: records are appended to its batch.
     sink: writer::Sink,
     file: String,
-    events: u16,
-    scene: u16,
-    log: u16,
     every: u64,
     boundary: u64,
-    bodies: Vec<SceneBody>,
-    red: Vec<bool>,
 }
 
 /// How the per-cycle topics `/state` and `/tf` are encoded. `docs/log.md` has the
@@ -213,18 +183,85 @@ impl std::fmt::Debug for McapLog {
     }
 }
 
-fn ts(t: i64) -> serde_json::Value {
-    serde_json::json!({"sec": t.max(0) / 1_000_000_000, "nsec": t.max(0) % 1_000_000_000})
-}
-
-fn pose_json(p: &Iso) -> serde_json::Value {
-    let q = proto::quat(&p.r);
-    serde_json::json!({"position": {"x": p.t[0], "y": p.t[1], "z": p.t[2]}, "orientation": {"x": q[0], "y": q[1], "z": q[2], "w": q[3]}})
+/// Registers the schemas and channels (returns their ids, indexed like [`TOPICS`]) and
+/// writes the metadata and the attachments. Runs on the writer thread.
+fn open(
+    w: &mut writer::Mcap,
+    cell: &Cell,
+    encoding: Encoding,
+) -> Result<[u16; TOPICS.len()], String> {
+    let io = |e: &dyn std::error::Error| error_chain(e);
+    let none = BTreeMap::new();
+    let (state_schema, tf_schema) = match encoding {
+        Encoding::Json => (
+            json::STATE_SCHEMA.as_bytes().to_vec(),
+            json::tf_schema().into_bytes(),
+        ),
+        Encoding::Protobuf => {
+            let tf = <FrameTransforms as foxglove::Encode>::get_schema()
+                .ok_or("the foxglove crate has no FrameTransforms schema")?;
+            (proto::cycle_state_descriptor(), tf.data.into_owned())
+        }
+    };
+    let json = Encoding::Json;
+    let (scene_schema, log_schema) = (json::scene_schema(), json::log_schema());
+    let topics: [(&str, Encoding, &[u8]); TOPICS.len()] = [
+        ("vworks.Event", json, json::EVENT_SCHEMA.as_bytes()),
+        ("vworks.CycleState", encoding, &state_schema),
+        ("foxglove.FrameTransforms", encoding, &tf_schema),
+        ("foxglove.SceneUpdate", json, scene_schema.as_bytes()),
+        ("foxglove.Log", json, log_schema.as_bytes()),
+    ];
+    let mut channels = [0; TOPICS.len()];
+    for ((channel, (name, encoding, schema)), topic) in channels.iter_mut().zip(topics).zip(TOPICS)
+    {
+        let (schema_encoding, message_encoding) = match encoding {
+            Encoding::Json => ("jsonschema", "json"),
+            Encoding::Protobuf => ("protobuf", "protobuf"),
+        };
+        let s = w
+            .add_schema(name, schema_encoding, schema)
+            .map_err(|e| io(&e))?;
+        *channel = w
+            .add_channel(s, topic, message_encoding, &none)
+            .map_err(|e| io(&e))?;
+    }
+    let mut meta = BTreeMap::new();
+    meta.insert(
+        "vworks_version".to_string(),
+        env!("CARGO_PKG_VERSION").to_string(),
+    );
+    meta.insert("cell".to_string(), cell.name.clone());
+    meta.insert("cycle_ns".to_string(), cell.cycle_ns.to_string());
+    meta.insert("workcell_file".to_string(), cell.file.display().to_string());
+    meta.insert("clearance_m".to_string(), cell.clearance.to_string());
+    // The engine draws no random numbers: the same inputs give the same run.
+    meta.insert("seed".to_string(), "none (deterministic)".to_string());
+    let robots: Vec<&str> = cell.robots.iter().map(|r| r.name.as_str()).collect();
+    meta.insert("robots".to_string(), robots.join(","));
+    w.write_metadata(&mcap::records::Metadata {
+        name: "vworks".into(),
+        metadata: meta,
+    })
+    .map_err(|e| io(&e))?;
+    let texts = cell.sources.iter().map(|(n, t)| (n, t.as_bytes(), true));
+    let files = cell.files.iter().map(|(n, b)| (n, b.as_slice(), false));
+    for (name, data, text) in texts.chain(files) {
+        w.attach(&mcap::Attachment {
+            log_time: 0,
+            create_time: 0,
+            name: name.clone(),
+            media_type: media_type(name, text).into(),
+            data: std::borrow::Cow::Borrowed(data),
+        })
+        .map_err(|e| io(&e))?;
+    }
+    Ok(channels)
 }
 
 impl McapLog {
     /// Creates the log for `cell`; `every` thins cycle states (1 = every boundary).
-    pub fn create(path: &Path, cell: &Cell, every: u64) -> Result<McapLog, LogError> {
+    pub fn create(path: &Path, cell: &Arc<Cell>, every: u64) -> Result<McapLog, LogError> {
         McapLog::create_with(
             path,
             cell,
@@ -235,174 +272,39 @@ impl McapLog {
         )
     }
 
-    /// Creates the log for `cell` with these options.
-    pub fn create_with(path: &Path, cell: &Cell, options: LogOptions) -> Result<McapLog, LogError> {
-        let every = options.every;
+    /// Creates the log for `cell` with these options. The file is created here (an error
+    /// if it cannot be); its contents are written by the log's writer thread, whose errors
+    /// (a full disk, say) come out of [`McapLog::finish`] or the run's `log_error`.
+    pub fn create_with(
+        path: &Path,
+        cell: &Arc<Cell>,
+        options: LogOptions,
+    ) -> Result<McapLog, LogError> {
         let file = path.display().to_string();
         let io = |e: &dyn std::error::Error| LogError::Io {
             file: file.clone(),
             reason: error_chain(e),
         };
-        let f = File::create(path).map_err(|e| io(&e))?;
-        let mut w = write_options()
-            .create(BufWriter::new(f))
-            .map_err(|e| io(&e))?;
-        let none = BTreeMap::new();
-        let channel = |w: &mut writer::Mcap,
-                       name: &str,
-                       encoding: Encoding,
-                       schema: &[u8],
-                       topic: &str|
-         -> Result<u16, LogError> {
-            let (schema_encoding, message_encoding) = match encoding {
-                Encoding::Json => ("jsonschema", "json"),
-                Encoding::Protobuf => ("protobuf", "protobuf"),
-            };
-            let s = w
-                .add_schema(name, schema_encoding, schema)
-                .map_err(|e| io(&e))?;
-            w.add_channel(s, topic, message_encoding, &none)
-                .map_err(|e| io(&e))
-        };
-        let json = Encoding::Json;
-        let events = channel(
-            &mut w,
-            "vworks.Event",
-            json,
-            json::EVENT_SCHEMA.as_bytes(),
-            TOPICS[EVENTS],
-        )?;
-        let (state_schema, tf_schema) = match options.encoding {
-            Encoding::Json => (
-                json::STATE_SCHEMA.as_bytes().to_vec(),
-                json::tf_schema().into_bytes(),
-            ),
-            Encoding::Protobuf => {
-                let tf = <FrameTransforms as foxglove::Encode>::get_schema().ok_or_else(|| {
-                    LogError::Io {
-                        file: file.clone(),
-                        reason: "the foxglove crate has no FrameTransforms schema".into(),
-                    }
-                })?;
-                (proto::cycle_state_descriptor(), tf.data.into_owned())
-            }
-        };
-        let state = channel(
-            &mut w,
-            "vworks.CycleState",
-            options.encoding,
-            &state_schema,
-            TOPICS[STATE],
-        )?;
-        let tf = channel(
-            &mut w,
-            "foxglove.FrameTransforms",
-            options.encoding,
-            &tf_schema,
-            TOPICS[TF],
-        )?;
-        let scene = channel(
-            &mut w,
-            "foxglove.SceneUpdate",
-            json,
-            json::scene_schema().as_bytes(),
-            TOPICS[SCENE],
-        )?;
-        let log = channel(
-            &mut w,
-            "foxglove.Log",
-            json,
-            json::log_schema().as_bytes(),
-            TOPICS[LOG],
-        )?;
-        let mut meta = BTreeMap::new();
-        meta.insert(
-            "vworks_version".to_string(),
-            env!("CARGO_PKG_VERSION").to_string(),
-        );
-        meta.insert("cell".to_string(), cell.name.clone());
-        meta.insert("cycle_ns".to_string(), cell.cycle_ns.to_string());
-        meta.insert("workcell_file".to_string(), cell.file.display().to_string());
-        meta.insert("clearance_m".to_string(), cell.clearance.to_string());
-        // The engine draws no random numbers: the same inputs give the same run.
-        meta.insert("seed".to_string(), "none (deterministic)".to_string());
-        meta.insert(
-            "robots".to_string(),
-            cell.robots
-                .iter()
-                .map(|r| r.name.as_str())
-                .collect::<Vec<_>>()
-                .join(","),
-        );
-        w.write_metadata(&mcap::records::Metadata {
-            name: "vworks".into(),
-            metadata: meta,
-        })
-        .map_err(|e| io(&e))?;
-        let texts = cell.sources.iter().map(|(n, t)| (n, t.as_bytes(), true));
-        let files = cell.files.iter().map(|(n, b)| (n, b.as_slice(), false));
-        for (name, data, text) in texts.chain(files) {
-            w.attach(&mcap::Attachment {
-                log_time: 0,
-                create_time: 0,
-                name: name.clone(),
-                media_type: media_type(name, text).into(),
-                data: std::borrow::Cow::Borrowed(data),
+        let f = BufWriter::new(File::create(path).map_err(|e| io(&e))?);
+        let cell = Arc::clone(cell);
+        let encoding = options.encoding;
+        let open = move || {
+            let mut mcap = write_options().create(f).map_err(|e| error_chain(&e))?;
+            let channels = open(&mut mcap, &cell, encoding)?;
+            Ok(writer::WriterSetup {
+                mcap,
+                cycles: cycles::CycleEncoder::new(&cell, encoding),
+                channels,
+                scene: scene::Scene::new(&cell),
             })
-            .map_err(|e| io(&e))?;
-        }
-        let mut bodies = Vec::new();
-        for r in &cell.robots {
-            for l in &r.model.links {
-                for s in &l.shapes {
-                    bodies.push(SceneBody {
-                        frame: format!("{}.{}", r.name, l.name),
-                        hull: hull_triangles(&s.geometry),
-                        geometry: s.geometry.clone(),
-                        local: s.origin,
-                    });
-                }
-            }
-        }
-        for d in cell.devices.iter().chain(&cell.parts) {
-            bodies.push(SceneBody {
-                frame: d.name.clone(),
-                hull: hull_triangles(&d.geometry),
-                geometry: d.geometry.clone(),
-                local: Iso::IDENTITY,
-            });
-        }
-        let red = vec![false; bodies.len()];
-        let setup = writer::WriterSetup {
-            mcap: w,
-            cycles: cycles::CycleEncoder::new(cell, options.encoding),
-            channels: [events, state, tf, scene, log],
         };
-        let sink = writer::Sink::spawn(setup).map_err(|e| io(&e))?;
-        let mut log = McapLog {
+        let sink = writer::Sink::spawn(open).map_err(|e| io(&e))?;
+        Ok(McapLog {
             sink,
             file,
-            events,
-            scene,
-            log,
-            every: every.max(1),
+            every: options.every.max(1),
             boundary: 0,
-            bodies,
-            red,
-        };
-        log.write_scene(0, None)?;
-        Ok(log)
-    }
-
-    /// Starts a message on `channel` at time `t`: returns where it starts and the buffer
-    /// to encode it into; [`McapLog::end`] completes it.
-    fn begin(&mut self, channel: u16, t: i64) -> (writer::Started, &mut Vec<u8>) {
-        self.sink.begin(channel, t.max(0) as u64)
-    }
-
-    /// Completes the message begun at `start`.
-    fn end(&mut self, start: writer::Started) -> Result<(), LogError> {
-        self.sink.end(start).map_err(|reason| self.failed(reason))
+        })
     }
 
     /// The error to report when the writer failed: the thread's own reason if it has one.
@@ -413,76 +315,14 @@ impl McapLog {
         }
     }
 
-    /// Writes one JSON message.
-    fn write(&mut self, channel: u16, t: i64, value: &serde_json::Value) -> Result<(), LogError> {
-        let (start, b) = self.begin(channel, t);
+    /// Writes one JSON message on topic `topic` (index in [`TOPICS`]).
+    fn write(&mut self, topic: usize, t: i64, value: &serde_json::Value) -> Result<(), LogError> {
+        let (start, b) = self.sink.begin(topic, t.max(0) as u64);
         if let Err(e) = serde_json::to_writer(b, value) {
             self.sink.cancel(start);
             return Err(self.failed(e.to_string()));
         }
-        self.end(start)
-    }
-
-    /// Publishes the geometry; with `only`, just the bodies whose frame is one of those.
-    fn write_scene(&mut self, t: i64, only: Option<&[&str]>) -> Result<(), LogError> {
-        let mut entities = Vec::new();
-        for (i, b) in self.bodies.iter().enumerate() {
-            if only.is_some_and(|o| !o.contains(&b.frame.as_str())) {
-                continue;
-            }
-            let color = if self.red[i] {
-                serde_json::json!({"r": 0.9, "g": 0.1, "b": 0.1, "a": 1.0})
-            } else {
-                serde_json::json!({"r": 0.6, "g": 0.65, "b": 0.7, "a": 1.0})
-            };
-            let (mut cubes, mut spheres, mut cylinders) = (Vec::new(), Vec::new(), Vec::new());
-            let mut triangles = Vec::new();
-            let local = b.local;
-            match &b.geometry {
-                Geometry::Box { half } => cubes.push(serde_json::json!({"pose": pose_json(&local), "size": {"x": 2.0 * half[0], "y": 2.0 * half[1], "z": 2.0 * half[2]}, "color": color})),
-                Geometry::Sphere { radius } => spheres.push(serde_json::json!({"pose": pose_json(&local), "size": {"x": 2.0 * radius, "y": 2.0 * radius, "z": 2.0 * radius}, "color": color})),
-                Geometry::Cylinder { radius, length } => cylinders.push(serde_json::json!({"pose": pose_json(&local), "size": {"x": 2.0 * radius, "y": 2.0 * radius, "z": length}, "bottom_scale": 1.0, "top_scale": 1.0, "color": color})),
-                Geometry::Capsule { radius, length } => {
-                    cylinders.push(serde_json::json!({"pose": pose_json(&local), "size": {"x": 2.0 * radius, "y": 2.0 * radius, "z": length}, "bottom_scale": 1.0, "top_scale": 1.0, "color": color}));
-                    for end in [-0.5, 0.5] {
-                        let c = local.mul(&Iso { r: vworks_model::math::I3, t: [0.0, 0.0, end * length] });
-                        spheres.push(serde_json::json!({"pose": pose_json(&c), "size": {"x": 2.0 * radius, "y": 2.0 * radius, "z": 2.0 * radius}, "color": color}));
-                    }
-                }
-                Geometry::Hull { .. } if !b.hull.is_empty() => {
-                    let points: Vec<serde_json::Value> = b
-                        .hull
-                        .iter()
-                        .map(|p| serde_json::json!({"x": p[0], "y": p[1], "z": p[2]}))
-                        .collect();
-                    triangles.push(serde_json::json!({"pose": pose_json(&local), "points": points, "color": color, "colors": [], "indices": []}));
-                }
-                Geometry::Hull { points, .. } => {
-                    // A degenerate hull (flat or a line): its bounding box stands in.
-                    let mut lo = [f64::INFINITY; 3];
-                    let mut hi = [f64::NEG_INFINITY; 3];
-                    for p in points {
-                        for k in 0..3 {
-                            lo[k] = lo[k].min(p[k]);
-                            hi[k] = hi[k].max(p[k]);
-                        }
-                    }
-                    let c = local.mul(&Iso { r: vworks_model::math::I3, t: [(lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0, (lo[2] + hi[2]) / 2.0] });
-                    cubes.push(serde_json::json!({"pose": pose_json(&c), "size": {"x": hi[0] - lo[0], "y": hi[1] - lo[1], "z": hi[2] - lo[2]}, "color": color}));
-                }
-            }
-            entities.push(serde_json::json!({
-                "timestamp": ts(t), "frame_id": b.frame, "id": format!("{}#{i}", b.frame),
-                "lifetime": {"sec": 0, "nsec": 0}, "frame_locked": true, "metadata": [],
-                "arrows": [], "cubes": cubes, "spheres": spheres, "cylinders": cylinders,
-                "lines": [], "triangles": triangles, "texts": [], "models": [],
-            }));
-        }
-        self.write(
-            self.scene,
-            t,
-            &serde_json::json!({"deletions": [], "entities": entities}),
-        )
+        self.sink.end(start).map_err(|reason| self.failed(reason))
     }
 
     /// Logs an event (and, for `log`, `warning` and `error`, a Foxglove log message); on
@@ -494,7 +334,7 @@ impl McapLog {
             .as_ref()
             .map_or((None, 0, 0), |(f, p)| (Some(f.to_string()), p.line, p.col));
         let v = serde_json::json!({"time_ns": e.time, "robot": robot, "kind": e.kind, "details": e.details, "file": file, "line": line, "col": col});
-        self.write(self.events, e.time, &v)?;
+        self.write(EVENTS, e.time, &v)?;
         let level = match e.kind {
             "log" => Some(2),
             "warning" => Some(3),
@@ -502,22 +342,19 @@ impl McapLog {
             _ => None,
         };
         if let Some(level) = level {
-            let v = serde_json::json!({"timestamp": ts(e.time), "level": level, "message": e.details.trim_matches('"'), "name": robot.unwrap_or_else(|| "cell".into()), "file": file.unwrap_or_default(), "line": line});
-            self.write(self.log, e.time, &v)?;
+            let v = serde_json::json!({"timestamp": scene::ts(e.time), "level": level, "message": e.details.trim_matches('"'), "name": robot.unwrap_or_else(|| "cell".into()), "file": file.unwrap_or_default(), "line": line});
+            self.write(LOG, e.time, &v)?;
         }
         if matches!(e.kind, "collision_start" | "collision_end") {
             let mut names = e.details.split(' ');
             let (a, b) = (
-                names.next().unwrap_or_default().to_string(),
-                names.next().unwrap_or_default().to_string(),
+                names.next().unwrap_or_default(),
+                names.next().unwrap_or_default(),
             );
             let on = e.kind == "collision_start";
-            for (i, body) in self.bodies.iter().enumerate() {
-                if body.frame == a || body.frame == b {
-                    self.red[i] = on;
-                }
-            }
-            self.write_scene(e.time, Some(&[a.as_str(), b.as_str()]))?;
+            self.sink
+                .colour(e.time.max(0) as u64, on, a, b)
+                .map_err(|reason| self.failed(reason))?;
         }
         Ok(())
     }

@@ -136,23 +136,47 @@ pub(crate) fn frame_ids(parent: &str, child: &str) -> Vec<u8> {
     b
 }
 
+/// A `FrameTransform`'s `timestamp` field (field 1), encoded once for all the transforms
+/// of a message.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Stamp {
+    bytes: [u8; 16],
+    len: usize,
+}
+
+impl Stamp {
+    /// The timestamp of `time` ns (≥ 0): seconds (saturating at `u32::MAX`) and nanoseconds.
+    pub(crate) fn new(time: u64) -> Stamp {
+        let (sec, nsec) = (
+            (time / 1_000_000_000).min(u64::from(u32::MAX)),
+            time % 1_000_000_000,
+        );
+        let mut b = Vec::with_capacity(16);
+        let body = usize::from(sec != 0) * (1 + varint_len(sec))
+            + usize::from(nsec != 0) * (1 + varint_len(nsec));
+        key(&mut b, 1, LEN);
+        b.push(body as u8); // at most 2 × (1 + 5) bytes
+        uint(&mut b, 1, sec);
+        uint(&mut b, 2, nsec);
+        let mut bytes = [0; 16];
+        let len = b.len().min(16);
+        bytes[..len].copy_from_slice(&b[..len]);
+        Stamp { bytes, len }
+    }
+
+    fn as_slice(&self) -> &[u8] {
+        &self.bytes[..self.len]
+    }
+}
+
 /// Appends one `FrameTransform` as a `transforms` entry (field 1) of `FrameTransforms`:
-/// `time` (ns, ≥ 0) as its timestamp, `ids` from [`frame_ids`], `pose` in the parent.
-pub(crate) fn frame_transform(b: &mut Vec<u8>, time: u64, ids: &[u8], pose: &Iso) {
-    let (sec, nsec) = (
-        (time / 1_000_000_000).min(u64::from(u32::MAX)),
-        time % 1_000_000_000,
-    );
-    let stamp = usize::from(sec != 0) * (1 + varint_len(sec))
-        + usize::from(nsec != 0) * (1 + varint_len(nsec));
+/// `stamp` as its timestamp, `ids` from [`frame_ids`], `pose` in the parent.
+pub(crate) fn frame_transform(b: &mut Vec<u8>, stamp: &Stamp, ids: &[u8], pose: &Iso) {
     let q = quat(&pose.r);
-    let len = 2 + stamp + ids.len() + 2 + doubles_len(&pose.t) + 2 + doubles_len(&q);
+    let len = stamp.len + ids.len() + 2 + doubles_len(&pose.t) + 2 + doubles_len(&q);
     key(b, 1, LEN);
     varint(b, len as u64);
-    key(b, 1, LEN);
-    b.push(stamp as u8);
-    uint(b, 1, sec);
-    uint(b, 2, nsec);
+    b.extend_from_slice(stamp.as_slice());
     b.extend_from_slice(ids);
     doubles_message(b, 4, &pose.t);
     doubles_message(b, 5, &q);
@@ -382,7 +406,7 @@ mod tests {
                 let mut ours = Vec::new();
                 let mut theirs = FrameTransforms::default();
                 for p in poses() {
-                    frame_transform(&mut ours, time, &frame_ids("world", child), &p);
+                    frame_transform(&mut ours, &Stamp::new(time), &frame_ids("world", child), &p);
                     let q = quat(&p.r);
                     theirs.transforms.push(FrameTransform {
                         timestamp: Some(Timestamp::new(

@@ -2,12 +2,16 @@
 //! them into MCAP messages, compresses the chunks (zstd) and writes the file, so the
 //! per-cycle encoding and the compression run beside the simulation instead of inside it.
 //!
-//! A batch is a byte buffer of records, each a tag byte and the time (u64), then:
-//! - [`MESSAGE`]: the channel (u16), the length (u32) and a message encoded by the
-//!   simulation (events, scene updates, log lines: rare);
+//! The thread opens the file's MCAP structure itself (schemas, channels, metadata,
+//! attachments, the first scene), so creating a log costs the simulation only the file's
+//! creation. A batch is a byte buffer of records, each a tag byte and the time (u64), then:
+//! - [`MESSAGE`]: the topic (u8, index in [`TOPICS`]), the length (u32) and a message
+//!   encoded by the simulation (events and log lines: rare);
 //! - [`CYCLE`]: the boundary's index (u64) and its cycle payload
-//!   ([`super::cycles::append_cycle`]), from which the thread's
-//!   [`CycleEncoder`] builds `/state` and `/tf`.
+//!   ([`super::cycles::append_cycle`]), from which the thread's [`CycleEncoder`] builds
+//!   `/state` and `/tf`;
+//! - [`COLOUR`]: on (u8), the lengths (u16) of two frame names and the names: a collision
+//!   started or ended, and the thread publishes the two bodies' new colour on `/scene`.
 //!
 //! All integers little-endian. A bounded channel carries full batches to the thread
 //! (back-pressure: the simulation waits when the writer is [`QUEUED_BATCHES`] behind) and a
@@ -21,7 +25,8 @@ use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::thread::JoinHandle;
 
 use super::cycles::CycleEncoder;
-use super::{STATE, TF, TOPICS};
+use super::scene::Scene;
+use super::{SCENE, STATE, TF, TOPICS};
 
 /// The MCAP writer the thread owns.
 pub(crate) type Mcap = mcap::Writer<BufWriter<File>>;
@@ -36,16 +41,21 @@ pub(crate) const QUEUED_BATCHES: usize = 4;
 const MESSAGE: u8 = 0;
 /// Record tag: a cycle boundary's joints and part poses.
 const CYCLE: u8 = 1;
+/// Record tag: two bodies change colour.
+const COLOUR: u8 = 2;
 
 /// Messages written per topic, indexed like [`TOPICS`].
 pub(crate) type Counts = [u64; TOPICS.len()];
 
 /// What the writer thread needs besides the records (`W`: the file; tests use others).
 pub(crate) struct WriterSetup<W: Write + Seek> {
+    /// The MCAP writer, schemas and channels registered, metadata and attachments written.
     pub(crate) mcap: mcap::Writer<W>,
     pub(crate) cycles: CycleEncoder,
     /// The channel id of each topic, indexed like [`TOPICS`].
     pub(crate) channels: [u16; TOPICS.len()],
+    /// The bodies; published whole at t = 0.
+    pub(crate) scene: Scene,
 }
 
 /// The simulation's end of the writer thread.
@@ -65,22 +75,24 @@ pub(crate) struct Sink {
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Started(usize);
 
-/// Bytes of a message record's header: tag, time, channel, length.
-const MESSAGE_HEADER: usize = 1 + 8 + 2 + 4;
+/// Bytes of a message record's header: tag, time, topic, length.
+const MESSAGE_HEADER: usize = 1 + 8 + 1 + 4;
 
 impl Sink {
-    /// Starts the thread; it writes the records into `setup.mcap` (which already holds
-    /// schemas, channels, metadata and attachments) and finishes the file when the sink is
-    /// finished or dropped.
-    pub(crate) fn spawn<W>(setup: WriterSetup<W>) -> std::io::Result<Sink>
+    /// Starts the thread: it runs `open` (which registers the schemas and channels and
+    /// writes metadata and attachments), publishes the scene, writes the records, and
+    /// finishes the file when the sink is finished or dropped. An error from `open` is the
+    /// log's error (see [`Sink::finish`]).
+    pub(crate) fn spawn<W, F>(open: F) -> std::io::Result<Sink>
     where
-        W: Write + Seek + Send + 'static,
+        W: Write + Seek + 'static,
+        F: FnOnce() -> Result<WriterSetup<W>, String> + Send + 'static,
     {
         let (full_tx, full_rx) = sync_channel::<Vec<u8>>(QUEUED_BATCHES);
         let (empty_tx, empty_rx) = sync_channel::<Vec<u8>>(QUEUED_BATCHES + 2);
         let thread = std::thread::Builder::new()
             .name("vworks-log".into())
-            .spawn(move || write_batches(setup, &full_rx, &empty_tx))?;
+            .spawn(move || write_batches(open()?, &full_rx, &empty_tx))?;
         Ok(Sink {
             batch: Vec::with_capacity(BATCH_BYTES + BATCH_BYTES / 4),
             full: Some(full_tx),
@@ -90,13 +102,14 @@ impl Sink {
         })
     }
 
-    /// Starts a message on `channel` at `time`: returns where it starts and the buffer to
-    /// append its encoding to; [`Sink::end`] completes it, [`Sink::cancel`] drops it.
-    pub(crate) fn begin(&mut self, channel: u16, time: u64) -> (Started, &mut Vec<u8>) {
+    /// Starts a message on topic `topic` (index in [`TOPICS`]) at `time`: returns where it
+    /// starts and the buffer to append its encoding to; [`Sink::end`] completes it,
+    /// [`Sink::cancel`] drops it.
+    pub(crate) fn begin(&mut self, topic: usize, time: u64) -> (Started, &mut Vec<u8>) {
         let start = self.batch.len();
         self.batch.push(MESSAGE);
         self.batch.extend_from_slice(&time.to_le_bytes());
-        self.batch.extend_from_slice(&channel.to_le_bytes());
+        self.batch.push(topic as u8);
         self.batch.extend_from_slice(&0u32.to_le_bytes());
         (Started(start), &mut self.batch)
     }
@@ -131,6 +144,22 @@ impl Sink {
         self.batch.extend_from_slice(&time.to_le_bytes());
         self.batch.extend_from_slice(&cycle.to_le_bytes());
         payload(&mut self.batch);
+        self.ship_if_full()
+    }
+
+    /// Appends a colour record: the bodies of frames `a` and `b` turn red (`on`) or grey.
+    pub(crate) fn colour(&mut self, time: u64, on: bool, a: &str, b: &str) -> Result<(), String> {
+        // Frame names longer than 64 KiB do not exist (they come from URDFs and the cell).
+        let (a, b) = (clip(a), clip(b));
+        self.batch.push(COLOUR);
+        self.batch.extend_from_slice(&time.to_le_bytes());
+        self.batch.push(u8::from(on));
+        self.batch
+            .extend_from_slice(&(a.len() as u16).to_le_bytes());
+        self.batch
+            .extend_from_slice(&(b.len() as u16).to_le_bytes());
+        self.batch.extend_from_slice(a);
+        self.batch.extend_from_slice(b);
         self.ship_if_full()
     }
 
@@ -192,6 +221,12 @@ impl Drop for Sink {
     }
 }
 
+/// At most `u16::MAX` bytes of `s`.
+fn clip(s: &str) -> &[u8] {
+    let b = s.as_bytes();
+    &b[..b.len().min(usize::from(u16::MAX))]
+}
+
 /// Splits `n` bytes off the front of `rest`.
 fn take<'a>(rest: &mut &'a [u8], n: usize) -> Result<&'a [u8], String> {
     let Some((head, tail)) = rest.split_at_checked(n) else {
@@ -208,66 +243,114 @@ fn take_u64(rest: &mut &[u8]) -> Result<u64, String> {
     ]))
 }
 
-/// The thread: writes every record of every batch, returns the batches, finishes the
-/// file when the channel closes. Stops at the first error (the simulation learns of it at
-/// its next send).
+/// The thread: publishes the scene, writes every record of every batch, returns the
+/// batches, finishes the file when the channel closes. Stops at the first error (the
+/// simulation learns of it at its next send).
 fn write_batches<W: Write + Seek>(
     setup: WriterSetup<W>,
     full: &Receiver<Vec<u8>>,
     empty: &SyncSender<Vec<u8>>,
 ) -> Result<Counts, String> {
     let WriterSetup {
-        mut mcap,
+        mcap,
         mut cycles,
         channels,
+        mut scene,
     } = setup;
+    let mut out = Out {
+        mcap,
+        channels,
+        counts: [0; TOPICS.len()],
+        sequence: 0,
+        json: Vec::with_capacity(4096),
+    };
+    out.scene(&scene, 0, None)?;
     let payload_len = cycles.payload_len();
-    let mut counts: Counts = [0; TOPICS.len()];
-    let mut sequence = 0u32;
     let (mut state, mut tf) = (Vec::with_capacity(1024), Vec::with_capacity(4096));
-    let mut write =
-        |mcap: &mut mcap::Writer<W>, counts: &mut Counts, channel: u16, time: u64, data: &[u8]| {
-            sequence = sequence.wrapping_add(1);
-            let header = mcap::records::MessageHeader {
-                channel_id: channel,
-                sequence,
-                log_time: time,
-                publish_time: time,
-            };
-            mcap.write_to_known_channel(&header, data)
-                .map_err(|e| super::error_chain(&e))?;
-            if let Some(topic) = channels.iter().position(|c| *c == channel) {
-                counts[topic] += 1;
-            }
-            Ok::<(), String>(())
-        };
     while let Ok(mut batch) = full.recv() {
         let mut rest = batch.as_slice();
         while let Some((&tag, tail)) = rest.split_first() {
             rest = tail;
             let time = take_u64(&mut rest)?;
-            if tag == CYCLE {
-                let cycle = take_u64(&mut rest)?;
-                let payload = take(&mut rest, payload_len)?;
-                cycles.encode(time, cycle, payload, &mut state, &mut tf);
-                write(&mut mcap, &mut counts, channels[STATE], time, &state)?;
-                if !tf.is_empty() {
-                    write(&mut mcap, &mut counts, channels[TF], time, &tf)?;
+            match tag {
+                CYCLE => {
+                    let cycle = take_u64(&mut rest)?;
+                    let payload = take(&mut rest, payload_len)?;
+                    cycles.encode(time, cycle, payload, &mut state, &mut tf);
+                    out.write(STATE, time, &state)?;
+                    if !tf.is_empty() {
+                        out.write(TF, time, &tf)?;
+                    }
                 }
-            } else {
-                let head = take(&mut rest, 6)?;
-                let channel = u16::from_le_bytes([head[0], head[1]]);
-                let len = u32::from_le_bytes([head[2], head[3], head[4], head[5]]) as usize;
-                let data = take(&mut rest, len)?;
-                write(&mut mcap, &mut counts, channel, time, data)?;
+                COLOUR => {
+                    let head = take(&mut rest, 5)?;
+                    let on = head[0] != 0;
+                    let a_len = usize::from(u16::from_le_bytes([head[1], head[2]]));
+                    let b_len = usize::from(u16::from_le_bytes([head[3], head[4]]));
+                    let a = String::from_utf8_lossy(take(&mut rest, a_len)?).into_owned();
+                    let b = String::from_utf8_lossy(take(&mut rest, b_len)?).into_owned();
+                    scene.colour(&a, &b, on);
+                    out.scene(&scene, time, Some(&[a.as_str(), b.as_str()]))?;
+                }
+                _ => {
+                    let head = take(&mut rest, 5)?;
+                    let topic = usize::from(head[0]);
+                    let len = u32::from_le_bytes([head[1], head[2], head[3], head[4]]) as usize;
+                    let data = take(&mut rest, len)?;
+                    out.write(topic, time, data)?;
+                }
             }
         }
         batch.clear();
         // The simulation may have finished meanwhile; a batch nobody takes is just freed.
         let _ = empty.try_send(batch);
     }
-    mcap.finish().map_err(|e| super::error_chain(&e))?;
-    Ok(counts)
+    out.mcap.finish().map_err(|e| super::error_chain(&e))?;
+    Ok(out.counts)
+}
+
+/// The thread's output: the MCAP writer, with sequence numbers and counts per topic.
+struct Out<W: Write + Seek> {
+    mcap: mcap::Writer<W>,
+    channels: [u16; TOPICS.len()],
+    counts: Counts,
+    sequence: u32,
+    /// A reused buffer for scene updates.
+    json: Vec<u8>,
+}
+
+impl<W: Write + Seek> Out<W> {
+    /// Writes one message on topic `topic` (index in [`TOPICS`]) and counts it.
+    fn write(&mut self, topic: usize, time: u64, data: &[u8]) -> Result<(), String> {
+        let (Some(channel), Some(count)) = (self.channels.get(topic), self.counts.get_mut(topic))
+        else {
+            return Err(format!("internal error: no topic {topic}"));
+        };
+        self.sequence = self.sequence.wrapping_add(1);
+        let header = mcap::records::MessageHeader {
+            channel_id: *channel,
+            sequence: self.sequence,
+            log_time: time,
+            publish_time: time,
+        };
+        self.mcap
+            .write_to_known_channel(&header, data)
+            .map_err(|e| super::error_chain(&e))?;
+        *count += 1;
+        Ok(())
+    }
+
+    /// Publishes the scene (or the bodies of the frames `only`) at `time`.
+    fn scene(&mut self, scene: &Scene, time: u64, only: Option<&[&str]>) -> Result<(), String> {
+        let mut json = std::mem::take(&mut self.json);
+        json.clear();
+        let t = i64::try_from(time).unwrap_or(i64::MAX);
+        let r = serde_json::to_writer(&mut json, &scene.update(t, only))
+            .map_err(|e| e.to_string())
+            .and_then(|()| self.write(SCENE, time, &json));
+        self.json = json;
+        r
+    }
 }
 
 #[cfg(test)]
@@ -326,11 +409,12 @@ mod tests {
             mcap,
             cycles: CycleEncoder::new(&cell, Encoding::Protobuf),
             channels: [channel; TOPICS.len()],
+            scene: Scene::new(&cell),
         };
-        let mut sink = Sink::spawn(setup).unwrap();
+        let mut sink = Sink::spawn(move || Ok(setup)).unwrap();
         let mut failed = None;
         for i in 0..100_000u64 {
-            let (start, b) = sink.begin(channel, i);
+            let (start, b) = sink.begin(0, i);
             // Incompressible enough that the room runs out.
             b.extend((0..200u64).map(|k| ((i * 7919 + k * 104_729) % 251) as u8));
             if let Err(e) = sink.end(start) {
@@ -366,15 +450,17 @@ mod tests {
         let channels = [ids[0], ids[1], ids[2], ids[3], ids[4]];
         let cycles = CycleEncoder::new(&cell, Encoding::Protobuf);
         let payload = vec![0u8; cycles.payload_len()];
-        let mut sink = Sink::spawn(WriterSetup {
+        let scene = Scene::new(&cell);
+        let setup = WriterSetup {
             mcap,
             cycles,
             channels,
-        })
-        .unwrap();
+            scene,
+        };
+        let mut sink = Sink::spawn(move || Ok(setup)).unwrap();
         // Enough records for several batches: events and cycles interleaved.
         for i in 0..5_000u64 {
-            let (start, b) = sink.begin(channels[0], i * 10);
+            let (start, b) = sink.begin(0, i * 10);
             b.extend_from_slice(&i.to_le_bytes());
             sink.end(start).unwrap();
             sink.cycle(i * 10 + 5, i, |b| b.extend_from_slice(&payload))
@@ -382,8 +468,9 @@ mod tests {
         }
         let counts = sink.finish().unwrap();
         // Every cycle gives a state; only the first (a keyframe) has transforms, since the
-        // joints never change (and the next keyframe is a second away, past the end).
-        assert_eq!(counts, [5_000, 5_000, 1, 0, 0]);
+        // joints never change (and the next keyframe is a second away, past the end); the
+        // scene is published once at the start.
+        assert_eq!(counts, [5_000, 5_000, 1, 1, 0]);
         let bytes = std::fs::read(&path).unwrap();
         let _ = std::fs::remove_file(&path);
         let mut last = (0, 0);

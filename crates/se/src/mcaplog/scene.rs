@@ -1,0 +1,156 @@
+//! The `/scene` topic: every collision body as Foxglove scene primitives attached to its
+//! frame (boxes as cubes, capsules as a cylinder and two spheres, meshes as their convex
+//! hull's triangles), grey, and red while it touches another body. Built on the log's
+//! writer thread: the convex hulls and the JSON cost the simulation nothing.
+
+use vworks_model::math::Iso;
+use vworks_model::model::Geometry;
+
+use super::proto;
+use crate::workcell::Cell;
+
+/// A body of the scene: its frame and primitives.
+pub(crate) struct SceneBody {
+    frame: String,
+    geometry: Geometry,
+    /// Shape pose in the frame (URDF convention: cylinders and capsules along z).
+    local: Iso,
+    /// For a hull: its triangles, three corners each (empty if the hull is degenerate).
+    hull: Vec<[f64; 3]>,
+}
+
+/// The bodies and their colours.
+pub(crate) struct Scene {
+    bodies: Vec<SceneBody>,
+    red: Vec<bool>,
+}
+
+/// The convex hull of `points` as a triangle list (three corners per triangle).
+fn hull_triangles(geometry: &Geometry) -> Vec<[f64; 3]> {
+    let Geometry::Hull { points, .. } = geometry else {
+        return Vec::new();
+    };
+    let pts: Vec<parry3d::math::Vector3> = points
+        .iter()
+        .map(|p| parry3d::math::Vector3::new(p[0] as f32, p[1] as f32, p[2] as f32))
+        .collect();
+    let Ok((vertices, faces)) = parry3d::transformation::try_convex_hull(&pts) else {
+        return Vec::new();
+    };
+    let mut out = Vec::with_capacity(faces.len() * 3);
+    for face in faces {
+        for k in face {
+            if let Some(v) = vertices.get(k as usize) {
+                out.push([f64::from(v.x), f64::from(v.y), f64::from(v.z)]);
+            }
+        }
+    }
+    out
+}
+
+/// A Foxglove time of `t` nanoseconds (negative: 0), as JSON.
+pub(crate) fn ts(t: i64) -> serde_json::Value {
+    serde_json::json!({"sec": t.max(0) / 1_000_000_000, "nsec": t.max(0) % 1_000_000_000})
+}
+
+fn pose_json(p: &Iso) -> serde_json::Value {
+    let q = proto::quat(&p.r);
+    serde_json::json!({"position": {"x": p.t[0], "y": p.t[1], "z": p.t[2]}, "orientation": {"x": q[0], "y": q[1], "z": q[2], "w": q[3]}})
+}
+
+impl Scene {
+    /// Every body of `cell`: robots' link shapes, devices, parts.
+    pub(crate) fn new(cell: &Cell) -> Scene {
+        let mut bodies = Vec::new();
+        for r in &cell.robots {
+            for l in &r.model.links {
+                for s in &l.shapes {
+                    bodies.push(SceneBody {
+                        frame: format!("{}.{}", r.name, l.name),
+                        hull: hull_triangles(&s.geometry),
+                        geometry: s.geometry.clone(),
+                        local: s.origin,
+                    });
+                }
+            }
+        }
+        for d in cell.devices.iter().chain(&cell.parts) {
+            bodies.push(SceneBody {
+                frame: d.name.clone(),
+                hull: hull_triangles(&d.geometry),
+                geometry: d.geometry.clone(),
+                local: Iso::IDENTITY,
+            });
+        }
+        let red = vec![false; bodies.len()];
+        Scene { bodies, red }
+    }
+
+    /// Bodies of frames `a` and `b` turn red (`on`) or back to grey.
+    pub(crate) fn colour(&mut self, a: &str, b: &str, on: bool) {
+        for (body, red) in self.bodies.iter().zip(&mut self.red) {
+            if body.frame == a || body.frame == b {
+                *red = on;
+            }
+        }
+    }
+
+    /// A `SceneUpdate` at `t` of every body, or with `only`, of the bodies whose frame is
+    /// one of those.
+    pub(crate) fn update(&self, t: i64, only: Option<&[&str]>) -> serde_json::Value {
+        let mut entities = Vec::new();
+        for (i, b) in self.bodies.iter().enumerate() {
+            if only.is_some_and(|o| !o.contains(&b.frame.as_str())) {
+                continue;
+            }
+            let color = if self.red[i] {
+                serde_json::json!({"r": 0.9, "g": 0.1, "b": 0.1, "a": 1.0})
+            } else {
+                serde_json::json!({"r": 0.6, "g": 0.65, "b": 0.7, "a": 1.0})
+            };
+            let (mut cubes, mut spheres, mut cylinders) = (Vec::new(), Vec::new(), Vec::new());
+            let mut triangles = Vec::new();
+            let local = b.local;
+            match &b.geometry {
+                Geometry::Box { half } => cubes.push(serde_json::json!({"pose": pose_json(&local), "size": {"x": 2.0 * half[0], "y": 2.0 * half[1], "z": 2.0 * half[2]}, "color": color})),
+                Geometry::Sphere { radius } => spheres.push(serde_json::json!({"pose": pose_json(&local), "size": {"x": 2.0 * radius, "y": 2.0 * radius, "z": 2.0 * radius}, "color": color})),
+                Geometry::Cylinder { radius, length } => cylinders.push(serde_json::json!({"pose": pose_json(&local), "size": {"x": 2.0 * radius, "y": 2.0 * radius, "z": length}, "bottom_scale": 1.0, "top_scale": 1.0, "color": color})),
+                Geometry::Capsule { radius, length } => {
+                    cylinders.push(serde_json::json!({"pose": pose_json(&local), "size": {"x": 2.0 * radius, "y": 2.0 * radius, "z": length}, "bottom_scale": 1.0, "top_scale": 1.0, "color": color}));
+                    for end in [-0.5, 0.5] {
+                        let c = local.mul(&Iso { r: vworks_model::math::I3, t: [0.0, 0.0, end * length] });
+                        spheres.push(serde_json::json!({"pose": pose_json(&c), "size": {"x": 2.0 * radius, "y": 2.0 * radius, "z": 2.0 * radius}, "color": color}));
+                    }
+                }
+                Geometry::Hull { .. } if !b.hull.is_empty() => {
+                    let points: Vec<serde_json::Value> = b
+                        .hull
+                        .iter()
+                        .map(|p| serde_json::json!({"x": p[0], "y": p[1], "z": p[2]}))
+                        .collect();
+                    triangles.push(serde_json::json!({"pose": pose_json(&local), "points": points, "color": color, "colors": [], "indices": []}));
+                }
+                Geometry::Hull { points, .. } => {
+                    // A degenerate hull (flat or a line): its bounding box stands in.
+                    let mut lo = [f64::INFINITY; 3];
+                    let mut hi = [f64::NEG_INFINITY; 3];
+                    for p in points {
+                        for k in 0..3 {
+                            lo[k] = lo[k].min(p[k]);
+                            hi[k] = hi[k].max(p[k]);
+                        }
+                    }
+                    let c = local.mul(&Iso { r: vworks_model::math::I3, t: [(lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0, (lo[2] + hi[2]) / 2.0] });
+                    cubes.push(serde_json::json!({"pose": pose_json(&c), "size": {"x": hi[0] - lo[0], "y": hi[1] - lo[1], "z": hi[2] - lo[2]}, "color": color}));
+                }
+            }
+            entities.push(serde_json::json!({
+                "timestamp": ts(t), "frame_id": b.frame, "id": format!("{}#{i}", b.frame),
+                "lifetime": {"sec": 0, "nsec": 0}, "frame_locked": true, "metadata": [],
+                "arrows": [], "cubes": cubes, "spheres": spheres, "cylinders": cylinders,
+                "lines": [], "triangles": triangles, "texts": [], "models": [],
+            }));
+        }
+        serde_json::json!({"deletions": [], "entities": entities})
+    }
+}
