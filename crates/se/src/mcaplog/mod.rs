@@ -7,7 +7,8 @@
 //! - `/state` (`vworks.CycleState`, protobuf by default): per cycle boundary (every
 //!   `every`-th), every robot's joints and TCP.
 //! - `/tf` (`foxglove.FrameTransforms`, protobuf by default): per logged boundary, the
-//!   link, device and part frames that moved (all of them once per simulated second).
+//!   transforms of the frame tree (world → robot root links → links by joint; devices and
+//!   parts under world) that changed, all of them once per simulated second.
 //! - `/scene` (`foxglove.SceneUpdate`, JSON): the bodies' geometry attached to those frames
 //!   (boxes as cubes, capsules as a cylinder and two spheres, meshes as their convex
 //!   hull's triangles), at the start and whenever a body's collision colour changes (red
@@ -17,10 +18,12 @@
 //! The workcell file, every program source, every URDF and every mesh are attachments;
 //! `vworks` metadata holds the version, the cell name, the cycle and the seed.
 //!
-//! Messages are encoded on the simulation's thread straight into batches ([`writer`]); a
-//! writer thread frames, compresses and writes them. The file is finished (summary, CRCs)
-//! when [`McapLog::finish`] runs, which the engine does for every outcome, or when the
-//! log is dropped.
+//! The simulation's thread only appends records to batches: per logged boundary the
+//! joints, TCPs and part poses, per event its JSON message. The log's writer thread
+//! ([`writer`]) opens the file's MCAP structure, builds `/state`, `/tf` ([`cycles`]) and
+//! `/scene`, frames, compresses and writes. The file is finished (summary, CRCs) when
+//! [`McapLog::finish`] runs, which the engine does for every outcome, or when the log is
+//! dropped.
 
 mod cycles;
 mod json;
