@@ -589,3 +589,87 @@ fn chunks_are_compressed_at_the_documented_zstd_level() {
     }
     assert!(checked >= 2, "{checked} full chunks");
 }
+
+#[test]
+fn bodies_turn_red_while_they_touch() {
+    // The crash cell, but the run goes on through the collision and the arms pull back.
+    let dir = std::env::temp_dir().join(format!("vworks-log-red-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let toml = std::fs::read_to_string(root().join("workcells/crash/cell.toml")).unwrap();
+    std::fs::write(
+        dir.join("cell.toml"),
+        toml.replace("on_collision = \"stop\"", "on_collision = \"continue\""),
+    )
+    .unwrap();
+    let program = "proc main() {\n    move_j joints(0deg, 60deg, -30deg, 0deg, 30deg, 0deg) speed 50%;\n    move_j joints(0deg, -30deg, 30deg, 0deg, 60deg, 0deg) speed 50%;\n}\n";
+    for name in ["left.wsl", "right.wsl"] {
+        std::fs::write(dir.join(name), program).unwrap();
+    }
+    let cell = Arc::new(load(&dir.join("cell.toml")).unwrap());
+    let (r, bytes) = run_logged(&cell, 1, None, "red");
+    check(&cell, &r, &bytes);
+    let changes: Vec<(i64, bool, String, String)> = r
+        .trace
+        .iter()
+        .filter(|e| matches!(e.kind, "collision_start" | "collision_end"))
+        .map(|e| {
+            let mut n = e.details.split(' ');
+            let (a, b) = (n.next().unwrap(), n.next().unwrap());
+            (
+                e.time,
+                e.kind == "collision_start",
+                a.to_string(),
+                b.to_string(),
+            )
+        })
+        .collect();
+    assert!(
+        changes.iter().any(|c| c.1) && changes.iter().any(|c| !c.1),
+        "{changes:?}"
+    );
+    let scenes: Vec<(u64, serde_json::Value)> = mcap::MessageStream::new(&bytes)
+        .unwrap()
+        .map(Result::unwrap)
+        .filter(|m| m.channel.topic == "/scene")
+        .map(|m| (m.log_time, serde_json::from_slice(&m.data).unwrap()))
+        .collect();
+    assert_eq!(scenes.len(), 1 + changes.len());
+    let colour = |e: &serde_json::Value| {
+        let prims = ["cubes", "spheres", "cylinders", "triangles"];
+        let c = prims
+            .iter()
+            .find_map(|p| e[p].as_array().and_then(|a| a.first()))
+            .unwrap();
+        (
+            c["color"]["r"].as_f64().unwrap(),
+            c["color"]["g"].as_f64().unwrap(),
+        )
+    };
+    // At t = 0 every body, grey.
+    let all = scenes[0].1["entities"].as_array().unwrap();
+    assert!(all.len() > 10 && all.iter().all(|e| colour(e) == (0.6, 0.65)));
+    // Then, per change, exactly the two bodies' entities, red from start to end.
+    for ((t, on, a, b), (log_time, scene)) in changes.iter().zip(&scenes[1..]) {
+        assert_eq!(*log_time, *t as u64);
+        let entities = scene["entities"].as_array().unwrap();
+        assert!(!entities.is_empty());
+        for e in entities {
+            let frame = e["frame_id"].as_str().unwrap();
+            assert!(
+                frame == a || frame == b,
+                "{frame} in the update for {a} {b}"
+            );
+            assert_eq!(colour(e), if *on { (0.9, 0.1) } else { (0.6, 0.65) });
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_same_run_writes_the_same_bytes() {
+    let cell = Arc::new(load(&root().join("workcells/handoff/cell.toml")).unwrap());
+    let (_, first) = run_logged(&cell, 1, None, "same-1");
+    let (_, second) = run_logged(&cell, 1, None, "same-2");
+    assert!(first.len() > 1_000_000);
+    assert!(first == second, "two runs of one cell wrote different logs");
+}
