@@ -20,10 +20,10 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use vworks_model::math::Iso;
+use vworks_vm::Type;
 use vworks_vm::bytecode::SrcPos;
 use vworks_vm::machine::{Event, EventKind, Next, Vm, VmConfig};
 use vworks_vm::types::fmt_quantity;
-use vworks_vm::{ConstValue, Type};
 
 use crate::collide::{Collider, Contact};
 use crate::workcell::Cell;
@@ -844,10 +844,7 @@ impl Simulation {
             .globals
             .iter()
             .zip(&self.globals)
-            .map(|(g, (v, ty))| {
-                let _ = ConstValue::Int(0);
-                (g.name.clone(), format_value(*v, *ty))
-            })
+            .map(|(g, (v, ty))| (g.name.clone(), format_value(*v, *ty)))
             .collect();
         let mut log_counts = BTreeMap::new();
         if let Some(log) = self.log.take() {
