@@ -174,79 +174,40 @@ fn read_log(what: LogCommand) -> Result<ExitCode, String> {
     let file = match &what {
         LogCommand::Info { file } | LogCommand::Events { file, .. } => file.clone(),
     };
-    let bytes =
-        std::fs::read(&file).map_err(|e| format!("cannot read `{}`: {e}", file.display()))?;
-    if !bytes.starts_with(mcap::MAGIC) {
-        return Err(format!(
-            "{}: not an MCAP file (it does not start with the MCAP magic bytes); give a log written by `vworks run --log FILE`",
-            file.display()
-        ));
-    }
-    let stream = mcap::MessageStream::new(&bytes)
-        .map_err(|e| format!("{}: not a valid MCAP file: {e}", file.display()))?;
-    let mut counts: std::collections::BTreeMap<String, u64> = std::collections::BTreeMap::new();
-    let (mut first, mut last) = (u64::MAX, 0u64);
     // A log cut short (the process was killed) still has every chunk written before the
-    // kill: read up to the damage, report what was read, and say so.
-    let mut damage = None;
-    let mut read = 0u64;
-    for m in stream {
-        let m = match m {
-            Ok(m) => m,
-            Err(e) => {
-                damage = Some(e.to_string());
-                break;
-            }
-        };
-        read += 1;
-        *counts.entry(m.channel.topic.clone()).or_default() += 1;
-        first = first.min(m.log_time);
-        last = last.max(m.log_time);
-        if let LogCommand::Events { kind, robot, .. } = &what
-            && m.channel.topic == "/events"
-        {
-            let v: serde_json::Value = serde_json::from_slice(&m.data)
-                .map_err(|e| format!("{}: an event is not JSON: {e}", file.display()))?;
-            let k = v["kind"].as_str().unwrap_or("?");
-            let r = v["robot"].as_str();
-            if kind.as_deref().is_some_and(|want| want != k)
-                || robot.as_deref().is_some_and(|want| Some(want) != r)
-            {
-                continue;
-            }
-            let details = v["details"]
-                .as_str()
-                .filter(|d| !d.is_empty())
-                .unwrap_or("-");
-            let pos = match v["file"].as_str() {
-                Some(f) => {
-                    let name = Path::new(f)
-                        .file_name()
-                        .map_or(f.to_string(), |n| n.to_string_lossy().into_owned());
-                    format!("{name}:{}:{}", v["line"], v["col"])
+    // kill: what was read is printed, and the damage is a warning and exit code 1.
+    let log = vworks_se::mcaplog::read_log(&file).map_err(|e| e.to_string())?;
+    match &what {
+        LogCommand::Events { kind, robot, .. } => {
+            for e in &log.events {
+                if kind.as_deref().is_some_and(|want| want != e.kind)
+                    || robot
+                        .as_deref()
+                        .is_some_and(|want| Some(want) != e.robot.as_deref())
+                {
+                    continue;
                 }
-                None => "-".into(),
-            };
-            out!("{} {} {k} {details} {pos}", v["time_ns"], r.unwrap_or("-"));
+                out!("{}", e.line());
+            }
+        }
+        LogCommand::Info { .. } => {
+            out!("{}", file.display());
+            for (topic, n) in &log.counts {
+                out!("  {topic:<10} {n:>8} messages");
+            }
+            if let Some((first, last)) = log.span {
+                out!(
+                    "  simulated span {} .. {}",
+                    secs(first as i64),
+                    secs(last as i64)
+                );
+            }
+            if log.damage.is_some() {
+                out!("  unfinished: only the messages before the damage are counted");
+            }
         }
     }
-    if let LogCommand::Info { .. } = what {
-        out!("{}", file.display());
-        for (topic, n) in &counts {
-            out!("  {topic:<10} {n:>8} messages");
-        }
-        if first <= last {
-            out!(
-                "  simulated span {} .. {}",
-                secs(first as i64),
-                secs(last as i64)
-            );
-        }
-        if damage.is_some() {
-            out!("  unfinished: only the messages before the damage are counted");
-        }
-    }
-    if let Some(e) = damage {
+    if let Some((read, e)) = log.damage {
         eprintln!(
             "warning: {} is unfinished or damaged after {read} messages ({e}); everything before that was read. \
              The run was probably killed: `mcap recover {} -o fixed.mcap` (the mcap CLI) rebuilds the index, or run the cell again.",

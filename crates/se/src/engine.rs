@@ -112,6 +112,29 @@ pub struct RobotStats {
     pub ended: String,
 }
 
+/// The value of a global.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum Value {
+    /// A `bool` global.
+    Bool(bool),
+    /// An `int` global.
+    Int(i64),
+    /// A `num` global, in SI units (m, rad, s, …).
+    Num(f64),
+}
+
+impl Value {
+    fn of(bits: u64, ty: Type) -> Value {
+        match ty {
+            Type::Bool => Value::Bool(bits != 0),
+            Type::Int => Value::Int(bits as i64),
+            // Globals are scalars; a wider type never reaches here.
+            _ => Value::Num(f64::from_bits(bits)),
+        }
+    }
+}
+
 /// What a run produced.
 #[derive(Clone, Debug)]
 pub struct RunResult {
@@ -127,8 +150,10 @@ pub struct RunResult {
     pub warnings: Vec<Issue>,
     /// Errors (runtime errors, deadlock).
     pub errors: Vec<Issue>,
-    /// Final values of the globals, by name.
+    /// Final values of the globals, by name, formatted with units (as `run` prints them).
     pub globals: Vec<(String, String)>,
+    /// Final values of the globals, by name.
+    pub global_values: Vec<(String, Value)>,
     /// The event trace.
     pub trace: Vec<TraceEvent>,
     /// Cycle boundaries passed and collision queries made.
@@ -194,10 +219,12 @@ pub struct Simulation {
     /// The MCAP log, if one is written, and the first error writing it.
     log: Option<crate::mcaplog::McapLog>,
     log_error: Option<String>,
-    /// Reused per logged boundary: each robot's joints, and the parts' poses.
     /// Whether each robot moves at the boundary being processed (reused).
     moving: Vec<bool>,
+    /// The parts' poses at a logged boundary (reused).
     log_parts: Vec<Iso>,
+    /// Whether every robot has been queued (the first step does it).
+    started: bool,
     /// Set from outside to stop the run between two events.
     stop: Option<Arc<AtomicBool>>,
 }
@@ -291,6 +318,7 @@ impl Simulation {
             log: None,
             log_error: None,
             moving: Vec::with_capacity(cell.robots.len()),
+            started: false,
             log_parts: Vec::new(),
             stop: None,
             cell,
@@ -327,6 +355,94 @@ impl Simulation {
     /// The trace so far.
     pub fn trace(&self) -> &[TraceEvent] {
         &self.trace
+    }
+
+    /// Handles every queue entry and cycle boundary at or before `t` and moves the clock to
+    /// `t`, unless the run ends first. Unlike `run(Some(t))` the run can go on afterwards.
+    /// Returns false once the run is over.
+    pub fn advance_to(&mut self, t: i64) -> bool {
+        self.start();
+        loop {
+            if self.outcome.is_some() {
+                return false;
+            }
+            match self.queue.peek() {
+                // Nothing left to do: the step ends the run (completed or deadlock).
+                None => {
+                    self.step(None);
+                    return self.outcome.is_none();
+                }
+                Some(Reverse((next, ..))) if *next <= t => {
+                    self.step(None);
+                }
+                Some(_) => break,
+            }
+        }
+        self.advance_cycles(t);
+        if self.outcome.is_some() {
+            return false;
+        }
+        self.time = self.time.max(t);
+        true
+    }
+
+    /// The time of the next cycle boundary still to be processed.
+    pub fn next_boundary(&self) -> i64 {
+        self.next_boundary
+    }
+
+    /// How the run ended, once it has.
+    pub fn outcome(&self) -> Option<Outcome> {
+        self.outcome
+    }
+
+    /// Every cell global's current value, in the linked cell's order (sorted by name).
+    pub fn global_values(&self) -> Vec<(&str, Value)> {
+        self.cell
+            .linked
+            .globals
+            .iter()
+            .zip(&self.globals)
+            .map(|(g, (v, ty))| (g.name.as_str(), Value::of(*v, *ty)))
+            .collect()
+    }
+
+    /// Robot `r`'s joints now (one per axis; rad or m); empty if there is no robot `r`.
+    pub fn joints(&self, r: usize) -> Vec<f64> {
+        match (self.vms.get(r), self.cell.robots.get(r)) {
+            (Some(vm), Some(robot)) => vm.joints_at(self.time)[..robot.model.dof()].to_vec(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// Robot `r`'s TCP in the cell now (base × flange × tool); identity if there is no
+    /// robot `r`.
+    pub fn tcp(&self, r: usize) -> Iso {
+        match (self.vms.get(r), self.cell.robots.get(r)) {
+            (Some(vm), Some(robot)) => {
+                let q = vm.joints_at(self.time);
+                robot
+                    .base
+                    .mul(&robot.model.tcp(&q[..robot.model.dof()], &robot.tool))
+            }
+            _ => Iso::IDENTITY,
+        }
+    }
+
+    /// The warnings so far.
+    pub fn warnings(&self) -> &[Issue] {
+        &self.warnings
+    }
+
+    /// The errors so far (runtime errors, a deadlock).
+    pub fn errors(&self) -> &[Issue] {
+        &self.errors
+    }
+
+    /// Ends the run where it is and gives its result (statistics up to now; the log, if
+    /// any, is finished).
+    pub fn into_result(self) -> RunResult {
+        self.finish()
     }
 
     /// The program file of robot `r` as messages name it (its file name).
@@ -431,15 +547,25 @@ impl Simulation {
 
     /// Runs to the end (or to `until` ns).
     pub fn run(mut self, until: Option<i64>) -> RunResult {
-        for r in 0..self.vms.len() {
-            self.requeue(r);
-        }
         while self.step(until) {}
         self.finish()
     }
 
-    /// Handles the next queue entry. Returns false when the run is over.
+    /// Queues every robot's first event, once.
+    fn start(&mut self) {
+        if !self.started {
+            self.started = true;
+            for r in 0..self.vms.len() {
+                self.requeue(r);
+            }
+        }
+    }
+
+    /// Handles the next queue entry (and the cycle boundaries before it). Returns false
+    /// when the run is over; with `until`, the run is over (outcome `until`) once the next
+    /// entry lies after it.
     pub fn step(&mut self, until: Option<i64>) -> bool {
+        self.start();
         if self.outcome.is_some() {
             return false;
         }
@@ -838,6 +964,11 @@ impl Simulation {
             }
             st.idle_ns = (end - st.moving_ns - st.waiting_ns).max(0);
         }
+        let global_values = self
+            .global_values()
+            .into_iter()
+            .map(|(n, v)| (n.to_string(), v))
+            .collect();
         let globals = self
             .cell
             .linked
@@ -864,6 +995,7 @@ impl Simulation {
             collisions: self.collisions,
             warnings: self.warnings,
             errors: self.errors,
+            global_values,
             globals,
             trace: self.trace,
             cycles: self.cycles,

@@ -28,6 +28,7 @@
 mod cycles;
 mod json;
 mod proto;
+mod read;
 mod scene;
 mod writer;
 
@@ -40,6 +41,8 @@ use std::sync::{Arc, OnceLock};
 use foxglove::messages::FrameTransforms;
 use vworks_model::math::Iso;
 
+pub use read::{LogContents, LoggedEvent, read_log, read_log_bytes};
+
 use crate::engine::TraceEvent;
 use crate::workcell::Cell;
 
@@ -50,6 +53,30 @@ pub enum LogError {
     /// The file could not be created or written.
     #[error("cannot write the log `{file}`: {reason}")]
     Io {
+        /// The file.
+        file: String,
+        /// Why.
+        reason: String,
+    },
+    /// The file could not be read.
+    #[error("cannot read `{file}`: {reason}")]
+    Read {
+        /// The file.
+        file: String,
+        /// Why.
+        reason: String,
+    },
+    /// The file read is not an MCAP file.
+    #[error(
+        "{file}: not an MCAP file (it does not start with the MCAP magic bytes); give a log written by `vworks run --log FILE`"
+    )]
+    NotMcap {
+        /// The file.
+        file: String,
+    },
+    /// The file read is MCAP but not a vworks log, or broken before any message.
+    #[error("{file}: not a valid vworks log: {reason}")]
+    Invalid {
         /// The file.
         file: String,
         /// Why.
