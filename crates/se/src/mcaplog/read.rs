@@ -88,8 +88,7 @@ pub fn read_log_bytes(file: &str, bytes: &[u8]) -> Result<LogContents, LogError>
     };
     let stream = mcap::MessageStream::new(bytes).map_err(|e| invalid(e.to_string()))?;
     let mut out = LogContents::default();
-    let mut read = 0u64;
-    for m in stream {
+    for (read, m) in (0u64..).zip(stream) {
         let m = match m {
             Ok(m) => m,
             Err(e) => {
@@ -97,7 +96,6 @@ pub fn read_log_bytes(file: &str, bytes: &[u8]) -> Result<LogContents, LogError>
                 break;
             }
         };
-        read += 1;
         *out.counts.entry(m.channel.topic.clone()).or_default() += 1;
         let (first, last) = out.span.unwrap_or((m.log_time, m.log_time));
         out.span = Some((first.min(m.log_time), last.max(m.log_time)));
