@@ -1,5 +1,1052 @@
-//! Python bindings of vworks (`import vworks`), built with maturin.
+//! Python bindings of vworks: the `vworks._vworks` extension module, re-exported by the
+//! `vworks` package (`crates/py/python/vworks`). Built with maturin (`pip install
+//! ./crates/py`, or `maturin develop` in a virtualenv).
 //!
-//! Not built yet: issue 7 adds the pyo3 module (compile, load a cell, run or step it,
-//! read robot state, events and logs). The crate holds its place in the workspace and is
-//! outside `default-members`, because building it needs a Python environment.
+//! What Python sees: `compile` → `Module`; `load_cell` → `Cell`; `Cell.run` → `Result`;
+//! `Cell.simulation` → `Simulation` (stepping, robot state, globals, events); `read_log`.
+//! Times are seconds (floats) with `_ns` twins (integers); lengths metres, angles
+//! radians. Errors are `vworks.Error` and its subclasses, never a crash: the library
+//! does not panic on input, and a panic that slipped through would surface as pyo3's
+//! `PanicException`, not an abort. Simulating releases the GIL.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use pyo3::create_exception;
+use pyo3::exceptions::{PyException, PyIndexError, PyKeyError, PyRuntimeWarning, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList, PySlice};
+use vworks_se::engine::{Issue, Outcome, RunResult, TraceEvent, Value};
+use vworks_se::mcaplog::{LoggedEvent, McapLog};
+use vworks_se::workcell::CellError as WorkcellError;
+use vworks_wslc::Diagnostic as WslDiagnostic;
+
+create_exception!(
+    vworks,
+    Error,
+    PyException,
+    "Every error vworks raises: a program that does not compile or link, a workcell that does not load, a simulation that fails, a log that cannot be read."
+);
+create_exception!(
+    vworks,
+    CompileError,
+    Error,
+    "A program does not compile. `.diagnostics` lists every problem (`Diagnostic`: code, message, file, line, col, rendered)."
+);
+create_exception!(
+    vworks,
+    LinkError,
+    Error,
+    "The cell's programs compile but do not fit together (globals, remote calls, signals, parts, joints). `.diagnostics` lists why."
+);
+create_exception!(
+    vworks,
+    CellError,
+    Error,
+    "A workcell file (or a robot model it names) is wrong: the message names the file, the place and what to do."
+);
+create_exception!(
+    vworks,
+    SimulationError,
+    Error,
+    "A robot's program failed while running. `.robot`, `.file`, `.line`, `.col` say where; `.result` holds the run up to the failure when there is one."
+);
+
+const NS: f64 = 1e9;
+
+fn secs(ns: i64) -> f64 {
+    ns as f64 / NS
+}
+
+/// Seconds (a float or an int) to integer nanoseconds.
+fn to_ns(seconds: f64, what: &str) -> PyResult<i64> {
+    if !seconds.is_finite() || seconds < 0.0 || seconds * NS > i64::MAX as f64 {
+        return Err(PyValueError::new_err(format!(
+            "{what} must be a time in seconds, at least 0 (got {seconds})"
+        )));
+    }
+    Ok((seconds * NS).round() as i64)
+}
+
+/// One compiler or linker diagnostic.
+#[pyclass(frozen, module = "vworks", get_all)]
+#[derive(Clone)]
+struct Diagnostic {
+    /// Stable code, e.g. `E0012` or `W0003`.
+    code: String,
+    /// `error` or `warning`.
+    severity: String,
+    /// What is wrong, in a sentence.
+    message: String,
+    /// The file.
+    file: String,
+    /// 1-based line (0 if unknown).
+    line: u32,
+    /// 1-based column (0 if unknown).
+    col: u32,
+    /// What to do about it, if known.
+    help: Option<String>,
+    /// The diagnostic rendered with its source line and a caret, as `vworks check` prints it.
+    rendered: String,
+}
+
+#[pymethods]
+impl Diagnostic {
+    fn __repr__(&self) -> String {
+        format!(
+            "<Diagnostic {} {}:{}:{}: {}>",
+            self.code, self.file, self.line, self.col, self.message
+        )
+    }
+
+    fn __str__(&self) -> String {
+        self.rendered.clone()
+    }
+}
+
+fn diagnostic(d: &WslDiagnostic, sources: &vworks_wslc::Sources) -> Diagnostic {
+    Diagnostic {
+        code: d.code.as_str().to_string(),
+        severity: if d.is_error() { "error" } else { "warning" }.to_string(),
+        message: d.message.clone(),
+        file: d.at.file.clone(),
+        line: d.at.line,
+        col: d.at.col,
+        help: d.help.clone(),
+        rendered: vworks_wslc::render(std::slice::from_ref(d), sources, false),
+    }
+}
+
+/// A `CompileError`/`LinkError` carrying `.diagnostics`.
+fn program_error(
+    py: Python<'_>,
+    link: bool,
+    message: String,
+    diagnostics: Vec<Diagnostic>,
+) -> PyErr {
+    let err = if link {
+        LinkError::new_err(message)
+    } else {
+        CompileError::new_err(message)
+    };
+    let set = PyList::new(py, diagnostics)
+        .and_then(|list| err.value(py).setattr("diagnostics", list));
+    match set {
+        Ok(()) => err,
+        Err(e) => e,
+    }
+}
+
+/// A compiled WSL module.
+#[pyclass(frozen, module = "vworks")]
+struct Module {
+    module: vworks_vm::Module,
+    source: String,
+    warnings: Vec<Diagnostic>,
+}
+
+#[pymethods]
+impl Module {
+    /// The file name given to `compile`.
+    #[getter]
+    fn path(&self) -> String {
+        self.module.source_path.clone()
+    }
+
+    /// The module's globals, by name, in declaration order.
+    #[getter]
+    fn globals(&self) -> Vec<String> {
+        let m = &self.module;
+        m.globals.iter().map(|g| m.str(g.name).to_string()).collect()
+    }
+
+    /// The module's procedures (`proc`) and functions (`func`), by name, in order.
+    #[getter]
+    fn procs(&self) -> Vec<String> {
+        use vworks_vm::bytecode::ProcKind;
+        let m = &self.module;
+        m.procs
+            .iter()
+            .filter(|p| matches!(p.kind, ProcKind::Proc | ProcKind::Func))
+            .map(|p| m.str(p.name).to_string())
+            .collect()
+    }
+
+    /// The compiler's warnings (`Diagnostic`s; errors raise `CompileError` instead).
+    #[getter]
+    fn warnings(&self) -> Vec<Diagnostic> {
+        self.warnings.clone()
+    }
+
+    /// The bytecode, one instruction per line, with the source line beside it (as
+    /// `vworks disasm`).
+    fn disasm(&self) -> String {
+        vworks_vm::bytecode::disassemble(&self.module, Some(&self.source))
+    }
+
+    /// The encoded bytecode (`.wslb`), as `vworks build` writes it.
+    fn to_bytes(&self) -> Vec<u8> {
+        self.module.encode()
+    }
+
+    fn __repr__(&self) -> String {
+        format!("<Module {}>", self.module.source_path)
+    }
+}
+
+/// Compiles WSL `source`; `path` names the file in diagnostics. Raises `CompileError`
+/// (with `.diagnostics`) if it does not compile.
+#[pyfunction]
+#[pyo3(signature = (source, path = "x.wsl"))]
+fn compile(py: Python<'_>, source: &str, path: &str) -> PyResult<Module> {
+    let mut sources = vworks_wslc::Sources::new();
+    sources.add(path, source);
+    match vworks_wslc::compile(path, source) {
+        Ok(c) => Ok(Module {
+            warnings: c.warnings.iter().map(|d| diagnostic(d, &sources)).collect(),
+            module: c.module,
+            source: source.to_string(),
+        }),
+        Err(e) => {
+            let diags: Vec<Diagnostic> = e.diagnostics.iter().map(|d| diagnostic(d, &sources)).collect();
+            let message = vworks_wslc::render(&e.diagnostics, &sources, false);
+            Err(program_error(py, false, message, diags))
+        }
+    }
+}
+
+/// A loaded workcell: robots with their models and compiled, linked programs; devices;
+/// parts. Run it whole (`run`) or step by step (`simulation`); a cell can be run many times.
+#[pyclass(frozen, module = "vworks")]
+struct Cell {
+    cell: Arc<vworks_se::workcell::Cell>,
+}
+
+/// Loads the workcell file at `path` (TOML). Raises `CellError` for a wrong workcell or
+/// robot model, `CompileError` or `LinkError` (with `.diagnostics`) for its programs.
+#[pyfunction]
+fn load_cell(py: Python<'_>, path: PathBuf) -> PyResult<Cell> {
+    match py.detach(|| vworks_se::workcell::load(&path)) {
+        Ok(cell) => Ok(Cell {
+            cell: Arc::new(cell),
+        }),
+        Err(WorkcellError::Program {
+            diagnostics,
+            rendered,
+        }) => {
+            let mut sources = vworks_wslc::Sources::new();
+            for d in &diagnostics {
+                if let Ok(text) = std::fs::read_to_string(&d.at.file) {
+                    sources.add(&d.at.file, &text);
+                }
+            }
+            let link = diagnostics.iter().any(|d| d.code.as_str().starts_with("E01"));
+            let diags = diagnostics.iter().map(|d| diagnostic(d, &sources)).collect();
+            Err(program_error(py, link, rendered, diags))
+        }
+        Err(e) => Err(CellError::new_err(e.to_string())),
+    }
+}
+
+#[pymethods]
+impl Cell {
+    /// The cell's name.
+    #[getter]
+    fn name(&self) -> String {
+        self.cell.name.clone()
+    }
+
+    /// The workcell file.
+    #[getter]
+    fn file(&self) -> PathBuf {
+        self.cell.file.clone()
+    }
+
+    /// The cycle (s): collisions are checked and states logged at every multiple of it.
+    #[getter]
+    fn cycle(&self) -> f64 {
+        secs(self.cell.cycle_ns)
+    }
+
+    /// The robots' names, in workcell order.
+    #[getter]
+    fn robots(&self) -> Vec<String> {
+        self.cell.robots.iter().map(|r| r.name.clone()).collect()
+    }
+
+    /// The devices' names.
+    #[getter]
+    fn devices(&self) -> Vec<String> {
+        self.cell.devices.iter().map(|d| d.name.clone()).collect()
+    }
+
+    /// The parts' names.
+    #[getter]
+    fn parts(&self) -> Vec<String> {
+        self.cell.parts.iter().map(|p| p.name.clone()).collect()
+    }
+
+    /// Runs the cell to the end, or to `until` seconds, releasing the GIL meanwhile.
+    /// `log`: write an MCAP log there (every `log_every`-th cycle state). With `check`
+    /// (the default) a runtime error raises `SimulationError` (its `.result` is the run);
+    /// without, it is in the result (`outcome == "error"`, `errors`). Collisions and
+    /// deadlocks are results, not exceptions.
+    #[pyo3(signature = (until = None, log = None, log_every = 1, check = true))]
+    fn run(
+        &self,
+        py: Python<'_>,
+        until: Option<f64>,
+        log: Option<PathBuf>,
+        log_every: u64,
+        check: bool,
+    ) -> PyResult<RunReport> {
+        let until = until.map(|t| to_ns(t, "until")).transpose()?;
+        if log_every == 0 {
+            return Err(PyValueError::new_err("log_every must be 1 or more"));
+        }
+        let mut sim = vworks_se::engine::Simulation::new(Arc::clone(&self.cell));
+        if let Some(path) = &log {
+            let l = McapLog::create(path, &self.cell, log_every)
+                .map_err(|e| Error::new_err(e.to_string()))?;
+            sim = sim.with_log(l);
+        }
+        let r = py.detach(|| sim.run(until));
+        let report = RunReport::new(&self.cell, r);
+        if check && report.outcome == Outcome::Error.name() {
+            return Err(report.simulation_error(py));
+        }
+        Ok(report)
+    }
+
+    /// A simulation of the cell at time 0, to step (`step_event`, `step_cycle`,
+    /// `run_until`) and inspect (`robot(name)`, `globals`, `events_since`).
+    fn simulation(&self) -> Simulation {
+        Simulation {
+            cell: Arc::clone(&self.cell),
+            sim: Some(vworks_se::engine::Simulation::new(Arc::clone(&self.cell))),
+            result: None,
+        }
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<Cell {} ({} robots, cycle {} s)>",
+            self.cell.name,
+            self.cell.robots.len(),
+            secs(self.cell.cycle_ns)
+        )
+    }
+}
+
+/// One event of a run: a trace line's fields.
+#[pyclass(frozen, module = "vworks", get_all)]
+#[derive(Clone)]
+struct Event {
+    /// Simulated time (s).
+    time: f64,
+    /// Simulated time (ns).
+    time_ns: i64,
+    /// The robot, or `None` for cell events (a collision, a deadlock).
+    robot: Option<String>,
+    /// Kind, e.g. `motion_start`, `set`, `wait_until`, `collision_start`, `end`.
+    kind: String,
+    /// What the trace line shows between kind and position (may be empty).
+    details: String,
+    /// The WSL file, if the event has a source position.
+    file: Option<String>,
+    /// Its line (0 if none).
+    line: u32,
+    /// Its column (0 if none).
+    col: u32,
+}
+
+#[pymethods]
+impl Event {
+    /// The event as a trace line: `time_ns robot kind details file:line:col`, `-` for an
+    /// empty field (the golden traces' and `vworks log events`' format).
+    fn trace_line(&self) -> String {
+        LoggedEvent {
+            time_ns: self.time_ns,
+            robot: self.robot.clone(),
+            kind: self.kind.clone(),
+            details: self.details.clone(),
+            file: self.file.clone(),
+            line: self.line,
+            col: self.col,
+        }
+        .line()
+    }
+
+    fn __repr__(&self) -> String {
+        format!("<Event {}>", self.trace_line())
+    }
+}
+
+fn event(cell: &vworks_se::workcell::Cell, e: &TraceEvent) -> Event {
+    Event {
+        time: secs(e.time),
+        time_ns: e.time,
+        robot: e.robot.and_then(|r| cell.robots.get(r)).map(|r| r.name.clone()),
+        kind: e.kind.to_string(),
+        details: e.details.clone(),
+        file: e.pos.as_ref().map(|(f, _)| f.to_string()),
+        line: e.pos.as_ref().map_or(0, |(_, p)| p.line),
+        col: e.pos.as_ref().map_or(0, |(_, p)| p.col),
+    }
+}
+
+fn logged_event(e: LoggedEvent) -> Event {
+    Event {
+        time: secs(e.time_ns),
+        time_ns: e.time_ns,
+        robot: e.robot,
+        kind: e.kind,
+        details: e.details,
+        file: e.file,
+        line: e.line,
+        col: e.col,
+    }
+}
+
+/// A sequence of `Event`s (indexable, sliceable, iterable), with `to_pandas()`.
+#[pyclass(frozen, sequence, module = "vworks")]
+struct EventList {
+    events: Vec<Event>,
+}
+
+#[pymethods]
+impl EventList {
+    fn __len__(&self) -> usize {
+        self.events.len()
+    }
+
+    fn __getitem__(&self, py: Python<'_>, index: &Bound<'_, PyAny>) -> PyResult<Py<PyAny>> {
+        if let Ok(slice) = index.cast::<PySlice>() {
+            let ix = slice.indices(self.events.len() as isize)?;
+            let mut events = Vec::new();
+            let mut i = ix.start;
+            while (ix.step > 0 && i < ix.stop) || (ix.step < 0 && i > ix.stop) {
+                if let Some(e) = usize::try_from(i).ok().and_then(|i| self.events.get(i)) {
+                    events.push(e.clone());
+                }
+                i += ix.step;
+            }
+            return Ok(Py::new(py, EventList { events })?.into_any());
+        }
+        let i: isize = index.extract()?;
+        let n = self.events.len() as isize;
+        let at = if i < 0 { i + n } else { i };
+        match usize::try_from(at).ok().and_then(|a| self.events.get(a)) {
+            Some(e) => Ok(Py::new(py, e.clone())?.into_any()),
+            None => Err(PyIndexError::new_err(format!(
+                "event index {i} out of range ({n} events)"
+            ))),
+        }
+    }
+
+    fn __iter__(slf: PyRef<'_, Self>) -> PyResult<Py<PyAny>> {
+        let py = slf.py();
+        let list = PyList::new(py, slf.events.iter().cloned())?;
+        Ok(list.try_iter()?.into_any().unbind())
+    }
+
+    /// The events as a pandas DataFrame (columns: time, time_ns, robot, kind, details,
+    /// file, line, col). Needs pandas (`pip install pandas`).
+    fn to_pandas(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        let pandas = py.import("pandas").map_err(|_| {
+            pyo3::exceptions::PyImportError::new_err(
+                "to_pandas needs pandas; install it with `pip install pandas`",
+            )
+        })?;
+        let columns = PyDict::new(py);
+        let e = &self.events;
+        columns.set_item("time", e.iter().map(|e| e.time).collect::<Vec<_>>())?;
+        columns.set_item("time_ns", e.iter().map(|e| e.time_ns).collect::<Vec<_>>())?;
+        columns.set_item("robot", e.iter().map(|e| e.robot.clone()).collect::<Vec<_>>())?;
+        columns.set_item("kind", e.iter().map(|e| e.kind.clone()).collect::<Vec<_>>())?;
+        columns.set_item("details", e.iter().map(|e| e.details.clone()).collect::<Vec<_>>())?;
+        columns.set_item("file", e.iter().map(|e| e.file.clone()).collect::<Vec<_>>())?;
+        columns.set_item("line", e.iter().map(|e| e.line).collect::<Vec<_>>())?;
+        columns.set_item("col", e.iter().map(|e| e.col).collect::<Vec<_>>())?;
+        Ok(pandas.getattr("DataFrame")?.call1((columns,))?.unbind())
+    }
+
+    fn __repr__(&self) -> String {
+        format!("<EventList of {} events>", self.events.len())
+    }
+}
+
+/// Time spent by one robot.
+#[pyclass(frozen, module = "vworks", get_all)]
+#[derive(Clone)]
+struct RobotStats {
+    /// The robot.
+    name: String,
+    /// Seconds in motion.
+    moving: f64,
+    /// Seconds waiting (conditions, signals, joins).
+    waiting: f64,
+    /// Seconds neither moving nor waiting (delays, and after the program ended).
+    idle: f64,
+    /// Seconds in handlers (always 0: handlers run in zero simulated time).
+    handler: f64,
+    /// Motions started.
+    motions: u32,
+    /// When its program ended (s): its cycle time.
+    end_time: f64,
+    /// The same in ns.
+    end_time_ns: i64,
+    /// How it ended: `ended`, `error`, `waiting`, `running`.
+    ended: String,
+}
+
+#[pymethods]
+impl RobotStats {
+    fn __repr__(&self) -> String {
+        format!(
+            "<RobotStats {}: moving {:.3} s, waiting {:.3} s, idle {:.3} s, ended at {:.3} s>",
+            self.name, self.moving, self.waiting, self.idle, self.end_time
+        )
+    }
+}
+
+/// A collision that started.
+#[pyclass(frozen, module = "vworks", get_all)]
+#[derive(Clone)]
+struct Collision {
+    /// When (s).
+    time: f64,
+    /// When (ns).
+    time_ns: i64,
+    /// First body (`r1.link_4`, a device or a part).
+    a: String,
+    /// Second body.
+    b: String,
+    /// Penetration depth (m).
+    depth: f64,
+    /// A contact point in the cell (m).
+    point: (f64, f64, f64),
+}
+
+#[pymethods]
+impl Collision {
+    fn __repr__(&self) -> String {
+        format!(
+            "<Collision {} {} at {:.3} s, depth {:.4} m>",
+            self.a, self.b, self.time, self.depth
+        )
+    }
+}
+
+/// A warning or an error of a run.
+#[pyclass(frozen, module = "vworks", get_all, name = "Issue")]
+#[derive(Clone)]
+struct PyIssue {
+    /// `race`, `near_miss`, `slowdown`, `runtime`, `deadlock`, …
+    kind: String,
+    /// The message.
+    message: String,
+    /// The robot, if one.
+    robot: Option<String>,
+    /// The WSL file, if known.
+    file: Option<String>,
+    /// Line (0 if unknown).
+    line: u32,
+    /// Column (0 if unknown).
+    col: u32,
+}
+
+#[pymethods]
+impl PyIssue {
+    fn __repr__(&self) -> String {
+        format!("<Issue {}: {}>", self.kind, self.message)
+    }
+}
+
+fn issue(i: &Issue) -> PyIssue {
+    PyIssue {
+        kind: i.kind.clone(),
+        message: i.message.clone(),
+        robot: i.robot.clone(),
+        file: i.file.clone(),
+        line: i.line,
+        col: i.col,
+    }
+}
+
+fn value_object(py: Python<'_>, v: Value) -> PyResult<Py<PyAny>> {
+    Ok(match v {
+        Value::Bool(b) => b.into_pyobject(py)?.to_owned().into_any().unbind(),
+        Value::Int(i) => i.into_pyobject(py)?.into_any().unbind(),
+        Value::Num(x) => x.into_pyobject(py)?.into_any().unbind(),
+        _ => py.None(),
+    })
+}
+
+/// What a run produced.
+#[pyclass(frozen, module = "vworks", name = "Result")]
+struct RunReport {
+    outcome: String,
+    end_time_ns: i64,
+    robots: Vec<RobotStats>,
+    collisions: Vec<Collision>,
+    warnings: Vec<PyIssue>,
+    errors: Vec<PyIssue>,
+    globals: Vec<(String, Value)>,
+    events: Vec<Event>,
+    cycles: u64,
+    log_counts: Vec<(String, u64)>,
+    log_error: Option<String>,
+}
+
+impl RunReport {
+    fn new(cell: &vworks_se::workcell::Cell, r: RunResult) -> RunReport {
+        RunReport {
+            outcome: r.outcome.name().to_string(),
+            end_time_ns: r.end_time_ns,
+            robots: r
+                .robots
+                .iter()
+                .map(|s| RobotStats {
+                    name: s.name.clone(),
+                    moving: secs(s.moving_ns),
+                    waiting: secs(s.waiting_ns),
+                    idle: secs(s.idle_ns),
+                    handler: secs(s.handler_ns),
+                    motions: s.motions,
+                    end_time: secs(s.end_time_ns),
+                    end_time_ns: s.end_time_ns,
+                    ended: s.ended.clone(),
+                })
+                .collect(),
+            collisions: r
+                .collisions
+                .iter()
+                .map(|c| Collision {
+                    time: secs(c.time_ns),
+                    time_ns: c.time_ns,
+                    a: c.a.clone(),
+                    b: c.b.clone(),
+                    depth: c.depth,
+                    point: (c.point[0], c.point[1], c.point[2]),
+                })
+                .collect(),
+            warnings: r.warnings.iter().map(issue).collect(),
+            errors: r.errors.iter().map(issue).collect(),
+            globals: r.global_values.clone(),
+            events: r.trace.iter().map(|e| event(cell, e)).collect(),
+            cycles: r.cycles,
+            log_counts: r
+                .log_counts
+                .iter()
+                .map(|(k, v)| (k.to_string(), *v))
+                .collect(),
+            log_error: r.log_error.clone(),
+        }
+    }
+
+    /// The `SimulationError` for this run's first error (its `.result` is the run).
+    fn simulation_error(self, py: Python<'_>) -> PyErr {
+        let first = self.errors.first().cloned();
+        let message = first
+            .as_ref()
+            .map_or_else(|| "the run ended with an error".to_string(), error_text);
+        let err = SimulationError::new_err(message);
+        let set = || -> PyResult<()> {
+            let v = err.value(py);
+            let first = first.as_ref();
+            v.setattr("robot", first.and_then(|i| i.robot.clone()))?;
+            v.setattr("file", first.and_then(|i| i.file.clone()))?;
+            v.setattr("line", first.map_or(0, |i| i.line))?;
+            v.setattr("col", first.map_or(0, |i| i.col))?;
+            v.setattr("result", Py::new(py, self)?)?;
+            Ok(())
+        };
+        match set() {
+            Ok(()) => err,
+            Err(e) => e,
+        }
+    }
+}
+
+fn error_text(i: &PyIssue) -> String {
+    match (&i.robot, &i.file) {
+        (Some(r), Some(f)) => format!("{r}: {f}:{}:{}: {}", i.line, i.col, i.message),
+        (Some(r), None) => format!("{r}: {}", i.message),
+        _ => i.message.clone(),
+    }
+}
+
+#[pymethods]
+impl RunReport {
+    /// How the run ended: `completed`, `collision`, `deadlock`, `error`, `until`.
+    #[getter]
+    fn outcome(&self) -> String {
+        self.outcome.clone()
+    }
+
+    /// Simulated end time (s).
+    #[getter]
+    fn end_time(&self) -> f64 {
+        secs(self.end_time_ns)
+    }
+
+    /// Simulated end time (ns).
+    #[getter]
+    fn end_time_ns(&self) -> i64 {
+        self.end_time_ns
+    }
+
+    /// Per robot, in workcell order: time moving, waiting, idle, motions, cycle time.
+    #[getter]
+    fn robots(&self) -> Vec<RobotStats> {
+        self.robots.clone()
+    }
+
+    /// The collisions that started, in order.
+    #[getter]
+    fn collisions(&self) -> Vec<Collision> {
+        self.collisions.clone()
+    }
+
+    /// Warnings (races, near misses, slowdowns).
+    #[getter]
+    fn warnings(&self) -> Vec<PyIssue> {
+        self.warnings.clone()
+    }
+
+    /// Errors (runtime errors, a deadlock).
+    #[getter]
+    fn errors(&self) -> Vec<PyIssue> {
+        self.errors.clone()
+    }
+
+    /// Final values of the globals by name (bool, int, or float in SI units).
+    #[getter]
+    fn globals<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (name, v) in &self.globals {
+            d.set_item(name, value_object(py, *v)?)?;
+        }
+        Ok(d)
+    }
+
+    /// Every event of the run, in order (an `EventList`: `to_pandas()` for a DataFrame).
+    #[getter]
+    fn events(&self) -> EventList {
+        EventList {
+            events: self.events.clone(),
+        }
+    }
+
+    /// Cycle boundaries passed.
+    #[getter]
+    fn cycles(&self) -> u64 {
+        self.cycles
+    }
+
+    /// Messages written per log topic (empty without a log).
+    #[getter]
+    fn log_counts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (k, v) in &self.log_counts {
+            d.set_item(k, v)?;
+        }
+        Ok(d)
+    }
+
+    /// Why the log could not be written, if it could not.
+    #[getter]
+    fn log_error(&self) -> Option<String> {
+        self.log_error.clone()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<Result {} at {:.3} s: {} events, {} collisions>",
+            self.outcome,
+            secs(self.end_time_ns),
+            self.events.len(),
+            self.collisions.len()
+        )
+    }
+}
+
+/// A running simulation of a cell: step it and look at it.
+#[pyclass(module = "vworks")]
+struct Simulation {
+    cell: Arc<vworks_se::workcell::Cell>,
+    /// `None` once `result()` ended it.
+    sim: Option<vworks_se::engine::Simulation>,
+    result: Option<Py<RunReport>>,
+}
+
+impl Simulation {
+    fn running(&self) -> PyResult<&vworks_se::engine::Simulation> {
+        self.sim
+            .as_ref()
+            .ok_or_else(|| Error::new_err("this simulation has ended: result() was called"))
+    }
+
+    /// Runs `f` on the simulation with the GIL released; raises `SimulationError` if a
+    /// robot's program failed. Returns whether the run goes on.
+    fn drive(
+        &mut self,
+        py: Python<'_>,
+        f: impl FnOnce(&mut vworks_se::engine::Simulation) -> bool + Send,
+    ) -> PyResult<bool> {
+        let sim = self
+            .sim
+            .as_mut()
+            .ok_or_else(|| Error::new_err("this simulation has ended: result() was called"))?;
+        let going = py.detach(|| f(sim));
+        if sim.outcome() == Some(Outcome::Error) {
+            let first = sim.errors().first().map(issue);
+            let message = first
+                .as_ref()
+                .map_or_else(|| "a robot's program failed".to_string(), error_text);
+            let err = SimulationError::new_err(message);
+            let v = err.value(py);
+            let first = first.as_ref();
+            v.setattr("robot", first.and_then(|i| i.robot.clone()))?;
+            v.setattr("file", first.and_then(|i| i.file.clone()))?;
+            v.setattr("line", first.map_or(0, |i| i.line))?;
+            v.setattr("col", first.map_or(0, |i| i.col))?;
+            v.setattr("result", py.None())?;
+            return Err(err);
+        }
+        Ok(going)
+    }
+
+    fn robot_index(&self, name: &str) -> PyResult<usize> {
+        self.cell
+            .robots
+            .iter()
+            .position(|r| r.name == name)
+            .ok_or_else(|| {
+                let names: Vec<&str> = self.cell.robots.iter().map(|r| r.name.as_str()).collect();
+                PyKeyError::new_err(format!(
+                    "no robot `{name}` in cell `{}`; its robots: {}",
+                    self.cell.name,
+                    names.join(", ")
+                ))
+            })
+    }
+}
+
+#[pymethods]
+impl Simulation {
+    /// Handles the next event (and the cycle boundaries before it). Returns False once
+    /// the run is over. Raises `SimulationError` if a robot's program fails.
+    fn step_event(&mut self, py: Python<'_>) -> PyResult<bool> {
+        self.drive(py, |s| s.step(None))
+    }
+
+    /// Runs to the next cycle boundary and processes it (collision check). Returns False
+    /// once the run is over.
+    fn step_cycle(&mut self, py: Python<'_>) -> PyResult<bool> {
+        self.drive(py, |s| {
+            let b = s.next_boundary();
+            s.advance_to(b)
+        })
+    }
+
+    /// Runs everything due up to `t` seconds and moves the clock there (unless the run
+    /// ends first). Returns False once the run is over.
+    fn run_until(&mut self, py: Python<'_>, t: f64) -> PyResult<bool> {
+        let t = to_ns(t, "t")?;
+        self.drive(py, move |s| s.advance_to(t))
+    }
+
+    /// Runs to the end and returns the `Result` (as `Cell.run(check=False)` would).
+    fn run(&mut self, py: Python<'_>) -> PyResult<Py<RunReport>> {
+        self.drive(py, |s| {
+            while s.step(None) {}
+            false
+        })
+        .or_else(|e| if e.is_instance_of::<SimulationError>(py) { Ok(false) } else { Err(e) })?;
+        self.result(py)
+    }
+
+    /// Ends the simulation where it is and returns its `Result` (statistics up to now).
+    /// Afterwards only `result()` and `time` work.
+    fn result(&mut self, py: Python<'_>) -> PyResult<Py<RunReport>> {
+        if let Some(r) = &self.result {
+            return Ok(r.clone_ref(py));
+        }
+        let sim = self
+            .sim
+            .take()
+            .ok_or_else(|| Error::new_err("this simulation has no result"))?;
+        let r = py.detach(|| sim.into_result());
+        let report = Py::new(py, RunReport::new(&self.cell, r))?;
+        self.result = Some(report.clone_ref(py));
+        Ok(report)
+    }
+
+    /// Simulated time now (s).
+    #[getter]
+    fn time(&self, py: Python<'_>) -> PyResult<f64> {
+        Ok(secs(self.time_ns(py)?))
+    }
+
+    /// Simulated time now (ns).
+    #[getter]
+    fn time_ns(&self, py: Python<'_>) -> PyResult<i64> {
+        match (&self.sim, &self.result) {
+            (Some(s), _) => Ok(s.time()),
+            (None, Some(r)) => Ok(r.borrow(py).end_time_ns),
+            (None, None) => Err(Error::new_err("this simulation has ended")),
+        }
+    }
+
+    /// How the run ended (`completed`, `collision`, `deadlock`, `error`), or None while
+    /// it goes on.
+    #[getter]
+    fn outcome(&self) -> PyResult<Option<String>> {
+        Ok(self.running()?.outcome().map(|o| o.name().to_string()))
+    }
+
+    /// The robots' names.
+    #[getter]
+    fn robots(&self) -> Vec<String> {
+        self.cell.robots.iter().map(|r| r.name.clone()).collect()
+    }
+
+    /// A live view of robot `name`: `.joints` and `.tcp` are read when asked.
+    fn robot(slf: Bound<'_, Self>, name: &str) -> PyResult<Robot> {
+        let index = slf.borrow().robot_index(name)?;
+        Ok(Robot {
+            sim: slf.unbind(),
+            index,
+            name: name.to_string(),
+        })
+    }
+
+    /// The cell's globals now, by name: a read-only mapping (bool, int, or float in SI
+    /// units).
+    #[getter]
+    fn globals<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let d = PyDict::new(py);
+        for (name, v) in self.running()?.global_values() {
+            d.set_item(name, value_object(py, v)?)?;
+        }
+        py.import("types")?.getattr("MappingProxyType")?.call1((d,))
+    }
+
+    /// The events from index `i` on (0: all so far); with `len(...)` of an earlier call,
+    /// the new ones.
+    #[pyo3(signature = (i = 0))]
+    fn events_since(&self, i: usize) -> PyResult<EventList> {
+        let sim = self.running()?;
+        let events = sim
+            .trace()
+            .get(i..)
+            .unwrap_or_default()
+            .iter()
+            .map(|e| event(&self.cell, e))
+            .collect();
+        Ok(EventList { events })
+    }
+
+    fn __repr__(&self) -> String {
+        match &self.sim {
+            Some(s) => format!("<Simulation of {} at {:.3} s>", self.cell.name, secs(s.time())),
+            None => format!("<Simulation of {} (ended)>", self.cell.name),
+        }
+    }
+}
+
+/// A robot of a running `Simulation`.
+#[pyclass(frozen, module = "vworks")]
+struct Robot {
+    sim: Py<Simulation>,
+    index: usize,
+    name: String,
+}
+
+#[pymethods]
+impl Robot {
+    /// Its name.
+    #[getter]
+    fn name(&self) -> String {
+        self.name.clone()
+    }
+
+    /// Its joints now, one per axis (rad, or m for linear axes), as a numpy array.
+    #[getter]
+    fn joints<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let sim = self.sim.borrow(py);
+        let q = sim.running()?.joints(self.index);
+        py.import("numpy")?.getattr("array")?.call1((q,))
+    }
+
+    /// Its TCP in the cell now (base × flange × tool) as a 4×4 homogeneous matrix (numpy;
+    /// metres).
+    #[getter]
+    fn tcp<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let sim = self.sim.borrow(py);
+        let p = sim.running()?.tcp(self.index);
+        let rows: Vec<Vec<f64>> = (0..4)
+            .map(|i| {
+                if i < 3 {
+                    vec![p.r[i][0], p.r[i][1], p.r[i][2], p.t[i]]
+                } else {
+                    vec![0.0, 0.0, 0.0, 1.0]
+                }
+            })
+            .collect();
+        py.import("numpy")?.getattr("array")?.call1((rows,))
+    }
+
+    fn __repr__(&self) -> String {
+        format!("<Robot {}>", self.name)
+    }
+}
+
+/// The events of an MCAP log written by `vworks run --log` or `Cell.run(log=...)`. A log
+/// cut short (the run was killed) gives the events before the damage, with a
+/// `RuntimeWarning`. Raises `Error` for a file that is not a vworks log.
+#[pyfunction]
+fn read_log(py: Python<'_>, path: PathBuf) -> PyResult<EventList> {
+    let log = py
+        .detach(|| vworks_se::mcaplog::read_log(&path))
+        .map_err(|e| Error::new_err(e.to_string()))?;
+    if let Some((read, damage)) = &log.damage {
+        let msg = format!(
+            "{} is unfinished or damaged after {read} messages ({damage}); the events before that were read",
+            path.display()
+        );
+        PyErr::warn(py, &py.get_type::<PyRuntimeWarning>(), &std::ffi::CString::new(msg).unwrap_or_default(), 1)?;
+    }
+    Ok(EventList {
+        events: log.events.into_iter().map(logged_event).collect(),
+    })
+}
+
+/// The `vworks._vworks` extension module.
+#[pymodule]
+fn _vworks(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add_function(wrap_pyfunction!(compile, m)?)?;
+    m.add_function(wrap_pyfunction!(load_cell, m)?)?;
+    m.add_function(wrap_pyfunction!(read_log, m)?)?;
+    m.add_class::<Module>()?;
+    m.add_class::<Diagnostic>()?;
+    m.add_class::<Cell>()?;
+    m.add_class::<RunReport>()?;
+    m.add_class::<RobotStats>()?;
+    m.add_class::<Collision>()?;
+    m.add_class::<PyIssue>()?;
+    m.add_class::<Event>()?;
+    m.add_class::<EventList>()?;
+    m.add_class::<Simulation>()?;
+    m.add_class::<Robot>()?;
+    m.add("Error", py.get_type::<Error>())?;
+    m.add("CompileError", py.get_type::<CompileError>())?;
+    m.add("LinkError", py.get_type::<LinkError>())?;
+    m.add("CellError", py.get_type::<CellError>())?;
+    m.add("SimulationError", py.get_type::<SimulationError>())?;
+    Ok(())
+}

@@ -21,6 +21,7 @@
 
 use std::fs::File;
 use std::io::{BufWriter, Seek, Write};
+use std::sync::Mutex;
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::thread::JoinHandle;
 
@@ -64,8 +65,9 @@ pub(crate) struct Sink {
     batch: Vec<u8>,
     /// Full batches to the thread; `None` once closed.
     full: Option<SyncSender<Vec<u8>>>,
-    /// Emptied batches back from the thread.
-    empty: Receiver<Vec<u8>>,
+    /// Emptied batches back from the thread (in a mutex only so that a simulation is
+    /// `Sync`: the simulation's thread is its only user).
+    empty: Mutex<Receiver<Vec<u8>>>,
     thread: Option<JoinHandle<Result<Counts, String>>>,
     /// What `finish` returned, for a second call.
     finished: Option<Result<Counts, String>>,
@@ -96,7 +98,7 @@ impl Sink {
         Ok(Sink {
             batch: Vec::with_capacity(BATCH_BYTES + BATCH_BYTES / 4),
             full: Some(full_tx),
-            empty: empty_rx,
+            empty: Mutex::new(empty_rx),
             thread: Some(thread),
             finished: None,
         })
@@ -175,10 +177,11 @@ impl Sink {
         let Some(full) = &self.full else {
             return Err("the log is closed".into());
         };
-        let next = self
-            .empty
-            .try_recv()
-            .unwrap_or_else(|_| Vec::with_capacity(BATCH_BYTES + BATCH_BYTES / 4));
+        let recycled = match self.empty.get_mut() {
+            Ok(empty) => empty.try_recv().ok(),
+            Err(_) => None,
+        };
+        let next = recycled.unwrap_or_else(|| Vec::with_capacity(BATCH_BYTES + BATCH_BYTES / 4));
         let batch = std::mem::replace(&mut self.batch, next);
         if full.send(batch).is_err() {
             // The thread stopped on an error; `finish` reports it.

@@ -1,0 +1,59 @@
+"""vworks: offline programming of robot cells.
+
+Write robot programs in WSL, place robots, devices and parts in a workcell, and run every
+robot's program at once, as the controllers would: cycle times, waits, collisions and
+deadlocks, before any steel moves.
+
+    import vworks
+    cell = vworks.load_cell("workcells/handoff/cell.toml")
+    result = cell.run()
+    print(result.end_time, [r.end_time for r in result.robots])
+
+Times are seconds (floats) with ``_ns`` twins (integers); lengths metres; angles radians.
+"""
+
+from ._vworks import (
+    Cell,
+    CellError,
+    Collision,
+    CompileError,
+    Diagnostic,
+    Error,
+    Event,
+    EventList,
+    Issue,
+    LinkError,
+    Module,
+    Result,
+    Robot,
+    RobotStats,
+    Simulation,
+    SimulationError,
+    __version__,
+    compile,
+    load_cell,
+    read_log,
+)
+
+__all__ = [
+    "Cell",
+    "CellError",
+    "Collision",
+    "CompileError",
+    "Diagnostic",
+    "Error",
+    "Event",
+    "EventList",
+    "Issue",
+    "LinkError",
+    "Module",
+    "Result",
+    "Robot",
+    "RobotStats",
+    "Simulation",
+    "SimulationError",
+    "__version__",
+    "compile",
+    "load_cell",
+    "read_log",
+]

@@ -1,0 +1,280 @@
+"""Type stubs of the `vworks._vworks` extension (kept true by `mypy.stubtest` in the tests)."""
+
+import os
+from collections.abc import Iterator, Mapping
+from typing import Any, Optional, Union, final, overload
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+__all__ = [
+    "Cell",
+    "CellError",
+    "Collision",
+    "CompileError",
+    "Diagnostic",
+    "Error",
+    "Event",
+    "EventList",
+    "Issue",
+    "LinkError",
+    "Module",
+    "Result",
+    "Robot",
+    "RobotStats",
+    "Simulation",
+    "SimulationError",
+    "__version__",
+    "compile",
+    "load_cell",
+    "read_log",
+]
+
+class Error(Exception):
+    """Every error vworks raises."""
+
+class CompileError(Error):
+    """A program does not compile."""
+
+    diagnostics: list[Diagnostic]
+
+class LinkError(Error):
+    """The cell's programs compile but do not fit together."""
+
+    diagnostics: list[Diagnostic]
+
+class CellError(Error):
+    """A workcell file (or a robot model it names) is wrong."""
+
+class SimulationError(Error):
+    """A robot's program failed while running."""
+
+    robot: Optional[str]
+    file: Optional[str]
+    line: int
+    col: int
+    result: Optional[Result]
+
+@final
+class Diagnostic:
+    """One compiler or linker diagnostic."""
+
+    @property
+    def code(self) -> str: ...
+    @property
+    def severity(self) -> str: ...
+    @property
+    def message(self) -> str: ...
+    @property
+    def file(self) -> str: ...
+    @property
+    def line(self) -> int: ...
+    @property
+    def col(self) -> int: ...
+    @property
+    def help(self) -> Optional[str]: ...
+    @property
+    def rendered(self) -> str: ...
+
+@final
+class Module:
+    """A compiled WSL module."""
+
+    @property
+    def path(self) -> str: ...
+    @property
+    def globals(self) -> list[str]: ...
+    @property
+    def procs(self) -> list[str]: ...
+    @property
+    def warnings(self) -> list[Diagnostic]: ...
+    def disasm(self) -> str: ...
+    def to_bytes(self) -> bytes: ...
+
+def compile(source: str, path: str = "x.wsl") -> Module:
+    """Compiles WSL `source`; raises `CompileError` if it does not compile."""
+
+def load_cell(path: Union[str, os.PathLike[str]]) -> Cell:
+    """Loads a workcell file; raises `CellError`, `CompileError` or `LinkError`."""
+
+def read_log(path: Union[str, os.PathLike[str]]) -> EventList:
+    """The events of an MCAP log written by vworks."""
+
+@final
+class Cell:
+    """A loaded workcell."""
+
+    @property
+    def name(self) -> str: ...
+    @property
+    def file(self) -> str: ...
+    @property
+    def cycle(self) -> float: ...
+    @property
+    def robots(self) -> list[str]: ...
+    @property
+    def devices(self) -> list[str]: ...
+    @property
+    def parts(self) -> list[str]: ...
+    def run(
+        self,
+        until: Optional[float] = None,
+        log: Union[str, os.PathLike[str], None] = None,
+        log_every: int = 1,
+        check: bool = True,
+    ) -> Result: ...
+    def simulation(self) -> Simulation: ...
+
+@final
+class Event:
+    """One event of a run."""
+
+    @property
+    def time(self) -> float: ...
+    @property
+    def time_ns(self) -> int: ...
+    @property
+    def robot(self) -> Optional[str]: ...
+    @property
+    def kind(self) -> str: ...
+    @property
+    def details(self) -> str: ...
+    @property
+    def file(self) -> Optional[str]: ...
+    @property
+    def line(self) -> int: ...
+    @property
+    def col(self) -> int: ...
+    def trace_line(self) -> str: ...
+
+@final
+class EventList:
+    """A sequence of events, with `to_pandas()`."""
+
+    def __len__(self) -> int: ...
+    @overload
+    def __getitem__(self, key: int, /) -> Event: ...
+    @overload
+    def __getitem__(self, key: slice, /) -> EventList: ...
+    def __iter__(self) -> Iterator[Event]: ...
+    def to_pandas(self) -> Any: ...
+
+@final
+class RobotStats:
+    """Time spent by one robot."""
+
+    @property
+    def name(self) -> str: ...
+    @property
+    def moving(self) -> float: ...
+    @property
+    def waiting(self) -> float: ...
+    @property
+    def idle(self) -> float: ...
+    @property
+    def handler(self) -> float: ...
+    @property
+    def motions(self) -> int: ...
+    @property
+    def end_time(self) -> float: ...
+    @property
+    def end_time_ns(self) -> int: ...
+    @property
+    def ended(self) -> str: ...
+
+@final
+class Collision:
+    """A collision that started."""
+
+    @property
+    def time(self) -> float: ...
+    @property
+    def time_ns(self) -> int: ...
+    @property
+    def a(self) -> str: ...
+    @property
+    def b(self) -> str: ...
+    @property
+    def depth(self) -> float: ...
+    @property
+    def point(self) -> tuple[float, float, float]: ...
+
+@final
+class Issue:
+    """A warning or an error of a run."""
+
+    @property
+    def kind(self) -> str: ...
+    @property
+    def message(self) -> str: ...
+    @property
+    def robot(self) -> Optional[str]: ...
+    @property
+    def file(self) -> Optional[str]: ...
+    @property
+    def line(self) -> int: ...
+    @property
+    def col(self) -> int: ...
+
+@final
+class Result:
+    """What a run produced."""
+
+    @property
+    def outcome(self) -> str: ...
+    @property
+    def end_time(self) -> float: ...
+    @property
+    def end_time_ns(self) -> int: ...
+    @property
+    def robots(self) -> list[RobotStats]: ...
+    @property
+    def collisions(self) -> list[Collision]: ...
+    @property
+    def warnings(self) -> list[Issue]: ...
+    @property
+    def errors(self) -> list[Issue]: ...
+    @property
+    def globals(self) -> dict[str, Union[bool, int, float]]: ...
+    @property
+    def events(self) -> EventList: ...
+    @property
+    def cycles(self) -> int: ...
+    @property
+    def log_counts(self) -> dict[str, int]: ...
+    @property
+    def log_error(self) -> Optional[str]: ...
+
+@final
+class Simulation:
+    """A running simulation of a cell."""
+
+    def step_event(self) -> bool: ...
+    def step_cycle(self) -> bool: ...
+    def run_until(self, t: float) -> bool: ...
+    def run(self) -> Result: ...
+    def result(self) -> Result: ...
+    @property
+    def time(self) -> float: ...
+    @property
+    def time_ns(self) -> int: ...
+    @property
+    def outcome(self) -> Optional[str]: ...
+    @property
+    def robots(self) -> list[str]: ...
+    def robot(self, name: str) -> Robot: ...
+    @property
+    def globals(self) -> Mapping[str, Union[bool, int, float]]: ...
+    def events_since(self, i: int = 0) -> EventList: ...
+
+@final
+class Robot:
+    """A robot of a running simulation."""
+
+    @property
+    def name(self) -> str: ...
+    @property
+    def joints(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def tcp(self) -> npt.NDArray[np.float64]: ...

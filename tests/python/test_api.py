@@ -1,0 +1,354 @@
+"""The `vworks` Python package: every name, with its error cases.
+
+Built into the test virtualenv by scripts/test (`maturin develop`); the stub check
+(`mypy.stubtest vworks`) runs there too.
+"""
+
+import inspect
+import math
+import pathlib
+import tempfile
+import threading
+import time
+import warnings
+
+import numpy as np
+import pytest
+
+import vworks
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+HANDOFF = ROOT / "workcells" / "handoff" / "cell.toml"
+MAGIC = b"WSLB"  # the bytecode format's magic (crates/vm/src/bytecode/encode.rs)
+
+
+def golden(name):
+    """A golden trace's event lines and its `# outcome` line."""
+    lines = (ROOT / "tests" / "golden" / f"{name}.trace").read_text().splitlines()
+    return [l for l in lines if not l.startswith("#")], [l for l in lines if l.startswith("# outcome")]
+
+
+def write_cell(tmp, programs, extra=""):
+    """A one- or two-robot cell in `tmp` running `programs` (robot name → WSL source)."""
+    tmp = pathlib.Path(tmp)
+    toml = 'name = "t"\n' + extra
+    for i, (name, source) in enumerate(programs.items()):
+        (tmp / f"{name}.wsl").write_text(source)
+        toml += f'[[robot]]\nname = "{name}"\nmodel = "irb120"\nprogram = "{name}.wsl"\n'
+        toml += f'base = {{ xyz = ["{i * 2000}mm", "0mm", "0mm"] }}\n'
+    (tmp / "cell.toml").write_text(toml)
+    return tmp / "cell.toml"
+
+
+# --- every public name is documented, and the package is what the stub says -------------
+
+
+def test_every_public_name_has_a_docstring():
+    for name in vworks.__all__:
+        if name == "__version__":
+            continue
+        obj = getattr(vworks, name)
+        assert (obj.__doc__ or "").strip(), name
+        if inspect.isclass(obj) and not issubclass(obj, BaseException):
+            for attr, member in vars(obj).items():
+                if not attr.startswith("_"):
+                    assert (member.__doc__ or "").strip(), f"{name}.{attr}"
+    assert vworks.__version__.count(".") == 2
+
+
+def test_exception_hierarchy():
+    for e in (vworks.CompileError, vworks.LinkError, vworks.CellError, vworks.SimulationError):
+        assert issubclass(e, vworks.Error)
+    assert issubclass(vworks.Error, Exception)
+
+
+# --- compile ------------------------------------------------------------------------------
+
+
+def test_compile_gives_a_module():
+    src = "global parts = 0;\nconst home = joints(0deg, 0deg, 0deg, 0deg, 30deg, 0deg);\n" \
+          "func twice(x: int) -> int { return 2 * x; }\nproc main() { move_j home; parts = twice(parts); }\n"
+    m = vworks.compile(src, "cell/r1.wsl")
+    assert m.path == "cell/r1.wsl"
+    assert m.globals == ["parts"]
+    assert m.procs == ["twice", "main"]
+    assert m.warnings == []
+    listing = m.disasm()
+    assert "move_j home;" in listing and "parts = twice(parts);" in listing
+    assert m.to_bytes().startswith(MAGIC)
+    assert "cell/r1.wsl" in repr(m)
+
+
+def test_compile_default_path_and_warnings():
+    m = vworks.compile("proc main() { var unused = 1; }")
+    assert m.path == "x.wsl"
+    assert all(isinstance(w, vworks.Diagnostic) and w.severity == "warning" for w in m.warnings)
+
+
+def test_compile_error_carries_every_diagnostic():
+    src = "proc main() {\n    delay 2;\n    x = 1;\n}\n"
+    with pytest.raises(vworks.CompileError) as info:
+        vworks.compile(src, "bad.wsl")
+    diags = info.value.diagnostics
+    assert len(diags) >= 2
+    first = diags[0]
+    assert (first.file, first.line, first.severity) == ("bad.wsl", 2, "error")
+    assert first.code.startswith("E") and first.col > 0
+    assert "write 2s" in (first.help or "") + first.rendered
+    assert "bad.wsl:2:" in first.rendered and "^" in first.rendered
+    assert str(first) == first.rendered
+    assert "bad.wsl" in str(info.value)
+
+
+# --- load_cell and run --------------------------------------------------------------------
+
+
+def test_the_readme_line():
+    assert vworks.load_cell(str(HANDOFF)).run().end_time == pytest.approx(63.417729589)
+
+
+def test_cell_properties():
+    cell = vworks.load_cell(HANDOFF)
+    assert cell.name == "handoff"
+    assert pathlib.Path(cell.file).name == "cell.toml"
+    assert cell.robots == ["r1", "r2"]
+    assert cell.cycle == pytest.approx(0.004)
+    assert cell.parts == ["part1"]
+    assert isinstance(cell.devices, list)
+    assert "handoff" in repr(cell)
+
+
+@pytest.mark.parametrize("name", ["handoff", "weldline", "monitor", "crash", "deadlock", "track"])
+def test_run_matches_the_golden_trace(name):
+    result = vworks.load_cell(ROOT / "workcells" / name / "cell.toml").run()
+    lines, outcome = golden(name)
+    assert [e.trace_line() for e in result.events] == lines
+    assert outcome == [f"# outcome {result.outcome} at {result.end_time_ns} ns"]
+
+
+def test_result_fields():
+    r = vworks.load_cell(HANDOFF).run()
+    assert r.outcome == "completed"
+    assert r.end_time == pytest.approx(r.end_time_ns / 1e9)
+    assert r.cycles > 15000
+    r1, r2 = r.robots
+    assert (r1.name, r2.name) == ("r1", "r2")
+    assert r1.end_time == pytest.approx(63.417729589) and r1.ended == "ended"
+    assert r1.moving + r1.waiting + r1.idle == pytest.approx(r.end_time, abs=1e-6)
+    assert r1.motions == 41 and r1.handler == 0
+    assert r.globals == {"handed": 3}
+    assert r.collisions == [] and r.errors == []
+    assert isinstance(r.warnings, list)
+    assert r.log_counts == {} and r.log_error is None
+    events = r.events
+    assert len(events) == 187
+    e = events[0]
+    assert isinstance(e, vworks.Event) and e.time == e.time_ns / 1e9
+    assert events[-1].trace_line() == list(events)[-1].trace_line()
+    assert [x.kind for x in events[:3]] == [x.kind for x in list(events)[:3]]
+    assert len(events[::2]) == 94
+    with pytest.raises(IndexError):
+        events[1000]
+    assert "completed" in repr(r)
+
+
+def test_events_to_pandas():
+    import pandas as pd  # installed in the test environment (requirements-dev.txt)
+
+    df = vworks.load_cell(HANDOFF).run(until=5.0).events.to_pandas()
+    assert list(df.columns) == ["time", "time_ns", "robot", "kind", "details", "file", "line", "col"]
+    assert len(df) > 10 and (df["kind"] == "motion_start").any()
+    assert isinstance(df, pd.DataFrame)
+
+
+def test_run_until_and_a_log(tmp_path):
+    cell = vworks.load_cell(HANDOFF)
+    log = tmp_path / "run.mcap"
+    r = cell.run(until=5, log=log, log_every=10)
+    assert r.outcome == "until" and r.end_time_ns == 5_000_000_000
+    assert r.log_counts["/events"] == len(r.events)
+    assert r.log_counts["/state"] == -(-r.cycles // 10)
+    read = vworks.read_log(log)
+    assert [e.trace_line() for e in read] == [e.trace_line() for e in r.events]
+    # A cell runs again from the start, the same way.
+    again = cell.run(until=5)
+    assert [e.trace_line() for e in again.events] == [e.trace_line() for e in r.events]
+
+
+def test_collision_and_deadlock_are_results_not_exceptions():
+    crash = vworks.load_cell(ROOT / "workcells" / "crash" / "cell.toml").run()
+    assert crash.outcome == "collision"
+    (c,) = crash.collisions
+    assert {c.a, c.b} == {"left.link_6", "right.link_6"}
+    assert c.depth > 0 and len(c.point) == 3 and c.time == pytest.approx(0.376)
+    dead = vworks.load_cell(ROOT / "workcells" / "deadlock" / "cell.toml").run()
+    assert dead.outcome == "deadlock" and dead.errors[0].kind == "deadlock"
+
+
+def test_runtime_error_raises_simulation_error(tmp_path):
+    path = write_cell(tmp_path, {"r1": 'proc main() {\n    delay 0.1s;\n    fail "gripper empty";\n}\n'})
+    cell = vworks.load_cell(path)
+    with pytest.raises(vworks.SimulationError) as info:
+        cell.run()
+    err = info.value
+    assert (err.robot, pathlib.Path(err.file).name, err.line, err.col) == ("r1", "r1.wsl", 3, 5)
+    assert "gripper empty" in str(err)
+    assert err.result.outcome == "error" and err.result.errors[0].kind == "runtime"
+    r = cell.run(check=False)
+    assert r.outcome == "error" and r.robots[0].ended == "error"
+
+
+def test_load_cell_errors(tmp_path):
+    with pytest.raises(vworks.CellError, match="nope.toml"):
+        vworks.load_cell(tmp_path / "nope.toml")
+    (tmp_path / "bad.toml").write_text('[[robot]]\nname = "r1"\nmodel = "irb9999"\nprogram = "r1.wsl"\n')
+    (tmp_path / "r1.wsl").write_text("proc main() { }\n")
+    with pytest.raises(vworks.CellError, match="irb9999"):
+        vworks.load_cell(tmp_path / "bad.toml")
+    bad = write_cell(tmp_path, {"r1": "proc main() {\n    delay 2;\n}\n"})
+    with pytest.raises(vworks.CompileError) as info:
+        vworks.load_cell(bad)
+    (d,) = [d for d in info.value.diagnostics if d.severity == "error"]
+    assert pathlib.Path(d.file).name == "r1.wsl" and d.line == 2
+    assert "delay 2;" in d.rendered
+
+
+def test_link_error(tmp_path):
+    path = write_cell(
+        tmp_path,
+        {"r1": "global g = 0;\nproc main() { g = 1; }\n", "r2": "global g = 1;\nproc main() { g = 2; }\n"},
+    )
+    with pytest.raises(vworks.LinkError) as info:
+        vworks.load_cell(path)
+    assert info.value.diagnostics and info.value.diagnostics[0].code.startswith("E01")
+    assert "g" in str(info.value)
+
+
+def test_bad_arguments(tmp_path):
+    cell = vworks.load_cell(HANDOFF)
+    with pytest.raises(ValueError, match="until"):
+        cell.run(until=-1)
+    with pytest.raises(ValueError, match="until"):
+        cell.run(until=math.nan)
+    with pytest.raises(ValueError, match="log_every"):
+        cell.run(log=tmp_path / "x.mcap", log_every=0)
+    with pytest.raises(vworks.Error, match="no such dir"):
+        cell.run(log=tmp_path / "no such dir" / "x.mcap")
+
+
+# --- stepping ---------------------------------------------------------------------------
+
+
+def test_simulation_steps_and_state():
+    cell = vworks.load_cell(HANDOFF)
+    sim = cell.simulation()
+    assert sim.time == 0 and sim.outcome is None and sim.robots == ["r1", "r2"]
+    r1 = sim.robot("r1")
+    assert r1.name == "r1"
+    assert sim.step_event()
+    first = sim.events_since(0)
+    assert len(first) >= 1
+    assert sim.step_cycle()
+    assert sim.time_ns % 4_000_000 == 0 and sim.time_ns > 0
+    assert sim.run_until(2.0) and sim.time == 2.0
+    q = r1.joints
+    assert isinstance(q, np.ndarray) and q.shape == (6,) and q.dtype == np.float64
+    tcp = r1.tcp
+    assert tcp.shape == (4, 4) and np.allclose(tcp[3], [0, 0, 0, 1])
+    assert np.allclose(tcp[:3, :3] @ tcp[:3, :3].T, np.eye(3), atol=1e-12)
+    # The robot is moving at 2 s: its joints change by 2.5 s.
+    seen = len(sim.events_since(0))
+    sim.run_until(2.5)
+    assert not np.allclose(r1.joints, q)
+    new = sim.events_since(seen)
+    assert [e.trace_line() for e in new] == [e.trace_line() for e in sim.events_since(0)[seen:]]
+    g = sim.globals
+    assert dict(g) == {"handed": 0}
+    with pytest.raises(TypeError):
+        g["handed"] = 5  # read-only
+    with pytest.raises(KeyError, match="r3"):
+        sim.robot("r3")
+    with pytest.raises(ValueError):
+        sim.run_until(-1)
+
+
+def test_stepping_gives_the_same_run_as_run():
+    cell = vworks.load_cell(HANDOFF)
+    sim = cell.simulation()
+    steps = 0
+    while sim.step_cycle():
+        steps += 1
+    assert sim.outcome == "completed" and steps > 15000
+    assert sim.globals["handed"] == 3
+    stepped = [e.trace_line() for e in sim.events_since()]
+    assert stepped == golden("handoff")[0]
+    r = sim.result()
+    assert r.outcome == "completed" and r.end_time_ns == 63_417_729_589
+    assert sim.result() is r
+    with pytest.raises(vworks.Error, match="ended"):
+        sim.step_event()
+    assert sim.time == r.end_time
+
+
+def test_simulation_run_and_early_result():
+    cell = vworks.load_cell(HANDOFF)
+    assert cell.simulation().run().end_time_ns == 63_417_729_589
+    sim = cell.simulation()
+    sim.run_until(10)
+    early = sim.result()
+    assert early.end_time == 10 and early.robots[0].end_time <= 10
+
+
+def test_stepping_into_a_runtime_error_raises(tmp_path):
+    path = write_cell(tmp_path, {"r1": 'proc main() {\n    delay 0.1s;\n    fail "gripper empty";\n}\n'})
+    sim = vworks.load_cell(path).simulation()
+    with pytest.raises(vworks.SimulationError) as info:
+        while sim.step_event():
+            pass
+    assert info.value.robot == "r1" and info.value.line == 3
+    assert sim.outcome == "error"
+
+
+def test_the_gil_is_released_while_simulating():
+    # Another Python thread keeps running while a long run simulates.
+    cell = vworks.load_cell(HANDOFF)
+    ticks = []
+    done = threading.Event()
+
+    def tick():
+        while not done.is_set():
+            ticks.append(time.perf_counter())
+            time.sleep(0.0005)
+
+    t = threading.Thread(target=tick)
+    t.start()
+    start = time.perf_counter()
+    for _ in range(3):
+        cell.run()
+    end = time.perf_counter()
+    done.set()
+    t.join()
+    during = [x for x in ticks if start < x < end]
+    assert len(during) >= 3, f"{len(during)} ticks while simulating for {end - start:.3f} s"
+
+
+# --- read_log -----------------------------------------------------------------------------
+
+
+def test_read_log_errors_and_a_cut_log(tmp_path):
+    with pytest.raises(vworks.Error, match="cannot read"):
+        vworks.read_log(tmp_path / "missing.mcap")
+    (tmp_path / "notes.mcap").write_text("hello")
+    with pytest.raises(vworks.Error, match="not an MCAP file"):
+        vworks.read_log(tmp_path / "notes.mcap")
+    log = tmp_path / "run.mcap"
+    full = vworks.load_cell(HANDOFF).run(log=log)
+    data = log.read_bytes()
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(data[: len(data) // 2])
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        part = vworks.read_log(cut)
+    assert any(issubclass(w.category, RuntimeWarning) and "unfinished" in str(w.message) for w in caught)
+    assert 20 < len(part) < len(full.events)
+    assert [e.trace_line() for e in part] == [e.trace_line() for e in full.events][: len(part)]
