@@ -129,8 +129,8 @@ fn program_error(
     } else {
         CompileError::new_err(message)
     };
-    let set = PyList::new(py, diagnostics)
-        .and_then(|list| err.value(py).setattr("diagnostics", list));
+    let set =
+        PyList::new(py, diagnostics).and_then(|list| err.value(py).setattr("diagnostics", list));
     match set {
         Ok(()) => err,
         Err(e) => e,
@@ -157,7 +157,10 @@ impl Module {
     #[getter]
     fn globals(&self) -> Vec<String> {
         let m = &self.module;
-        m.globals.iter().map(|g| m.str(g.name).to_string()).collect()
+        m.globals
+            .iter()
+            .map(|g| m.str(g.name).to_string())
+            .collect()
     }
 
     /// The module's procedures (`proc`) and functions (`func`), by name, in order.
@@ -208,7 +211,11 @@ fn compile(py: Python<'_>, source: &str, path: &str) -> PyResult<Module> {
             source: source.to_string(),
         }),
         Err(e) => {
-            let diags: Vec<Diagnostic> = e.diagnostics.iter().map(|d| diagnostic(d, &sources)).collect();
+            let diags: Vec<Diagnostic> = e
+                .diagnostics
+                .iter()
+                .map(|d| diagnostic(d, &sources))
+                .collect();
             let message = vworks_wslc::render(&e.diagnostics, &sources, false);
             Err(program_error(py, false, message, diags))
         }
@@ -240,8 +247,13 @@ fn load_cell(py: Python<'_>, path: PathBuf) -> PyResult<Cell> {
                     sources.add(&d.at.file, &text);
                 }
             }
-            let link = diagnostics.iter().any(|d| d.code.as_str().starts_with("E01"));
-            let diags = diagnostics.iter().map(|d| diagnostic(d, &sources)).collect();
+            let link = diagnostics
+                .iter()
+                .any(|d| d.code.as_str().starts_with("E01"));
+            let diags = diagnostics
+                .iter()
+                .map(|d| diagnostic(d, &sources))
+                .collect();
             Err(program_error(py, link, rendered, diags))
         }
         Err(e) => Err(CellError::new_err(e.to_string())),
@@ -386,7 +398,10 @@ fn event(cell: &vworks_se::workcell::Cell, e: &TraceEvent) -> Event {
     Event {
         time: secs(e.time),
         time_ns: e.time,
-        robot: e.robot.and_then(|r| cell.robots.get(r)).map(|r| r.name.clone()),
+        robot: e
+            .robot
+            .and_then(|r| cell.robots.get(r))
+            .map(|r| r.name.clone()),
         kind: e.kind.to_string(),
         details: e.details.clone(),
         file: e.pos.as_ref().map(|(f, _)| f.to_string()),
@@ -462,9 +477,15 @@ impl EventList {
         let e = &self.events;
         columns.set_item("time", e.iter().map(|e| e.time).collect::<Vec<_>>())?;
         columns.set_item("time_ns", e.iter().map(|e| e.time_ns).collect::<Vec<_>>())?;
-        columns.set_item("robot", e.iter().map(|e| e.robot.clone()).collect::<Vec<_>>())?;
+        columns.set_item(
+            "robot",
+            e.iter().map(|e| e.robot.clone()).collect::<Vec<_>>(),
+        )?;
         columns.set_item("kind", e.iter().map(|e| e.kind.clone()).collect::<Vec<_>>())?;
-        columns.set_item("details", e.iter().map(|e| e.details.clone()).collect::<Vec<_>>())?;
+        columns.set_item(
+            "details",
+            e.iter().map(|e| e.details.clone()).collect::<Vec<_>>(),
+        )?;
         columns.set_item("file", e.iter().map(|e| e.file.clone()).collect::<Vec<_>>())?;
         columns.set_item("line", e.iter().map(|e| e.line).collect::<Vec<_>>())?;
         columns.set_item("col", e.iter().map(|e| e.col).collect::<Vec<_>>())?;
@@ -864,7 +885,13 @@ impl Simulation {
             while s.step(None) {}
             false
         })
-        .or_else(|e| if e.is_instance_of::<SimulationError>(py) { Ok(false) } else { Err(e) })?;
+        .or_else(|e| {
+            if e.is_instance_of::<SimulationError>(py) {
+                Ok(false)
+            } else {
+                Err(e)
+            }
+        })?;
         self.result(py)
     }
 
@@ -951,7 +978,11 @@ impl Simulation {
 
     fn __repr__(&self) -> String {
         match &self.sim {
-            Some(s) => format!("<Simulation of {} at {:.3} s>", self.cell.name, secs(s.time())),
+            Some(s) => format!(
+                "<Simulation of {} at {:.3} s>",
+                self.cell.name,
+                secs(s.time())
+            ),
             None => format!("<Simulation of {} (ended)>", self.cell.name),
         }
     }
@@ -1017,7 +1048,12 @@ fn read_log(py: Python<'_>, path: PathBuf) -> PyResult<EventList> {
             "{} is unfinished or damaged after {read} messages ({damage}); the events before that were read",
             path.display()
         );
-        PyErr::warn(py, &py.get_type::<PyRuntimeWarning>(), &std::ffi::CString::new(msg).unwrap_or_default(), 1)?;
+        PyErr::warn(
+            py,
+            &py.get_type::<PyRuntimeWarning>(),
+            &std::ffi::CString::new(msg).unwrap_or_default(),
+            1,
+        )?;
     }
     Ok(EventList {
         events: log.events.into_iter().map(logged_event).collect(),
