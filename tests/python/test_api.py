@@ -110,7 +110,7 @@ def test_the_readme_line():
 def test_cell_properties():
     cell = vworks.load_cell(HANDOFF)
     assert cell.name == "handoff"
-    assert pathlib.Path(cell.file).name == "cell.toml"
+    assert isinstance(cell.file, pathlib.Path) and cell.file.name == "cell.toml"
     assert cell.robots == ["r1", "r2"]
     assert cell.cycle == pytest.approx(0.004)
     assert cell.parts == ["part1"]
@@ -352,3 +352,21 @@ def test_read_log_errors_and_a_cut_log(tmp_path):
     assert any(issubclass(w.category, RuntimeWarning) and "unfinished" in str(w.message) for w in caught)
     assert 20 < len(part) < len(full.events)
     assert [e.trace_line() for e in part] == [e.trace_line() for e in full.events][: len(part)]
+
+
+def test_warnings_are_issues():
+    r = vworks.load_cell(ROOT / "workcells" / "crash" / "cell.toml").run()
+    (w,) = r.warnings
+    assert isinstance(w, vworks.Issue)
+    assert w.kind == "near_miss" and "left.link_6 and right.link_6" in w.message
+    assert (w.robot, w.file, w.line, w.col) == (None, None, 0, 0)
+    assert "near_miss" in repr(w)
+
+
+def test_to_pandas_without_pandas_says_what_to_install(monkeypatch):
+    import sys
+
+    events = vworks.load_cell(HANDOFF).run(until=1.0).events
+    monkeypatch.setitem(sys.modules, "pandas", None)  # `import pandas` now fails
+    with pytest.raises(ImportError, match="pip install pandas"):
+        events.to_pandas()

@@ -1,6 +1,7 @@
 """Type stubs of the `vworks._vworks` extension (kept true by `mypy.stubtest` in the tests)."""
 
 import os
+import pathlib
 from collections.abc import Iterator, Mapping
 from typing import Any, Optional, Union, final, overload
 
@@ -108,7 +109,7 @@ class Cell:
     @property
     def name(self) -> str: ...
     @property
-    def file(self) -> str: ...
+    def file(self) -> pathlib.Path: ...
     @property
     def cycle(self) -> float: ...
     @property
