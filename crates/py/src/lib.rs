@@ -300,9 +300,10 @@ impl Cell {
 
     /// Runs the cell to the end, or to `until` seconds, releasing the GIL meanwhile.
     /// `log`: write an MCAP log there (every `log_every`-th cycle state). With `check`
-    /// (the default) a runtime error raises `SimulationError` (its `.result` is the run);
-    /// without, it is in the result (`outcome == "error"`, `errors`). Collisions and
-    /// deadlocks are results, not exceptions.
+    /// (the default) a runtime error raises `SimulationError` (its `.result` is the run)
+    /// and a log that could not be written raises `Error`; without, both are in the result
+    /// (`outcome == "error"`, `errors`, `log_error`). Collisions and deadlocks are results,
+    /// not exceptions.
     #[pyo3(signature = (until = None, log = None, log_every = 1, check = true))]
     fn run(
         &self,
@@ -326,6 +327,10 @@ impl Cell {
         let report = RunReport::new(&self.cell, r);
         if check && report.outcome == Outcome::Error.name() {
             return Err(report.simulation_error(py));
+        }
+        if let (true, Some(e)) = (check, &report.log_error) {
+            // The log asked for is missing or incomplete.
+            return Err(Error::new_err(e.clone()));
         }
         Ok(report)
     }
