@@ -180,7 +180,8 @@ def test_collision_and_deadlock_are_results_not_exceptions():
     assert crash.outcome == "collision"
     (c,) = crash.collisions
     assert {c.a, c.b} == {"left.link_6", "right.link_6"}
-    assert c.depth > 0 and len(c.point) == 3 and c.time == pytest.approx(0.376)
+    # Found between two 4 ms boundaries (368 and 372 ms) by the sweep, at first contact.
+    assert c.depth >= 0 and len(c.point) == 3 and 0.368 < c.time < 0.372
     dead = vworks.load_cell(ROOT / "workcells" / "deadlock" / "cell.toml").run()
     assert dead.outcome == "deadlock" and dead.errors[0].kind == "deadlock"
 

@@ -225,6 +225,10 @@ pub struct Simulation {
     log_parts: Vec<Iso>,
     /// Whether every robot has been queued (the first step does it).
     started: bool,
+    /// Time up to which contacts between boundaries have been swept for.
+    swept: i64,
+    /// Whether to sweep between boundaries at all (see [`Simulation::with_sweep`]).
+    sweep: bool,
     /// Set from outside to stop the run between two events.
     stop: Option<Arc<AtomicBool>>,
 }
@@ -319,6 +323,8 @@ impl Simulation {
             log_error: None,
             moving: Vec::with_capacity(cell.robots.len()),
             started: false,
+            swept: 0,
+            sweep: true,
             log_parts: Vec::new(),
             stop: None,
             cell,
@@ -328,6 +334,15 @@ impl Simulation {
     /// Writes the run to an MCAP log (see [`crate::mcaplog`]).
     pub fn with_log(mut self, log: crate::mcaplog::McapLog) -> Simulation {
         self.log = Some(log);
+        self
+    }
+
+    /// With `false`, collisions are checked at cycle boundaries only, as in the paper: a
+    /// body that passes through another between two boundaries goes unnoticed. The default
+    /// (`true`) also sweeps the time between boundaries ([`Collider::sweep`]). For
+    /// comparison and testing.
+    pub fn with_sweep(mut self, sweep: bool) -> Simulation {
+        self.sweep = sweep;
         self
     }
 
@@ -379,7 +394,7 @@ impl Simulation {
             }
         }
         self.advance_cycles(t);
-        if self.outcome.is_some() {
+        if self.outcome.is_some() || self.sweep_until(t) {
             return false;
         }
         self.time = self.time.max(t);
@@ -585,12 +600,15 @@ impl Simulation {
             && t > u
         {
             self.advance_cycles(u);
+            if self.outcome.is_some() || self.sweep_until(u) {
+                return false;
+            }
             self.time = u;
             self.outcome = Some(Outcome::Until);
             return false;
         }
         self.advance_cycles(t);
-        if self.outcome.is_some() {
+        if self.outcome.is_some() || self.sweep_until(t) {
             return false;
         }
         self.time = t;
@@ -620,11 +638,55 @@ impl Simulation {
         self.outcome.is_none()
     }
 
+    /// Records a collision that started; true if the run stops on it.
+    fn collision_started(&mut self, contact: Contact) -> bool {
+        let d = format!(
+            "{} {} depth={} point=({:.4}, {:.4}, {:.4})",
+            contact.a,
+            contact.b,
+            fmt_quantity(contact.depth, vworks_vm::Dim::LENGTH),
+            contact.point[0],
+            contact.point[1],
+            contact.point[2]
+        );
+        let t = contact.time_ns;
+        self.record(t, None, "collision_start", d, None);
+        self.collisions.push(contact);
+        if self.cell.stop_on_collision {
+            self.time = t;
+            self.outcome = Some(Outcome::Collision);
+            return true;
+        }
+        false
+    }
+
+    /// Sweeps the time since the last sweep up to (not including) `t` for contacts
+    /// between boundaries (see [`Collider::sweep`]); runs before every boundary and
+    /// before every event, so motions do not change within a swept stretch. True if the
+    /// run stopped on a contact.
+    fn sweep_until(&mut self, t: i64) -> bool {
+        if !self.sweep || t <= self.swept {
+            return false;
+        }
+        let contacts = self.collider.sweep(&self.cell, &self.vms, self.swept, t);
+        self.swept = t;
+        for contact in contacts {
+            if self.collision_started(contact) {
+                return true;
+            }
+        }
+        false
+    }
+
     /// Processes every cycle boundary up to and including `t`.
     fn advance_cycles(&mut self, t: i64) {
         let c = self.cell.cycle_ns;
         while self.next_boundary <= t {
             let b = self.next_boundary;
+            // A contact before the boundary may end the run before it is reached.
+            if self.sweep_until(b) {
+                return;
+            }
             self.next_boundary += c;
             self.cycles += 1;
             self.moving.clear();
@@ -634,20 +696,7 @@ impl Simulation {
             for ev in events {
                 match ev {
                     crate::collide::CollisionEvent::Start(contact) => {
-                        let d = format!(
-                            "{} {} depth={} point=({:.4}, {:.4}, {:.4})",
-                            contact.a,
-                            contact.b,
-                            fmt_quantity(contact.depth, vworks_vm::Dim::LENGTH),
-                            contact.point[0],
-                            contact.point[1],
-                            contact.point[2]
-                        );
-                        self.record(b, None, "collision_start", d, None);
-                        self.collisions.push(contact);
-                        if self.cell.stop_on_collision {
-                            self.time = b;
-                            self.outcome = Some(Outcome::Collision);
+                        if self.collision_started(contact) {
                             return;
                         }
                     }

@@ -351,7 +351,8 @@ allow_collision = [["r1.tool0", "block"], ["r1.link_6", "block"]]
     assert_eq!(kinds[0].0, "collision_start");
     assert!(kinds[0].1.starts_with("post block"), "{kinds:?}");
     assert_eq!(kinds[1], ("collision_end", "post block"));
-    assert!(r.collisions.iter().all(|c| c.depth > 0.0));
+    // Found by the sweep between boundaries: at first touch, so no depth yet.
+    assert!(r.collisions.iter().all(|c| c.depth >= 0.0));
 }
 
 #[test]

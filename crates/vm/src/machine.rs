@@ -257,6 +257,9 @@ struct MotionOperands {
 }
 
 /// A planned motion.
+// One per VM (its current motion), never in a collection: the variants' sizes do not
+// matter, and boxing would add an allocation per motion.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug)]
 enum Trajectory {
     /// Joint-space: each axis from `from` by `delta` along a shared normalised profile.
@@ -274,6 +277,9 @@ enum Trajectory {
         end_joints: [f64; MAX_AXES],
         /// The analytic IK branch the motion stays on (spherical-wrist arms).
         branch: Option<u8>,
+        /// Per axis, the largest speed found at the samples the motion was checked at
+        /// (rad/s or m/s).
+        rates: [f64; MAX_AXES],
     },
 }
 
@@ -594,6 +600,7 @@ impl Vm {
                 profile,
                 end_joints,
                 branch,
+                ..
             } => {
                 if dt >= profile.t_total {
                     return *end_joints;
@@ -621,6 +628,24 @@ impl Vm {
                 q
             }
         }
+    }
+
+    /// Per axis, a bound on its speed during the current motion (rad/s or m/s; 0 when
+    /// not moving): for a joint motion exact; for a Cartesian one the largest speed at the
+    /// 64 samples its axis speeds were checked at (between samples it can be somewhat
+    /// higher; the collision sweep adds a margin).
+    pub fn axis_rate_bounds(&self) -> [f64; MAX_AXES] {
+        let mut out = [0.0; MAX_AXES];
+        match &self.motion {
+            Some((_, Trajectory::Joint { delta, profile, .. })) if profile.dist > 0.0 => {
+                for (o, d) in out.iter_mut().zip(delta) {
+                    *o = d.abs() * profile.v / profile.dist;
+                }
+            }
+            Some((_, Trajectory::Cartesian { rates, .. })) => out = *rates,
+            _ => {}
+        }
+        out
     }
 
     /// The TCP pose at time `t`.
@@ -1122,6 +1147,7 @@ impl Vm {
                 profile: Profile::new(0.0, 1.0, 1.0),
                 end_joints: from,
                 branch: None,
+                rates: [0.0; MAX_AXES],
             };
             return Ok((traj, 0));
         }
@@ -1130,6 +1156,7 @@ impl Vm {
         let mut prev = from;
         let mut worst = 1.0f64;
         let mut worst_axis = 0;
+        let mut rates = [0.0f64; MAX_AXES];
         for k in 1..=SAMPLES {
             let s = k as f64 / SAMPLES as f64;
             let pose = cartesian_at(&path, &start, &goal, s);
@@ -1139,6 +1166,7 @@ impl Vm {
             for i in 0..n {
                 // ds/dt at most vs: axis speed ≈ |Δq/Δs|·vs.
                 let rate = (q[i] - prev[i]).abs() * SAMPLES as f64 * vs;
+                rates[i] = rates[i].max(rate);
                 let j = self.model.axis(i);
                 if rate > j.max_velocity && j.max_velocity / rate < worst {
                     worst = j.max_velocity / rate;
@@ -1150,6 +1178,9 @@ impl Vm {
         if worst < 1.0 {
             vs *= worst;
             as_ *= worst;
+            for r in &mut rates {
+                *r *= worst;
+            }
             let pos = self.m.pos_of(self.main.pc);
             let j = self.model.axis(worst_axis);
             self.warnings.push((
@@ -1171,6 +1202,7 @@ impl Vm {
                 profile,
                 end_joints: prev,
                 branch,
+                rates,
             },
             dur,
         ))

@@ -1,0 +1,167 @@
+//! Contacts between cycle boundaries: a body that passes through another between two
+//! boundaries is found, at its first-contact time, by the sweep (conservative
+//! advancement) — checked against an analytic contact time and against a per-cycle check
+//! with a 40× finer cycle.
+
+#![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)] // tests fail by panicking
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use vworks_se::engine::{Outcome, RunResult, Simulation};
+use vworks_se::workcell::load;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn write_cell(name: &str, files: &[(&str, &str)]) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("vworks-sweep-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    for (f, text) in files {
+        std::fs::write(dir.join(f), text).unwrap();
+    }
+    dir.join("cell.toml")
+}
+
+fn run(path: &std::path::Path) -> RunResult {
+    run_with(path, true)
+}
+
+fn run_with(path: &std::path::Path, sweep: bool) -> RunResult {
+    let cell = Arc::new(load(path).unwrap_or_else(|e| panic!("{e}")));
+    let r = Simulation::new(cell).with_sweep(sweep).run(None);
+    let times: Vec<i64> = r.trace.iter().map(|e| e.time).collect();
+    assert!(times.is_sorted(), "the trace is in time order");
+    r
+}
+
+/// A 1 cm blade on a linear axis (3 m/s, full speed in 0.3 s) and a 2 mm plate.
+const SLIDER: &str = r#"<?xml version="1.0"?>
+<robot name="slider">
+  <link name="base_link"/>
+  <link name="blade">
+    <collision><geometry><box size="0.01 0.5 0.5"/></geometry></collision>
+  </link>
+  <joint name="slide" type="prismatic">
+    <parent link="base_link"/>
+    <child link="blade"/>
+    <origin xyz="0 0 0.5" rpy="0 0 0"/>
+    <axis xyz="1 0 0"/>
+    <limit lower="0" upper="2" velocity="3" effort="0"/>
+  </joint>
+</robot>
+"#;
+
+#[test]
+fn a_blade_passing_through_a_thin_plate_between_boundaries_is_found() {
+    let cell = r#"
+name = "plate"
+cycle = "12ms"
+clearance = "1mm"
+on_collision = "continue"
+[[robot]]
+name = "s"
+urdf = "slider.urdf"
+program = "s.wsl"
+[[device]]
+name = "plate"
+box = ["2mm", "500mm", "500mm"]
+pose = { xyz = ["610mm", "0mm", "500mm"] }
+"#;
+    let prog = "proc main() {\n    move_j joints(1500mm) speed 100%;\n}\n";
+    let path = write_cell(
+        "plate",
+        &[
+            ("cell.toml", cell),
+            ("slider.urdf", SLIDER),
+            ("s.wsl", prog),
+        ],
+    );
+    let r = run(&path);
+    // The motion: 10 m/s² to 3 m/s (0.3 s, 0.45 m), then 3 m/s. The blade's front face
+    // (q + 5 mm) meets the plate's back face (609 mm) at q = 0.604 m: 0.3 s + 0.154 m /
+    // 3 m/s. Its back face leaves the plate's front (611 mm) at q = 0.616 m, 4 ms later:
+    // between the boundaries at 348 ms (q = 0.594) and 360 ms (q = 0.630) the blade is
+    // through, so a check at boundaries alone never sees it touch.
+    let analytic = 0.3 + 0.154 / 3.0;
+    let q = |t: f64| 0.45 + 3.0 * (t - 0.3);
+    assert!(q(0.348) + 0.005 < 0.609 && q(0.360) - 0.005 > 0.611);
+    let (c,) = match &r.collisions[..] {
+        [c] => (c,),
+        other => panic!("{other:?}"),
+    };
+    assert_eq!((c.a.as_str(), c.b.as_str()), ("s.blade", "plate"));
+    let t = c.time_ns as f64 / 1e9;
+    assert!(t > 0.348 && t < 0.360);
+    // First contact to within 0.1 ms, as the issue asks; in fact within 2 µs (one minimum
+    // step late at most, and early only by parry's f32 precision).
+    assert!((analytic - t).abs() < 1e-4, "{t} vs {analytic}");
+    assert!((analytic - t).abs() < 2e-6, "{t} vs {analytic}");
+    // With boundary checks only, the run sees nothing.
+    assert!(run_with(&path, false).collisions.is_empty());
+    // It starts touching and, by the next boundary, has passed.
+    let kinds: Vec<(i64, &str)> = r
+        .trace
+        .iter()
+        .filter(|e| e.kind.starts_with("collision"))
+        .map(|e| (e.time, e.kind))
+        .collect();
+    assert_eq!(
+        kinds,
+        [
+            (c.time_ns, "collision_start"),
+            (360_000_000, "collision_end")
+        ]
+    );
+    assert_eq!(r.outcome, Outcome::Completed);
+}
+
+#[test]
+fn the_sweep_agrees_with_a_40x_finer_cycle() {
+    // The crash cell: its arms meet between two 4 ms boundaries. With a 0.1 ms cycle (the
+    // shortest a workcell allows) the per-cycle check finds the first boundary in contact;
+    // the sweep with 4 ms must agree with it to within 0.1 ms.
+    let dir = root().join("workcells/crash");
+    let toml = std::fs::read_to_string(dir.join("cell.toml")).unwrap();
+    let left = std::fs::read_to_string(dir.join("left.wsl")).unwrap();
+    let right = std::fs::read_to_string(dir.join("right.wsl")).unwrap();
+    let coarse = run(&write_cell(
+        "coarse",
+        &[
+            ("cell.toml", &toml),
+            ("left.wsl", &left),
+            ("right.wsl", &right),
+        ],
+    ));
+    let fine_toml = toml.replace("cycle = \"4ms\"", "cycle = \"0.1ms\"");
+    assert_ne!(fine_toml, toml);
+    let fine = run_with(
+        &write_cell(
+            "fine",
+            &[
+                ("cell.toml", &fine_toml),
+                ("left.wsl", &left),
+                ("right.wsl", &right),
+            ],
+        ),
+        false, // boundaries only: the oracle
+    );
+    assert_eq!(
+        (coarse.outcome, fine.outcome),
+        (Outcome::Collision, Outcome::Collision)
+    );
+    let (t, t_fine) = (coarse.collisions[0].time_ns, fine.collisions[0].time_ns);
+    // The true first contact lies in (t_fine − 0.1 ms, t_fine]; the sweep must be within
+    // 0.1 ms of it. (Here the arms touch almost exactly at a fine boundary, 370.1 ms, where
+    // parry finds a gap of 3.5e-11 m; the sweep reports 370.085 ms, where parry's f32
+    // capsule query already reads 0 for a gap of about 15 µm.)
+    assert!(
+        t > t_fine - 200_000 && t <= t_fine + 1_000,
+        "sweep {t} ns, 0.1 ms cycles {t_fine} ns"
+    );
+    // Both runs report the same pair.
+    let pair = |r: &RunResult| (r.collisions[0].a.clone(), r.collisions[0].b.clone());
+    assert_eq!(pair(&coarse), pair(&fine));
+}
