@@ -274,6 +274,9 @@ fn run_cell(
             "globals": r.globals.iter().map(|(k, v)| (k.clone(), serde_json::Value::String(v.clone()))).collect::<serde_json::Map<_, _>>(),
             "cycles": r.cycles,
             "collision_queries": r.queries,
+            // Narrow-phase queries per cycle boundary (adaptive checking and the sweep
+            // between boundaries included).
+            "queries_per_cycle": if r.cycles > 0 { r.queries as f64 / r.cycles as f64 } else { 0.0 },
             "events": r.trace.len(),
             "log": log.map(|p| serde_json::json!({
                 "file": p.display().to_string(),

@@ -162,6 +162,12 @@ fn run_json_has_the_contracts_fields() {
         .unwrap_or_else(|e| panic!("{e}: {}", text(&out.stdout)));
     assert_eq!(v["outcome"], "collision");
     assert!(v["end_time_ns"].as_i64().unwrap_or(0) > 0);
+    let (queries, cycles) = (v["collision_queries"].as_f64(), v["cycles"].as_f64());
+    let per_cycle = v["queries_per_cycle"].as_f64();
+    assert!(
+        matches!((queries, cycles, per_cycle), (Some(q), Some(c), Some(p)) if c > 0.0 && (q / c - p).abs() < 1e-9),
+        "{v}"
+    );
     for key in [
         "name",
         "moving_ns",

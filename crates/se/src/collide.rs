@@ -185,6 +185,14 @@ pub struct Collider {
     sweep_scratch: SweepScratch,
     /// The time `frames` and `poses` are for (the last check's), once there was one.
     checked_at: Option<i64>,
+    /// Adaptive checking: per pair (`i * n + j`), the time before which the current
+    /// motions cannot bring it within the clearance, so its query can be skipped.
+    /// Cleared whenever a motion starts or a part is gripped or released.
+    safe_until: Vec<i64>,
+    /// Whether to skip queries by `safe_until` (see [`Collider::set_adaptive`]).
+    adaptive: bool,
+    /// Boundary checks made (for queries per check).
+    pub checks: u64,
 }
 
 impl std::fmt::Debug for Collider {
@@ -336,8 +344,23 @@ impl Collider {
             queries: 0,
             sweep_scratch: SweepScratch::default(),
             checked_at: None,
+            safe_until: vec![i64::MIN; n * n],
+            adaptive: true,
+            checks: 0,
             bodies,
         }
+    }
+
+    /// With `false`, every pair the broadphase keeps is queried at every boundary (the
+    /// exhaustive check adaptive checking is tested against).
+    pub fn set_adaptive(&mut self, adaptive: bool) {
+        self.adaptive = adaptive;
+    }
+
+    /// A motion started, or a part was gripped or released: the speed bounds behind the
+    /// skipped queries no longer hold.
+    pub fn motions_changed(&mut self) {
+        self.safe_until.fill(i64::MIN);
     }
 
     /// Robot `r`'s tool link in the cell at time `t` (the frames of the last check stay).
@@ -353,6 +376,7 @@ impl Collider {
         let pose = self.current_part_pose(p, cell, t, None);
         self.held[p] = Some((r, tool.inverse().mul(&pose)));
         self.dirty = true;
+        self.motions_changed();
     }
 
     /// Part `p` is released at time `t` and stays where it is.
@@ -363,6 +387,7 @@ impl Collider {
         }
         self.held[p] = None;
         self.dirty = true;
+        self.motions_changed();
     }
 
     /// Every robot's link frames in the cell as of the last [`Collider::check`] (which
@@ -475,6 +500,19 @@ impl Collider {
             };
         }
         self.checked_at = Some(t);
+        self.checks += 1;
+        // Adaptive checking: each joint's speed bound under the current motions.
+        let mut joint_speed = std::mem::take(&mut self.sweep_scratch.disp);
+        joint_speed.resize_with(cell.robots.len(), Vec::new);
+        for ((robot, vm), js) in cell.robots.iter().zip(vms).zip(joint_speed.iter_mut()) {
+            let rates = vm.axis_rate_bounds();
+            js.clear();
+            js.resize(robot.model.joints.len(), 0.0);
+            for (i, &j) in robot.model.axes.iter().enumerate() {
+                js[j] = SPEED_MARGIN * rates[i];
+            }
+        }
+        let n = self.bodies.len();
         // Sort and sweep along x.
         let aabbs = &self.aabbs;
         self.order
@@ -502,17 +540,45 @@ impl Collider {
                 if static_pair {
                     continue;
                 }
+                let idx = pair.0 * n + pair.1;
+                if self.adaptive && t < self.safe_until[idx] {
+                    continue; // provably farther than the clearance until then
+                }
+                // Held parts' speeds are not bounded here: always queried.
+                let v = if self.is_held(a.owner) || self.is_held(b.owner) {
+                    f64::INFINITY
+                } else {
+                    self.closing_speed(pair, &joint_speed)
+                };
+                // Look ahead as far as the pair can close in 20 cycles, at most 0.5 m.
+                let lookahead = (v * 20.0 * cell.cycle_ns as f64 / 1e9).min(0.5);
                 self.queries += 1;
-                let Ok(Some(c)) = parry3d::query::contact(
+                let found = parry3d::query::contact(
                     &self.poses[pair.0],
                     a.shape.as_ref(),
                     &self.poses[pair.1],
                     b.shape.as_ref(),
-                    margin,
-                ) else {
+                    margin + lookahead as f32,
+                );
+                let gap = match &found {
+                    Ok(Some(c)) => f64::from(c.dist),
+                    Ok(None) => f64::from(margin) + lookahead,
+                    Err(_) => 0.0,
+                };
+                self.safe_until[idx] = if v <= 0.0 {
+                    i64::MAX
+                } else if v.is_finite() && gap > cell.clearance {
+                    t.saturating_add(((gap - cell.clearance) / v * 1e9) as i64)
+                } else {
+                    i64::MIN
+                };
+                let Ok(Some(c)) = found else {
                     continue;
                 };
                 let dist = f64::from(c.dist);
+                if dist > f64::from(margin) {
+                    continue; // found only by the look-ahead
+                }
                 if dist <= 0.0 {
                     touching.insert(pair);
                     if !self.touching.contains(&pair) {
@@ -551,7 +617,30 @@ impl Collider {
         }
         self.touching = touching;
         self.near = near_now;
+        self.sweep_scratch.disp = joint_speed;
         events
+    }
+
+    /// A bound on how fast bodies `i` and `j` can approach each other under the joint
+    /// speeds `joint_speed` (m/s); bodies of one robot count only unshared joints.
+    fn closing_speed(&self, (i, j): (usize, usize), joint_speed: &[Vec<f64>]) -> f64 {
+        let (a, b) = (&self.bodies[i], &self.bodies[j]);
+        let own = |x: &BodyRef| match x.owner {
+            Owner::Link { robot, .. } => Some(robot),
+            _ => None,
+        };
+        let sum = |body: &BodyRef, other: Option<&BodyRef>| -> f64 {
+            let Some(r) = own(body) else { return 0.0 };
+            body.reach
+                .iter()
+                .filter(|(jt, _)| other.is_none_or(|o| !o.reach.iter().any(|(k, _)| k == jt)))
+                .map(|(jt, arm)| joint_speed[r][*jt] * arm)
+                .sum()
+        };
+        match (own(a), own(b)) {
+            (Some(ra), Some(rb)) if ra == rb => sum(a, Some(b)) + sum(b, Some(a)),
+            _ => sum(a, None) + sum(b, None),
+        }
     }
 
     /// Sweeps the time `[from, to)`, in which no event changes any motion: for every pair
@@ -698,7 +787,10 @@ impl Collider {
         let pairs = std::mem::take(&mut sw.pairs);
         for &(i, j) in &pairs {
             {
-                if sw.bound[i] + sw.bound[j] <= 0.0 || self.skip_dense[i * nb + j] {
+                if sw.bound[i] + sw.bound[j] <= 0.0
+                    || self.skip_dense[i * nb + j]
+                    || (self.adaptive && to <= self.safe_until[i * nb + j])
+                {
                     continue;
                 }
                 let (a, b) = (&self.bodies[i], &self.bodies[j]);

@@ -165,3 +165,45 @@ fn the_sweep_agrees_with_a_40x_finer_cycle() {
     let pair = |r: &RunResult| (r.collisions[0].a.clone(), r.collisions[0].b.clone());
     assert_eq!(pair(&coarse), pair(&fine));
 }
+
+#[test]
+fn adaptive_checking_finds_what_the_exhaustive_check_finds() {
+    // Every example cell, and the crash cell going on through its collision: skipping the
+    // queries that speed bounds prove unneeded changes no event, only the query count.
+    let mut cells: Vec<PathBuf> = [
+        "handoff", "weldline", "monitor", "crash", "deadlock", "track",
+    ]
+    .iter()
+    .map(|n| root().join("workcells").join(n).join("cell.toml"))
+    .collect();
+    let dir = root().join("workcells/crash");
+    let toml = std::fs::read_to_string(dir.join("cell.toml"))
+        .unwrap()
+        .replace("on_collision = \"stop\"", "on_collision = \"continue\"");
+    let back = "proc main() {\n    move_j joints(0deg, 60deg, -30deg, 0deg, 30deg, 0deg) speed 50%;\n    move_j joints(0deg, -30deg, 30deg, 0deg, 60deg, 0deg) speed 50%;\n}\n";
+    cells.push(write_cell(
+        "through",
+        &[
+            ("cell.toml", &toml),
+            ("left.wsl", back),
+            ("right.wsl", back),
+        ],
+    ));
+    for path in &cells {
+        let cell = Arc::new(load(path).unwrap());
+        let run = |adaptive: bool| {
+            Simulation::new(Arc::clone(&cell))
+                .with_adaptive(adaptive)
+                .run(None)
+        };
+        let (fast, all) = (run(true), run(false));
+        let lines = |r: &RunResult| r.trace.iter().map(|e| e.line(&cell)).collect::<Vec<_>>();
+        assert_eq!(lines(&fast), lines(&all), "{}", path.display());
+        assert_eq!(fast.collisions, all.collisions);
+        assert!(fast.queries <= all.queries, "{}", path.display());
+        eprintln!(
+            "{}: {} queries adaptive, {} exhaustive ({} cycles)",
+            cell.name, fast.queries, all.queries, all.cycles
+        );
+    }
+}
