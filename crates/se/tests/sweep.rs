@@ -207,3 +207,51 @@ fn adaptive_checking_finds_what_the_exhaustive_check_finds() {
         );
     }
 }
+
+use proptest::prelude::Strategy as _;
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig { cases: 16, ..Default::default() })]
+
+    /// Two arms facing each other move through random joint targets (meeting or not):
+    /// adaptive checking reports exactly the contacts and near misses the exhaustive
+    /// check reports.
+    #[test]
+    fn adaptive_equals_exhaustive_on_random_motions(
+        // Around the crash cell's meeting pose (0, 60, -30, 0, 30, 0) deg: some meet,
+        // some pass close, some stay apart.
+        targets in proptest::collection::vec(
+            (-25i32..25, 20i32..75, -60i32..0, -40i32..40, 0i32..60, -40i32..40)
+                .prop_map(|(a, b, c, d, e, f)| vec![a, b, c, d, e, f]),
+            4,
+        ),
+        speed in 20i32..100,
+    ) {
+        let dir = root().join("workcells/crash");
+        let toml = std::fs::read_to_string(dir.join("cell.toml"))
+            .unwrap()
+            .replace("on_collision = \"stop\"", "on_collision = \"continue\"");
+        let program = |pair: &[Vec<i32>]| {
+            let mut p = String::from("proc main() {\n");
+            for t in pair {
+                let j: Vec<String> = t.iter().map(|d| format!("{d}deg")).collect();
+                p += &format!("    move_j joints({}) speed {speed}%;\n", j.join(", "));
+            }
+            p + "}\n"
+        };
+        let path = write_cell(
+            "random",
+            &[
+                ("cell.toml", &toml),
+                ("left.wsl", &program(&targets[..2])),
+                ("right.wsl", &program(&targets[2..])),
+            ],
+        );
+        let cell = Arc::new(load(&path).unwrap());
+        let run = |adaptive: bool| Simulation::new(Arc::clone(&cell)).with_adaptive(adaptive).run(None);
+        let (fast, all) = (run(true), run(false));
+        let lines = |r: &RunResult| r.trace.iter().map(|e| e.line(&cell)).collect::<Vec<_>>();
+        proptest::prop_assert_eq!(lines(&fast), lines(&all));
+        proptest::prop_assert!(fast.queries <= all.queries);
+    }
+}
