@@ -167,8 +167,7 @@ pub struct Collider {
     poses: Vec<Pose>,
     aabbs: Vec<Aabb>,
     order: Vec<usize>,
-    skip: BTreeSet<(usize, usize)>,
-    /// `skip` as a dense matrix (`i * n + j`), for the sweep's all-pairs loop.
+    /// Pairs never checked, as a dense matrix (`i * n + j`, both orders).
     skip_dense: Vec<bool>,
     touching: BTreeSet<(usize, usize)>,
     near: BTreeSet<(usize, usize)>,
@@ -329,7 +328,6 @@ impl Collider {
             poses: vec![Pose::IDENTITY; n],
             aabbs: vec![Aabb::new_invalid(); n],
             order: (0..n).collect(),
-            skip,
             touching: BTreeSet::new(),
             near: BTreeSet::new(),
             held: vec![None; cell.parts.len()],
@@ -529,7 +527,7 @@ impl Collider {
                     continue;
                 }
                 let pair = (i.min(j), i.max(j));
-                if self.skip.contains(&pair) || self.held_by(pair, cell) {
+                if self.skip_dense[pair.0 * n + pair.1] || self.held_by(pair, cell) {
                     continue;
                 }
                 let (a, b) = (&self.bodies[pair.0], &self.bodies[pair.1]);
@@ -774,8 +772,11 @@ impl Collider {
                 [f64::from(c.x) + r, f64::from(c.y) + r, f64::from(c.z) + r],
             ));
         }
-        sw.order.clear();
-        sw.order.extend(0..nb);
+        // The order of the last sweep is nearly sorted already: sorting it is near linear.
+        if sw.order.len() != nb {
+            sw.order.clear();
+            sw.order.extend(0..nb);
+        }
         let boxes = &sw.reach_box;
         sw.order
             .sort_by(|a, b| boxes[*a].0[0].total_cmp(&boxes[*b].0[0]).then(a.cmp(b)));
@@ -792,7 +793,7 @@ impl Collider {
                 }
             }
         }
-        sw.pairs.sort_unstable();
+        // (Pairs are advanced independently; the contacts found are sorted below.)
         let pairs = std::mem::take(&mut sw.pairs);
         for &(i, j) in &pairs {
             {
