@@ -169,6 +169,10 @@ pub struct Collider {
     order: Vec<usize>,
     /// Pairs never checked, as a dense matrix (`i * n + j`, both orders).
     skip_dense: Vec<bool>,
+    /// For two link bodies of one robot (`i * n + j`): how many leading entries of each
+    /// one's `reach` are joints the other does not have (the shared joints, above their
+    /// common ancestor, come last and move both alike).
+    unshared: Vec<(u8, u8)>,
     touching: BTreeSet<(usize, usize)>,
     near: BTreeSet<(usize, usize)>,
     /// Per part: the robot holding it and the part's pose in that robot's tool-link frame.
@@ -318,6 +322,20 @@ impl Collider {
             }
         }
         let n = bodies.len();
+        let mut unshared = vec![(0u8, 0u8); n * n];
+        for i in 0..n {
+            for j in 0..n {
+                let (a, b) = (&bodies[i], &bodies[j]);
+                let only = |x: &BodyRef, y: &BodyRef| {
+                    x.reach
+                        .iter()
+                        .take_while(|(jt, _)| !y.reach.iter().any(|(k, _)| k == jt))
+                        .count()
+                        .min(u8::MAX as usize) as u8
+                };
+                unshared[i * n + j] = (only(a, b), only(b, a));
+            }
+        }
         let mut skip_dense = vec![false; n * n];
         for &(i, j) in &skip {
             skip_dense[i * n + j] = true;
@@ -325,6 +343,7 @@ impl Collider {
         }
         Collider {
             skip_dense,
+            unshared,
             poses: vec![Pose::IDENTITY; n],
             aabbs: vec![Aabb::new_invalid(); n],
             order: (0..n).collect(),
@@ -636,17 +655,20 @@ impl Collider {
             Owner::Link { robot, .. } => Some(robot),
             _ => None,
         };
-        let sum = |body: &BodyRef, other: Option<&BodyRef>| -> f64 {
+        let sum = |body: &BodyRef, take: usize| -> f64 {
             let Some(r) = own(body) else { return 0.0 };
             body.reach
                 .iter()
-                .filter(|(jt, _)| other.is_none_or(|o| !o.reach.iter().any(|(k, _)| k == jt)))
+                .take(take)
                 .map(|(jt, arm)| joint_speed[r][*jt] * arm)
                 .sum()
         };
         match (own(a), own(b)) {
-            (Some(ra), Some(rb)) if ra == rb => sum(a, Some(b)) + sum(b, Some(a)),
-            _ => sum(a, None) + sum(b, None),
+            (Some(ra), Some(rb)) if ra == rb => {
+                let (na, nb) = self.unshared[i * self.bodies.len() + j];
+                sum(a, usize::from(na)) + sum(b, usize::from(nb))
+            }
+            _ => sum(a, usize::MAX) + sum(b, usize::MAX),
         }
     }
 
@@ -851,7 +873,22 @@ impl Collider {
             self.owner_reach(a, &sw.held_reach),
             self.owner_reach(b, &sw.held_reach),
         ) {
+            (Some((ra, reach_a)), Some((rb, reach_b)))
+                if ra == rb
+                    && matches!(a.owner, Owner::Link { .. })
+                    && matches!(b.owner, Owner::Link { .. }) =>
+            {
+                let (na, nb) = self.unshared[i * self.bodies.len() + j];
+                let sum = |x: &[(usize, f64)], k: u8| -> f64 {
+                    x.iter()
+                        .take(usize::from(k))
+                        .map(|(jt, arm)| sw.disp[ra][*jt] * arm)
+                        .sum()
+                };
+                sum(reach_a, na) + sum(reach_b, nb)
+            }
             (Some((ra, reach_a)), Some((rb, reach_b))) if ra == rb => {
+                // A held part and a link of the robot holding it: shared joints cancel.
                 let only = |x: &[(usize, f64)], y: &[(usize, f64)]| -> f64 {
                     x.iter()
                         .filter(|(j, _)| !y.iter().any(|(k, _)| k == j))
