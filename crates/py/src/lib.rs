@@ -674,24 +674,30 @@ impl RunReport {
     /// The `SimulationError` for this run's first error (its `.result` is the run).
     fn simulation_error(self, py: Python<'_>) -> PyErr {
         let first = self.errors.first().cloned();
-        let message = first
-            .as_ref()
-            .map_or_else(|| "the run ended with an error".to_string(), error_text);
-        let err = SimulationError::new_err(message);
-        let set = || -> PyResult<()> {
-            let v = err.value(py);
-            let first = first.as_ref();
-            v.setattr("robot", first.and_then(|i| i.robot.clone()))?;
-            v.setattr("file", first.and_then(|i| i.file.clone()))?;
-            v.setattr("line", first.map_or(0, |i| i.line))?;
-            v.setattr("col", first.map_or(0, |i| i.col))?;
-            v.setattr("result", Py::new(py, self)?)?;
-            Ok(())
-        };
-        match set() {
-            Ok(()) => err,
+        match Py::new(py, self) {
+            Ok(report) => simulation_error(py, first.as_ref(), report.into_any()),
             Err(e) => e,
         }
+    }
+}
+
+/// A `SimulationError` for the run's first error `first`, with its robot, file, line and
+/// column as attributes and `result` (a `Result`, or None).
+fn simulation_error(py: Python<'_>, first: Option<&PyIssue>, result: Py<PyAny>) -> PyErr {
+    let message = first.map_or_else(|| "a robot's program failed".to_string(), error_text);
+    let err = SimulationError::new_err(message);
+    let set = || -> PyResult<()> {
+        let v = err.value(py);
+        v.setattr("robot", first.and_then(|i| i.robot.clone()))?;
+        v.setattr("file", first.and_then(|i| i.file.clone()))?;
+        v.setattr("line", first.map_or(0, |i| i.line))?;
+        v.setattr("col", first.map_or(0, |i| i.col))?;
+        v.setattr("result", result)?;
+        Ok(())
+    };
+    match set() {
+        Ok(()) => err,
+        Err(e) => e,
     }
 }
 
@@ -828,18 +834,7 @@ impl Simulation {
         let going = py.detach(|| f(sim));
         if sim.outcome() == Some(Outcome::Error) {
             let first = sim.errors().first().map(issue);
-            let message = first
-                .as_ref()
-                .map_or_else(|| "a robot's program failed".to_string(), error_text);
-            let err = SimulationError::new_err(message);
-            let v = err.value(py);
-            let first = first.as_ref();
-            v.setattr("robot", first.and_then(|i| i.robot.clone()))?;
-            v.setattr("file", first.and_then(|i| i.file.clone()))?;
-            v.setattr("line", first.map_or(0, |i| i.line))?;
-            v.setattr("col", first.map_or(0, |i| i.col))?;
-            v.setattr("result", py.None())?;
-            return Err(err);
+            return Err(simulation_error(py, first.as_ref(), py.None()));
         }
         Ok(going)
     }
