@@ -194,8 +194,6 @@ pub struct Collider {
     safe_until: Vec<i64>,
     /// Whether to skip queries by `safe_until` (see [`Collider::set_adaptive`]).
     adaptive: bool,
-    /// Boundary checks made (for queries per check).
-    pub checks: u64,
 }
 
 impl std::fmt::Debug for Collider {
@@ -363,7 +361,6 @@ impl Collider {
             checked_at: None,
             safe_until: vec![i64::MIN; n * n],
             adaptive: true,
-            checks: 0,
             bodies,
         }
     }
@@ -517,7 +514,6 @@ impl Collider {
             };
         }
         self.checked_at = Some(t);
-        self.checks += 1;
         // Adaptive checking: each joint's speed bound under the current motions.
         let mut joint_speed = std::mem::take(&mut self.sweep_scratch.disp);
         joint_speed.resize_with(cell.robots.len(), Vec::new);
