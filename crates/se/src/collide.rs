@@ -561,7 +561,7 @@ impl Collider {
                 let v = if self.is_held(a.owner) || self.is_held(b.owner) {
                     f64::INFINITY
                 } else {
-                    self.closing_speed(pair, &joint_speed)
+                    self.pair_bound(pair.0, pair.1, &joint_speed, &[])
                 };
                 self.queries += 1;
                 let found = parry3d::query::contact(
@@ -641,31 +641,6 @@ impl Collider {
         self.near = near_now;
         self.sweep_scratch.disp = joint_speed;
         events
-    }
-
-    /// A bound on how fast bodies `i` and `j` can approach each other under the joint
-    /// speeds `joint_speed` (m/s); bodies of one robot count only unshared joints.
-    fn closing_speed(&self, (i, j): (usize, usize), joint_speed: &[Vec<f64>]) -> f64 {
-        let (a, b) = (&self.bodies[i], &self.bodies[j]);
-        let own = |x: &BodyRef| match x.owner {
-            Owner::Link { robot, .. } => Some(robot),
-            _ => None,
-        };
-        let sum = |body: &BodyRef, take: usize| -> f64 {
-            let Some(r) = own(body) else { return 0.0 };
-            body.reach
-                .iter()
-                .take(take)
-                .map(|(jt, arm)| joint_speed[r][*jt] * arm)
-                .sum()
-        };
-        match (own(a), own(b)) {
-            (Some(ra), Some(rb)) if ra == rb => {
-                let (na, nb) = self.unshared[i * self.bodies.len() + j];
-                sum(a, usize::from(na)) + sum(b, usize::from(nb))
-            }
-            _ => sum(a, usize::MAX) + sum(b, usize::MAX),
-        }
     }
 
     /// Sweeps the time `[from, to)`, in which no event changes any motion: for every pair
@@ -830,7 +805,7 @@ impl Collider {
                 {
                     continue;
                 }
-                let reach = self.pair_bound(i, j, sw);
+                let reach = self.pair_bound(i, j, &sw.disp, &sw.held_reach);
                 if gap > reach {
                     continue; // too far apart to meet in this interval
                 }
@@ -855,45 +830,54 @@ impl Collider {
     ) -> Option<(usize, &'a [(usize, f64)])> {
         match b.owner {
             Owner::Link { robot, .. } => Some((robot, &b.reach)),
-            Owner::Part(p) => self.held[p].map(|(r, _)| (r, held_reach[p].as_slice())),
+            Owner::Part(p) => match (self.held[p], held_reach.get(p)) {
+                (Some((r, _)), Some(reach)) => Some((r, reach.as_slice())),
+                _ => None,
+            },
             Owner::Device => None,
         }
     }
 
-    /// How far bodies `i` and `j` can move towards each other in the interval (m). Bodies
-    /// of one robot move together under the joints they share: only the joints on one
-    /// body's path and not the other's count.
-    fn pair_bound(&self, i: usize, j: usize, sw: &SweepScratch) -> f64 {
+    /// How far (or how fast) bodies `i` and `j` can move towards each other, given per
+    /// robot and joint how far (how fast) each joint can move: Σ per moving joint × the
+    /// body's reach from it. Bodies of one robot move together under the joints they
+    /// share: only the joints on one's path and not the other's count.
+    fn pair_bound(
+        &self,
+        i: usize,
+        j: usize,
+        per_joint: &[Vec<f64>],
+        held_reach: &[Vec<(usize, f64)>],
+    ) -> f64 {
         let (a, b) = (&self.bodies[i], &self.bodies[j]);
+        let sum = |r: usize, reach: &[(usize, f64)], take: usize, skip: &[(usize, f64)]| {
+            reach
+                .iter()
+                .take(take)
+                .filter(|(jt, _)| !skip.iter().any(|(k, _)| k == jt))
+                .map(|(jt, arm)| per_joint[r][*jt] * arm)
+                .sum::<f64>()
+        };
         match (
-            self.owner_reach(a, &sw.held_reach),
-            self.owner_reach(b, &sw.held_reach),
+            self.owner_reach(a, held_reach),
+            self.owner_reach(b, held_reach),
         ) {
-            (Some((ra, reach_a)), Some((rb, reach_b)))
-                if ra == rb
-                    && matches!(a.owner, Owner::Link { .. })
-                    && matches!(b.owner, Owner::Link { .. }) =>
-            {
-                let (na, nb) = self.unshared[i * self.bodies.len() + j];
-                let sum = |x: &[(usize, f64)], k: u8| -> f64 {
-                    x.iter()
-                        .take(usize::from(k))
-                        .map(|(jt, arm)| sw.disp[ra][*jt] * arm)
-                        .sum()
-                };
-                sum(reach_a, na) + sum(reach_b, nb)
-            }
             (Some((ra, reach_a)), Some((rb, reach_b))) if ra == rb => {
-                // A held part and a link of the robot holding it: shared joints cancel.
-                let only = |x: &[(usize, f64)], y: &[(usize, f64)]| -> f64 {
-                    x.iter()
-                        .filter(|(j, _)| !y.iter().any(|(k, _)| k == j))
-                        .map(|(j, arm)| sw.disp[ra][*j] * arm)
-                        .sum()
-                };
-                only(reach_a, reach_b) + only(reach_b, reach_a)
+                if matches!((a.owner, b.owner), (Owner::Link { .. }, Owner::Link { .. })) {
+                    // The unshared joints are a precomputed prefix of each reach.
+                    let (na, nb) = self.unshared[i * self.bodies.len() + j];
+                    sum(ra, reach_a, usize::from(na), &[]) + sum(ra, reach_b, usize::from(nb), &[])
+                } else {
+                    // A held part and a link of the robot holding it.
+                    sum(ra, reach_a, usize::MAX, reach_b) + sum(ra, reach_b, usize::MAX, reach_a)
+                }
             }
-            _ => sw.bound[i] + sw.bound[j],
+            (ea, eb) => {
+                let whole = |e: Option<(usize, &[(usize, f64)])>| {
+                    e.map_or(0.0, |(r, reach)| sum(r, reach, usize::MAX, &[]))
+                };
+                whole(ea) + whole(eb)
+            }
         }
     }
 
