@@ -153,6 +153,8 @@ struct SweepScratch {
     /// interval's start.
     frames: Vec<Vec<Iso>>,
     frames_at: Vec<i64>,
+    /// Whether `frames` holds this sweep's frames (else they are still the last check's).
+    frames_ready: bool,
     start: Vec<Pose>,
     /// The broadphase: per body its box grown by its bound, the bodies sorted by the
     /// boxes' lower x, and the overlapping pairs.
@@ -735,13 +737,16 @@ impl Collider {
             sw.bound.push(bound);
         }
         // Poses at `from`: the last check's when it was at `from` (the usual case, from
-        // one boundary to the next), else its frames with the moving robots' recomputed.
-        sw.frames.clone_from(&self.frames);
+        // one boundary to the next; its frames are copied only if a pair needs frames at
+        // another time), else its frames with the moving robots' recomputed.
         sw.frames_at.clear();
         sw.frames_at.resize(n, from);
         if self.checked_at == Some(from) {
             sw.start.clone_from(&self.poses);
+            sw.frames_ready = false;
         } else {
+            sw.frames.clone_from(&self.frames);
+            sw.frames_ready = true;
             for r in 0..n {
                 if sw.moving[r] {
                     self.robot_frame_at(cell, vms, r, from, &mut sw.frames[r]);
@@ -912,6 +917,10 @@ impl Collider {
             let (pa, pb) = if now == from {
                 (sw.start[i], sw.start[j])
             } else {
+                if !sw.frames_ready {
+                    sw.frames.clone_from(&self.frames); // the frames at `from`
+                    sw.frames_ready = true;
+                }
                 for r in [ri, rj].into_iter().flatten() {
                     if sw.moving[r] && sw.frames_at[r] != now {
                         self.robot_frame_at(cell, vms, r, now, &mut sw.frames[r]);
