@@ -148,7 +148,7 @@ pub struct LinkShape {
     pub origin: Iso,
     /// The parry shape.
     pub shape: SharedShape,
-    /// The shape's pose in the link frame as parry wants it (f32; cylinders turned from
+    /// The shape's pose in the link frame as parry wants it (cylinders turned from
     /// URDF's z axis to parry's y axis).
     pub local_pose: Pose,
 }
@@ -340,16 +340,16 @@ impl Iso {
         self.apply([d[0] * v, d[1] * v, d[2] * v])
     }
 
-    /// As a parry pose (f32).
+    /// As a parry pose.
     pub fn to_pose(&self) -> Pose {
         let r = &self.r;
         let m = parry3d::math::Mat3::from_cols(
-            Vector::new(r[0][0] as f32, r[1][0] as f32, r[2][0] as f32),
-            Vector::new(r[0][1] as f32, r[1][1] as f32, r[2][1] as f32),
-            Vector::new(r[0][2] as f32, r[1][2] as f32, r[2][2] as f32),
+            Vector::new(r[0][0], r[1][0], r[2][0]),
+            Vector::new(r[0][1], r[1][1], r[2][1]),
+            Vector::new(r[0][2], r[1][2], r[2][2]),
         );
         Pose::from_parts(
-            Vector::new(self.t[0] as f32, self.t[1] as f32, self.t[2] as f32),
+            Vector::new(self.t[0], self.t[1], self.t[2]),
             parry3d::math::Rot3::from_mat3(&m),
         )
     }

@@ -533,23 +533,19 @@ pub fn build_shape(
 ) -> Result<LinkShape, ModelError> {
     let mut local_pose = origin.to_pose();
     let shape = match &geometry {
-        Geometry::Box { half } => {
-            SharedShape::cuboid(half[0] as f32, half[1] as f32, half[2] as f32)
-        }
-        Geometry::Sphere { radius } => SharedShape::ball(*radius as f32),
-        Geometry::Capsule { radius, length } => {
-            SharedShape::capsule_z((*length / 2.0) as f32, *radius as f32)
-        }
+        Geometry::Box { half } => SharedShape::cuboid(half[0], half[1], half[2]),
+        Geometry::Sphere { radius } => SharedShape::ball(*radius),
+        Geometry::Capsule { radius, length } => SharedShape::capsule_z(*length / 2.0, *radius),
         Geometry::Cylinder { radius, length } => {
             // parry's cylinders stand on y; URDF's on z.
             let turn = Iso::from_xyz_rpy([0.0; 3], [std::f64::consts::FRAC_PI_2, 0.0, 0.0]);
             local_pose = origin.mul(&turn).to_pose();
-            SharedShape::cylinder((*length / 2.0) as f32, *radius as f32)
+            SharedShape::cylinder(*length / 2.0, *radius)
         }
         Geometry::Hull { points, .. } => {
             let pts: Vec<Vector> = points
                 .iter()
-                .map(|p| Vector::new(p[0] as f32, p[1] as f32, p[2] as f32))
+                .map(|p| Vector::new(p[0], p[1], p[2]))
                 .collect();
             SharedShape::convex_hull(&pts).ok_or_else(|| ModelError::Invalid {
                 file: file.into(),

@@ -154,9 +154,9 @@ fn the_sweep_agrees_with_a_40x_finer_cycle() {
     );
     let (t, t_fine) = (coarse.collisions[0].time_ns, fine.collisions[0].time_ns);
     // The true first contact lies in (t_fine − 0.1 ms, t_fine]; the sweep must be within
-    // 0.1 ms of it. (Here the arms touch almost exactly at a fine boundary, 370.1 ms, where
-    // parry finds a gap of 3.5e-11 m; the sweep reports 370.085 ms, where parry's f32
-    // capsule query already reads 0 for a gap of about 15 µm.)
+    // 0.1 ms of it. (The arms' flanges, two cylinders, first touch at 370.0857 ms: the
+    // sweep with 4 ms and with 0.1 ms cycles agree to 0.1 µs; boundaries alone see it at
+    // 370.1 ms.)
     assert!(
         t > t_fine - 200_000 && t <= t_fine + 1_000,
         "sweep {t} ns, 0.1 ms cycles {t_fine} ns"
@@ -164,6 +164,57 @@ fn the_sweep_agrees_with_a_40x_finer_cycle() {
     // Both runs report the same pair.
     let pair = |r: &RunResult| (r.collisions[0].a.clone(), r.collisions[0].b.clone());
     assert_eq!(pair(&coarse), pair(&fine));
+}
+
+#[test]
+fn every_first_contact_of_grazing_arms_agrees_with_a_40x_finer_cycle() {
+    // Found by the adaptive-checking property test: two arms whose links graze nearly
+    // parallel. parry's f32 capsule query read the overlapping links as 1 µm apart, then as
+    // not in contact at all, so the sweep missed left.link_3/right.link_4's first contact
+    // (1606.2 ms) until the 1608 ms boundary; its f32 GJK also put a capsule 1.9 mm from a
+    // cylinder in contact. Every pair's first contact must be within 0.1 ms of a
+    // boundary-only run with 0.1 ms cycles.
+    let toml = std::fs::read_to_string(root().join("workcells/crash/cell.toml"))
+        .unwrap()
+        .replace("on_collision = \"stop\"", "on_collision = \"continue\"");
+    let program = |targets: [[i32; 6]; 2]| {
+        let mut p = String::from("proc main() {\n");
+        for t in targets {
+            let j: Vec<String> = t.iter().map(|d| format!("{d}deg")).collect();
+            p += &format!("    move_j joints({}) speed 22%;\n", j.join(", "));
+        }
+        p + "}\n"
+    };
+    let left = program([[8, 59, -51, 0, 0, 0], [0, 20, -2, 0, 0, 0]]);
+    let right = program([[-2, 53, -26, -37, 13, -31], [-2, 41, -39, -39, 2, -2]]);
+    let first_contacts = |cycle: &str, sweep: bool| {
+        let toml = toml.replace("cycle = \"4ms\"", &format!("cycle = \"{cycle}\""));
+        let path = write_cell(
+            &format!("graze-{sweep}"),
+            &[
+                ("cell.toml", &toml),
+                ("left.wsl", &left),
+                ("right.wsl", &right),
+            ],
+        );
+        let mut first = std::collections::BTreeMap::new();
+        for c in run_with(&path, sweep).collisions {
+            first.entry((c.a, c.b)).or_insert(c.time_ns);
+        }
+        first
+    };
+    let (coarse, fine) = (first_contacts("4ms", true), first_contacts("0.1ms", false));
+    assert!(fine.len() >= 10, "{fine:?}");
+    for (pair, t_fine) in &fine {
+        let t = coarse[pair];
+        // The true first contact lies in (t_fine − 0.1 ms, t_fine].
+        assert!(
+            t > t_fine - 100_000 - 1_000 && t <= t_fine + 1_000,
+            "{pair:?}: sweep {t} ns, 0.1 ms cycles {t_fine} ns"
+        );
+    }
+    let graze = ("left.link_3".to_string(), "right.link_4".to_string());
+    assert!((1_606_100_000..=1_606_400_000).contains(&coarse[&graze]));
 }
 
 #[test]

@@ -32,7 +32,7 @@ fn hull_triangles(geometry: &Geometry) -> Vec<[f64; 3]> {
     };
     let pts: Vec<parry3d::math::Vector3> = points
         .iter()
-        .map(|p| parry3d::math::Vector3::new(p[0] as f32, p[1] as f32, p[2] as f32))
+        .map(|p| parry3d::math::Vector3::new(p[0], p[1], p[2]))
         .collect();
     let Ok((vertices, faces)) = parry3d::transformation::try_convex_hull(&pts) else {
         return Vec::new();
@@ -41,7 +41,7 @@ fn hull_triangles(geometry: &Geometry) -> Vec<[f64; 3]> {
     for face in faces {
         for k in face {
             if let Some(v) = vertices.get(k as usize) {
-                out.push([f64::from(v.x), f64::from(v.y), f64::from(v.z)]);
+                out.push([v.x, v.y, v.z]);
             }
         }
     }
