@@ -408,10 +408,10 @@ fn event(cell: &vworks_se::workcell::Cell, e: &TraceEvent) -> Event {
             .and_then(|r| cell.robots.get(r))
             .map(|r| r.name.clone()),
         kind: e.kind.to_string(),
-        details: e.details.clone(),
-        file: e.pos.as_ref().map(|(f, _)| f.to_string()),
-        line: e.pos.as_ref().map_or(0, |(_, p)| p.line),
-        col: e.pos.as_ref().map_or(0, |(_, p)| p.col),
+        details: e.details(cell),
+        file: e.file(cell).map(str::to_string),
+        line: e.pos.map_or(0, |p| p.line),
+        col: e.pos.map_or(0, |p| p.col),
     }
 }
 

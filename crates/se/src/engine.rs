@@ -59,7 +59,9 @@ impl Outcome {
     }
 }
 
-/// One line of the event trace.
+/// One line of the event trace. Recording one allocates nothing: its details are kept
+/// unformatted ([`Detail`]) and formatted on demand with the cell's names
+/// ([`TraceEvent::details`], [`TraceEvent::line`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TraceEvent {
     /// Time (ns).
@@ -68,10 +70,25 @@ pub struct TraceEvent {
     pub robot: Option<usize>,
     /// Kind, e.g. `motion_start`.
     pub kind: &'static str,
-    /// Details (no newlines).
-    pub details: String,
-    /// Source position: (file, line, col).
-    pub pos: Option<(Arc<str>, SrcPos)>,
+    /// What the event says beyond its kind, unformatted.
+    pub detail: Detail,
+    /// Source position in the robot's program (see [`TraceEvent::file`]).
+    pub pos: Option<SrcPos>,
+}
+
+/// The details of a trace event, as recorded: indices into the cell and the robot's
+/// module rather than text, so that the hot path formats nothing.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum Detail {
+    /// No details.
+    None,
+    /// An event of the robot's VM, formatted with its module's names.
+    Vm(EventKind),
+    /// `check_wait` / `check_when`: the cell global whose change caused it.
+    Global(u32),
+    /// Text formatted when recorded (collisions, warnings, errors: rare).
+    Text(String),
 }
 
 /// A warning or error of the run.
@@ -194,13 +211,21 @@ pub struct Simulation {
     /// Per robot: cell global index → module global index.
     to_module: Vec<Vec<Option<u32>>>,
     /// Per cell global: last set (time, robot, pos) and last condition read at a wait start.
-    last_set: Vec<Option<(i64, usize, SrcPos)>>,
+    /// A set also has a number (`sets` counts them).
+    last_set: Vec<Option<(i64, usize, SrcPos, u64)>>,
+    sets: u64,
+    /// Per robot: the set (time, cell global, number) whose check_wait released its last
+    /// wait. Its actions at that instant follow that set, so they do not race with it.
+    released_by: Vec<Option<(i64, u32, u64)>>,
     last_read: Vec<Option<(i64, usize, SrcPos)>>,
     /// The paper's WAIT list: per cell global, the robots whose wait condition reads it.
-    wait_list: Vec<std::collections::BTreeSet<usize>>,
+    wait_list: Vec<SortedSet<usize>>,
     /// The paper's WHEN list: per cell global, the (robot, handler procedure) of each
     /// enabled condition handler reading it.
-    when_list: Vec<std::collections::BTreeSet<(usize, u32)>>,
+    when_list: Vec<SortedSet<(usize, u32)>>,
+    /// Per robot and signal site: the receiving robot and the signal's index in its VM
+    /// (`None`: the receiver never waits for it).
+    signal_to: Vec<Vec<(usize, Option<u32>)>>,
     /// Remote requests each robot serves, in order: (caller, request number).
     serving: Vec<std::collections::VecDeque<(usize, u64)>>,
     /// Open intervals per robot: motion start, wait start.
@@ -262,7 +287,7 @@ impl Simulation {
                 to_module[r][*cg as usize] = Some(mg as u32);
             }
         }
-        let vms = cell
+        let vms: Vec<Vm> = cell
             .robots
             .iter()
             .enumerate()
@@ -276,6 +301,23 @@ impl Simulation {
                     ..VmConfig::default()
                 };
                 Vm::new(Arc::clone(&r.module), Arc::clone(&r.model), cfg, r.entry)
+            })
+            .collect();
+        let signal_to = (0..n)
+            .map(|r| {
+                let m = &cell.robots[r].module;
+                cell.linked.robots[r]
+                    .signals
+                    .iter()
+                    .zip(&m.signals_sent)
+                    .map(|(target, sent)| {
+                        let target = *target as usize;
+                        let idx = vms
+                            .get(target)
+                            .and_then(|v: &Vm| v.signal_index(m.str(sent.name)));
+                        (target, idx)
+                    })
+                    .collect()
             })
             .collect();
         let files = cell
@@ -294,6 +336,7 @@ impl Simulation {
         let collider = Collider::new(&cell);
         Simulation {
             vms,
+            signal_to,
             files,
             queue: BinaryHeap::new(),
             seq: 0,
@@ -301,6 +344,8 @@ impl Simulation {
             generation: vec![0; n],
             queued_at: vec![None; n],
             last_set: vec![None; globals.len()],
+            sets: 0,
+            released_by: vec![None; n],
             last_read: vec![None; globals.len()],
             globals,
             to_module,
@@ -511,18 +556,18 @@ impl Simulation {
         time: i64,
         robot: Option<usize>,
         kind: &'static str,
-        details: String,
+        detail: Detail,
         pos: Option<SrcPos>,
     ) {
         let pos = match (robot, pos) {
-            (Some(r), Some(p)) if p.line > 0 => Some((Arc::clone(&self.files[r]), p)),
+            (Some(_), Some(p)) if p.line > 0 => Some(p),
             _ => None,
         };
         self.trace.push(TraceEvent {
             time,
             robot,
             kind,
-            details,
+            detail,
             pos,
         });
         if let (Some(log), Some(e)) = (self.log.as_mut(), self.trace.last())
@@ -630,15 +675,17 @@ impl Simulation {
                 self.perform(r);
             }
             Entry::CheckWait(r, cg) => {
-                let name = self.cell.linked.globals[cg as usize].name.clone();
-                self.record(t, Some(r), "check_wait", name, None);
+                self.record(t, Some(r), "check_wait", Detail::Global(cg), None);
                 if self.vms[r].check_wait(t) {
+                    // What r does next follows the set that released it.
+                    self.released_by[r] = self.last_set[cg as usize]
+                        .filter(|s| s.0 == t)
+                        .map(|s| (t, cg, s.3));
                     self.requeue(r);
                 }
             }
             Entry::CheckWhen(r, cg) => {
-                let name = self.cell.linked.globals[cg as usize].name.clone();
-                self.record(t, Some(r), "check_when", name, None);
+                self.record(t, Some(r), "check_when", Detail::Global(cg), None);
                 if self.vms[r].check_when(t) > 0 {
                     self.requeue(r);
                 }
@@ -659,7 +706,7 @@ impl Simulation {
             contact.point[2]
         );
         let t = contact.time_ns;
-        self.record(t, None, "collision_start", d, None);
+        self.record(t, None, "collision_start", Detail::Text(d), None);
         self.collisions.push(contact);
         if self.cell.stop_on_collision {
             self.time = t;
@@ -709,15 +756,19 @@ impl Simulation {
                             return;
                         }
                     }
-                    crate::collide::CollisionEvent::End(a, bname) => {
-                        self.record(b, None, "collision_end", format!("{a} {bname}"), None)
-                    }
+                    crate::collide::CollisionEvent::End(a, bname) => self.record(
+                        b,
+                        None,
+                        "collision_end",
+                        Detail::Text(format!("{a} {bname}")),
+                        None,
+                    ),
                     crate::collide::CollisionEvent::NearMiss(a, bname, dist) => {
                         let m = format!(
                             "near miss: {a} and {bname} come within {}",
                             fmt_quantity(dist, vworks_vm::Dim::LENGTH)
                         );
-                        self.record(b, None, "warning", format!("\"{m}\""), None);
+                        self.record(b, None, "warning", Detail::Text(format!("\"{m}\"")), None);
                         let issue = self.issue("near_miss", m, None, None);
                         self.warnings.push(issue);
                     }
@@ -748,7 +799,13 @@ impl Simulation {
         self.account(r, &e);
         self.route(r, &e);
         for (t, pos, m) in self.vms[r].take_warnings() {
-            self.record(t, Some(r), "warning", format!("\"{m}\""), Some(pos));
+            self.record(
+                t,
+                Some(r),
+                "warning",
+                Detail::Text(format!("\"{m}\"")),
+                Some(pos),
+            );
             let issue = self.issue("slowdown", m, Some(r), Some(pos));
             self.warnings.push(issue);
         }
@@ -786,72 +843,27 @@ impl Simulation {
 
     fn route(&mut self, r: usize, e: &Event) {
         let t = e.time;
-        let m = self.vms[r].module();
-        let details = match &e.kind {
-            EventKind::MotionStart {
-                command,
-                duration_ns,
-            } => format!("{command} duration={duration_ns}"),
-            EventKind::Delay { duration_ns } => format!("duration={duration_ns}"),
-            EventKind::Set { global, value, ty } => format!(
-                "{}={}",
-                m.str(m.globals[*global as usize].name),
-                format_value(*value, *ty)
-            ),
-            EventKind::WaitUntil { cond, deadline } => {
-                let names: Vec<&str> = m.conds[*cond as usize]
-                    .globals
-                    .iter()
-                    .map(|g| m.str(m.globals[*g as usize].name))
-                    .collect();
-                format!(
-                    "condition({}){}",
-                    names.join(","),
-                    deadline.map_or(String::new(), |d| format!(" deadline={d}"))
-                )
-            }
-            EventKind::WaitSignal { name, deadline } => format!(
-                "signal={}{}",
-                m.str(*name),
-                deadline.map_or(String::new(), |d| format!(" deadline={d}"))
-            ),
-            EventKind::WaitEnd { timed_out } => {
-                (if *timed_out { "timeout" } else { "released" }).into()
-            }
-            EventKind::Signal { site } => {
-                let s = &m.signals_sent[*site as usize];
-                format!("{}.{}", m.str(s.robot), m.str(s.name))
-            }
-            EventKind::Grip { site } | EventKind::Release { site } => {
-                m.str(m.parts[*site as usize].part).to_string()
-            }
-            EventKind::Log { text } => format!("{text:?}"),
-            EventKind::Error { message } => format!("{message:?}"),
-            EventKind::EnableWhen { handler }
-            | EventKind::WhenFire { handler }
-            | EventKind::WhenEnd { handler } => m
-                .str(m.procs[m.handlers[*handler as usize].target as usize].name)
-                .to_string(),
-            EventKind::DisableWhen { proc } => m.str(m.procs[*proc as usize].name).to_string(),
-            EventKind::RemoteCall { site, .. } => {
-                let s = &m.remotes[*site as usize];
-                format!("{}.{}", m.str(s.robot), m.str(s.proc))
-            }
-            EventKind::RemoteStart { proc } | EventKind::RemoteEnd { proc } => {
-                m.str(m.procs[*proc as usize].name).to_string()
-            }
-            _ => String::new(),
-        };
-        self.record(t, Some(r), e.kind.name(), details, Some(e.pos));
+        self.record(
+            t,
+            Some(r),
+            e.kind.name(),
+            Detail::Vm(e.kind.clone()),
+            Some(e.pos),
+        );
         match &e.kind {
             EventKind::Set { global, value, .. } => self.on_set(r, *global, *value, t, e.pos),
             EventKind::WaitUntil { cond, .. } => {
-                let m = self.vms[r].module();
-                let globals: Vec<u32> = m.conds[*cond as usize].globals.clone();
-                for g in globals {
-                    let cg = self.cell.linked.robots[r].globals[g as usize] as usize;
+                let cell = Arc::clone(&self.cell);
+                // A later set at this instant races with this read only if the wait passed
+                // at once: a wait that blocks is re-tested by that set's check_wait at the
+                // same instant, so either order releases it at the same time.
+                let passed = !self.vms[r].waits();
+                for g in &cell.robots[r].module.conds[*cond as usize].globals {
+                    let cg = cell.linked.robots[r].globals[*g as usize] as usize;
                     self.check_race(cg, r, t, e.pos, false);
-                    self.last_read[cg] = Some((t, r, e.pos));
+                    if passed {
+                        self.last_read[cg] = Some((t, r, e.pos));
+                    }
                     self.wait_list[cg].insert(r);
                 }
             }
@@ -865,9 +877,9 @@ impl Simulation {
                 let h = &m.handlers[*handler as usize];
                 if let vworks_vm::bytecode::Trigger::Condition(c) = h.trigger {
                     let target = h.target;
-                    let globals: Vec<u32> = m.conds[c as usize].globals.clone();
-                    for g in globals {
-                        let cg = self.cell.linked.robots[r].globals[g as usize] as usize;
+                    let cell = Arc::clone(&self.cell);
+                    for g in &cell.robots[r].module.conds[c as usize].globals {
+                        let cg = cell.linked.robots[r].globals[*g as usize] as usize;
                         self.when_list[cg].insert((r, target));
                     }
                 }
@@ -883,12 +895,10 @@ impl Simulation {
                 }
             }
             EventKind::Signal { site } => {
-                let target = self.cell.linked.robots[r].signals[*site as usize] as usize;
-                let name = {
-                    let m = self.vms[r].module();
-                    m.str(m.signals_sent[*site as usize].name).to_string()
-                };
-                if self.vms[target].deliver_signal(&name, t) {
+                let (target, idx) = self.signal_to[r][*site as usize];
+                if let Some(idx) = idx
+                    && self.vms[target].deliver_signal_index(idx, t)
+                {
                     self.requeue(target);
                 }
             }
@@ -925,10 +935,10 @@ impl Simulation {
     }
 
     fn check_race(&mut self, cg: usize, r: usize, t: i64, pos: SrcPos, is_set: bool) {
-        let others = [
-            self.last_set[cg],
-            if is_set { self.last_read[cg] } else { None },
-        ];
+        let set = self.last_set[cg]
+            .filter(|s| self.released_by[r] != Some((s.0, cg as u32, s.3)))
+            .map(|(t, r, pos, _)| (t, r, pos));
+        let others = [set, if is_set { self.last_read[cg] } else { None }];
         for (ot, or, opos) in others.into_iter().flatten() {
             if ot == t && or != r {
                 let name = &self.cell.linked.globals[cg].name;
@@ -942,7 +952,13 @@ impl Simulation {
                     self.short(r),
                     pos
                 );
-                self.record(t, Some(r), "warning", format!("{m:?}"), Some(pos));
+                self.record(
+                    t,
+                    Some(r),
+                    "warning",
+                    Detail::Text(format!("{m:?}")),
+                    Some(pos),
+                );
                 let issue = self.issue("race", m, Some(r), Some(pos));
                 self.warnings.push(issue);
             }
@@ -952,7 +968,8 @@ impl Simulation {
     fn on_set(&mut self, r: usize, g: u32, value: u64, t: i64, pos: SrcPos) {
         let cg = self.cell.linked.robots[r].globals[g as usize] as usize;
         self.check_race(cg, r, t, pos, true);
-        self.last_set[cg] = Some((t, r, pos));
+        self.sets += 1;
+        self.last_set[cg] = Some((t, r, pos, self.sets));
         self.globals[cg].0 = value;
         for q in 0..self.vms.len() {
             if let Some(mg) = self.to_module[q][cg] {
@@ -961,14 +978,17 @@ impl Simulation {
         }
         // check_wait / check_when for exactly the robots on this global's wait and when
         // lists, queued behind what is already due (in robot order, for determinism).
-        let waiting: Vec<usize> = self.wait_list[cg].iter().copied().collect();
-        for q in waiting {
+        for i in 0..self.wait_list[cg].len() {
+            let q = self.wait_list[cg].0[i];
             self.push(t, Entry::CheckWait(q, cg as u32));
         }
-        let mut watching: Vec<usize> = self.when_list[cg].iter().map(|(q, _)| *q).collect();
-        watching.dedup();
-        for q in watching {
-            self.push(t, Entry::CheckWhen(q, cg as u32));
+        let mut last = None;
+        for i in 0..self.when_list[cg].len() {
+            let q = self.when_list[cg].0[i].0;
+            if last != Some(q) {
+                last = Some(q);
+                self.push(t, Entry::CheckWhen(q, cg as u32));
+            }
         }
     }
 
@@ -993,7 +1013,13 @@ impl Simulation {
             ));
         }
         let m = format!("deadlock: {}", parts.join("; "));
-        self.record(self.time, None, "error", format!("{m:?}"), None);
+        self.record(
+            self.time,
+            None,
+            "error",
+            Detail::Text(format!("{m:?}")),
+            None,
+        );
         let issue = self.issue("deadlock", m, None, None);
         self.errors.push(issue);
         self.outcome = Some(Outcome::Deadlock);
@@ -1065,22 +1091,141 @@ impl Simulation {
 }
 
 impl TraceEvent {
+    /// The details as trace lines show them (empty when there are none).
+    pub fn details(&self, cell: &Cell) -> String {
+        match &self.detail {
+            Detail::None => String::new(),
+            Detail::Vm(kind) => self
+                .robot
+                .and_then(|r| cell.robots.get(r))
+                .map_or_else(String::new, |robot| vm_details(kind, &robot.module)),
+            Detail::Global(g) => cell
+                .linked
+                .globals
+                .get(*g as usize)
+                .map_or_else(String::new, |g| g.name.clone()),
+            Detail::Text(text) => text.clone(),
+        }
+    }
+
+    /// The program file the source position refers to (the robot's program).
+    pub fn file<'c>(&self, cell: &'c Cell) -> Option<&'c str> {
+        self.pos?;
+        self.robot
+            .and_then(|r| cell.robots.get(r))
+            .map(|r| r.program.as_str())
+    }
+
     /// The trace line: `time_ns robot kind details file:line:col`, `-` for empty fields.
     pub fn line(&self, cell: &Cell) -> String {
         let robot = self
             .robot
             .map_or("-".to_string(), |r| cell.robots[r].name.clone());
-        let details = if self.details.is_empty() {
-            "-".to_string()
-        } else {
-            self.details.clone()
+        let mut details = self.details(cell);
+        if details.is_empty() {
+            details.push('-');
+        }
+        let pos = match (self.file(cell), self.pos) {
+            (Some(f), Some(p)) => {
+                let rel = std::path::Path::new(f)
+                    .file_name()
+                    .map_or(f.to_string(), |n| n.to_string_lossy().into_owned());
+                format!("{rel}:{}:{}", p.line, p.col)
+            }
+            _ => "-".to_string(),
         };
-        let pos = self.pos.as_ref().map_or("-".to_string(), |(f, p)| {
-            let rel = std::path::Path::new(f.as_ref())
-                .file_name()
-                .map_or(f.to_string(), |n| n.to_string_lossy().into_owned());
-            format!("{rel}:{}:{}", p.line, p.col)
-        });
         format!("{} {robot} {} {details} {pos}", self.time, self.kind)
+    }
+}
+
+/// A VM event's details as trace lines show them, with the names of module `m`.
+fn vm_details(kind: &EventKind, m: &vworks_vm::bytecode::Module) -> String {
+    match kind {
+        EventKind::MotionStart {
+            command,
+            duration_ns,
+        } => format!("{command} duration={duration_ns}"),
+        EventKind::Delay { duration_ns } => format!("duration={duration_ns}"),
+        EventKind::Set { global, value, ty } => format!(
+            "{}={}",
+            m.str(m.globals[*global as usize].name),
+            format_value(*value, *ty)
+        ),
+        EventKind::WaitUntil { cond, deadline } => {
+            let names: Vec<&str> = m.conds[*cond as usize]
+                .globals
+                .iter()
+                .map(|g| m.str(m.globals[*g as usize].name))
+                .collect();
+            format!(
+                "condition({}){}",
+                names.join(","),
+                deadline.map_or(String::new(), |d| format!(" deadline={d}"))
+            )
+        }
+        EventKind::WaitSignal { name, deadline } => format!(
+            "signal={}{}",
+            m.str(*name),
+            deadline.map_or(String::new(), |d| format!(" deadline={d}"))
+        ),
+        EventKind::WaitEnd { timed_out } => {
+            (if *timed_out { "timeout" } else { "released" }).into()
+        }
+        EventKind::Signal { site } => {
+            let s = &m.signals_sent[*site as usize];
+            format!("{}.{}", m.str(s.robot), m.str(s.name))
+        }
+        EventKind::Grip { site } | EventKind::Release { site } => {
+            m.str(m.parts[*site as usize].part).to_string()
+        }
+        EventKind::Log { text } => format!("{text:?}"),
+        EventKind::Error { message } => format!("{message:?}"),
+        EventKind::EnableWhen { handler }
+        | EventKind::WhenFire { handler }
+        | EventKind::WhenEnd { handler } => m
+            .str(m.procs[m.handlers[*handler as usize].target as usize].name)
+            .to_string(),
+        EventKind::DisableWhen { proc } => m.str(m.procs[*proc as usize].name).to_string(),
+        EventKind::RemoteCall { site, .. } => {
+            let s = &m.remotes[*site as usize];
+            format!("{}.{}", m.str(s.robot), m.str(s.proc))
+        }
+        EventKind::RemoteStart { proc } | EventKind::RemoteEnd { proc } => {
+            m.str(m.procs[*proc as usize].name).to_string()
+        }
+        _ => String::new(),
+    }
+}
+
+/// A small ordered set kept as a sorted `Vec`: iterated by index while the simulation
+/// queues entries, in the same (ascending) order a `BTreeSet` would give.
+#[derive(Clone, Debug)]
+struct SortedSet<T>(Vec<T>);
+
+impl<T> Default for SortedSet<T> {
+    fn default() -> Self {
+        SortedSet(Vec::new())
+    }
+}
+
+impl<T: Ord + Copy> SortedSet<T> {
+    fn insert(&mut self, x: T) {
+        if let Err(i) = self.0.binary_search(&x) {
+            self.0.insert(i, x);
+        }
+    }
+
+    fn remove(&mut self, x: &T) {
+        if let Ok(i) = self.0.binary_search(x) {
+            self.0.remove(i);
+        }
+    }
+
+    fn retain(&mut self, keep: impl FnMut(&T) -> bool) {
+        self.0.retain(keep);
+    }
+
+    fn len(&self) -> usize {
+        self.0.len()
     }
 }

@@ -63,7 +63,7 @@ fn a_set_queues_check_when_behind_events_already_due() {
                 "{} {} {}",
                 e.robot.map_or("-".into(), |i| cell.robots[i].name.clone()),
                 e.kind,
-                e.details
+                e.details(&cell)
             )
         })
         .collect();
@@ -136,6 +136,31 @@ fn wait_and_set_at_one_instant_is_a_race() {
         "{:?}",
         r.warnings
     );
+}
+
+#[test]
+fn a_handshake_at_one_instant_is_not_a_race() {
+    // A sets `done`; B, released by that set, clears it at the same instant, and A's next
+    // wait (which blocks) reads it at that instant too. Every order of the ties gives the
+    // same result, so nothing is reported. (Both would be flagged without causality.)
+    let path = write_cell(
+        "handshake",
+        &[
+            ("cell.toml", TWO_ROBOTS),
+            (
+                "a.wsl",
+                "global done = 0;\nproc main() {\n    delay 1s;\n    done = 1;\n    wait_until done == 0;\n    done = 1;\n}\n",
+            ),
+            (
+                "b.wsl",
+                "global done = 0;\nproc main() {\n    wait_until done == 1;\n    done = 0;\n    wait_until done == 1;\n}\n",
+            ),
+        ],
+    );
+    let (_, r) = run(&path);
+    assert_eq!(r.outcome, Outcome::Completed, "{:?}", r.errors);
+    assert!(r.warnings.is_empty(), "{:?}", r.warnings);
+    assert_eq!(r.end_time_ns, 1_000_000_000);
 }
 
 #[test]
@@ -337,20 +362,20 @@ allow_collision = [["r1.tool0", "block"], ["r1.link_6", "block"]]
 "#;
     let prog = "const p = pose(400mm, -200mm, 200mm, 180deg, 0deg, 0deg);\nproc main() {\n    move_l p speed 200mm/s;\n    grip block;\n    move_l offset(p, 0mm, 400mm, 0mm) speed 200mm/s;\n    release block;\n}\n";
     let path = write_cell("cont", &[("cell.toml", cell), ("r1.wsl", prog)]);
-    let (_, r) = run(&path);
+    let (cell, r) = run(&path);
     assert_eq!(r.outcome, Outcome::Completed, "{:?}", r.errors);
-    let kinds: Vec<(&str, &str)> = r
+    let kinds: Vec<(&str, String)> = r
         .trace
         .iter()
         .filter(|e| e.kind.starts_with("collision"))
-        .map(|e| (e.kind, e.details.as_str()))
+        .map(|e| (e.kind, e.details(&cell)))
         .collect();
     // Only the carried block (gripped 200 mm away from the post) meets the post: it starts
     // touching, and stops when it has passed.
     assert_eq!(kinds.len(), 2, "{kinds:?}");
     assert_eq!(kinds[0].0, "collision_start");
     assert!(kinds[0].1.starts_with("post block"), "{kinds:?}");
-    assert_eq!(kinds[1], ("collision_end", "post block"));
+    assert_eq!(kinds[1], ("collision_end", "post block".to_string()));
     // Found by the sweep between boundaries: at first touch, so no depth yet.
     assert!(r.collisions.iter().all(|c| c.depth >= 0.0));
 }

@@ -52,7 +52,7 @@ fn per_robot(cell: &Cell, r: &RunResult) -> BTreeMap<String, Vec<(i64, String, S
             m.entry(cell.robots[i].name.clone()).or_default().push((
                 e.time,
                 e.kind.to_string(),
-                e.details.clone(),
+                e.details(cell),
             ));
         }
     }

@@ -613,7 +613,8 @@ fn bodies_turn_red_while_they_touch() {
         .iter()
         .filter(|e| matches!(e.kind, "collision_start" | "collision_end"))
         .map(|e| {
-            let mut n = e.details.split(' ');
+            let details = e.details(&cell);
+            let mut n = details.split(' ');
             let (a, b) = (n.next().unwrap(), n.next().unwrap());
             (
                 e.time,

@@ -1730,6 +1730,11 @@ impl Vm {
         value
     }
 
+    /// Whether the VM is blocked in a `wait_until` or `wait_signal` (not released yet).
+    pub fn waits(&self) -> bool {
+        matches!(self.state, State::Waiting { .. })
+    }
+
     /// The SE's `check_wait` at time `t`: re-tests the condition this VM waits on.
     /// Returns true if the VM is released (its next event becomes `wait_end` at `t`).
     pub fn check_wait(&mut self, t: i64) -> bool {
@@ -1753,15 +1758,25 @@ impl Vm {
     /// Delivers a signal named `name` at time `t`: releases a matching wait, or is counted
     /// until one consumes it. Returns true if it released a wait.
     pub fn deliver_signal(&mut self, name: &str, t: i64) -> bool {
-        let Some(idx) = self
-            .m
+        match self.signal_index(name) {
+            Some(idx) => self.deliver_signal_index(idx, t),
+            None => false,
+        }
+    }
+
+    /// The index under which this VM knows the signal `name` (its string index), for
+    /// [`Vm::deliver_signal_index`]; `None` if its program never mentions it (a signal it
+    /// can never wait for).
+    pub fn signal_index(&self, name: &str) -> Option<u32> {
+        self.m
             .strings
             .iter()
             .position(|s| s == name)
             .map(|i| i as u32)
-        else {
-            return false;
-        };
+    }
+
+    /// [`Vm::deliver_signal`] with the name already looked up by [`Vm::signal_index`].
+    pub fn deliver_signal_index(&mut self, idx: u32, t: i64) -> bool {
         if let State::Waiting {
             signal: Some(s),
             pos,

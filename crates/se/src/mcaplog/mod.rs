@@ -359,11 +359,10 @@ impl McapLog {
     /// `collision_start`/`collision_end` the two bodies change colour.
     pub(crate) fn event(&mut self, cell: &Cell, e: &TraceEvent) -> Result<(), LogError> {
         let robot = e.robot.map(|r| cell.robots[r].name.clone());
-        let (file, line, col) = e
-            .pos
-            .as_ref()
-            .map_or((None, 0, 0), |(f, p)| (Some(f.to_string()), p.line, p.col));
-        let v = serde_json::json!({"time_ns": e.time, "robot": robot, "kind": e.kind, "details": e.details, "file": file, "line": line, "col": col});
+        let file = e.file(cell);
+        let (line, col) = e.pos.map_or((0, 0), |p| (p.line, p.col));
+        let details = e.details(cell);
+        let v = serde_json::json!({"time_ns": e.time, "robot": robot, "kind": e.kind, "details": details, "file": file, "line": line, "col": col});
         self.write(EVENTS, e.time, &v)?;
         let level = match e.kind {
             "log" => Some(2),
@@ -372,11 +371,11 @@ impl McapLog {
             _ => None,
         };
         if let Some(level) = level {
-            let v = serde_json::json!({"timestamp": scene::ts(e.time), "level": level, "message": e.details.trim_matches('"'), "name": robot.unwrap_or_else(|| "cell".into()), "file": file.unwrap_or_default(), "line": line});
+            let v = serde_json::json!({"timestamp": scene::ts(e.time), "level": level, "message": details.trim_matches('"'), "name": robot.unwrap_or_else(|| "cell".into()), "file": file.unwrap_or_default(), "line": line});
             self.write(LOG, e.time, &v)?;
         }
         if matches!(e.kind, "collision_start" | "collision_end") {
-            let mut names = e.details.split(' ');
+            let mut names = details.split(' ');
             let (a, b) = (
                 names.next().unwrap_or_default(),
                 names.next().unwrap_or_default(),
