@@ -567,9 +567,18 @@ impl Collider {
                 };
                 self.queries += 1;
                 let (pa, pb) = (&self.poses[pair.0], &self.poses[pair.1]);
-                let (dist, point, _) = gap(pa, a.shape.as_ref(), pb, b.shape.as_ref());
+                let found = gap(pa, a.shape.as_ref(), pb, b.shape.as_ref(), margin);
                 if self.adaptive && v.is_finite() {
-                    let gap = dist.max(0.0) * trust(a.shape.as_ref(), b.shape.as_ref());
+                    // The gap behind the promise: the query's when within the clearance,
+                    // else an unbounded distance query.
+                    let d = match &found {
+                        Some((d, _, _)) => *d,
+                        None => {
+                            self.queries += 1;
+                            distance(pa, a.shape.as_ref(), pb, b.shape.as_ref())
+                        }
+                    };
+                    let gap = d.max(0.0) * trust(a.shape.as_ref(), b.shape.as_ref());
                     self.safe_until[idx] = if v <= 0.0 {
                         i64::MAX
                     } else if gap > cell.clearance {
@@ -578,9 +587,9 @@ impl Collider {
                         i64::MIN
                     };
                 }
-                if dist > margin {
+                let Some((dist, point, _)) = found else {
                     continue;
-                }
+                };
                 if dist <= 0.0 {
                     touching.insert(pair);
                     if !self.touching.contains(&pair) {
@@ -914,12 +923,11 @@ impl Collider {
             let rest = speed * (to - now) as f64 / 1e9;
             // Reported in body order, as the boundary check reports: the point is on the
             // first body.
-            let (d, p1, p2) = gap(&pa, a.shape.as_ref(), &pb, b.shape.as_ref());
-            // The part of the gap relied on (see `trust`).
-            let safe = d * trust(a.shape.as_ref(), b.shape.as_ref());
-            if safe > rest {
-                return None; // too far apart to touch in the rest of the interval
-            }
+            // The part of a gap relied on is `trust` of it: farther apart than `rest /
+            // trust`, they cannot touch in the rest of the interval.
+            let trust = trust(a.shape.as_ref(), b.shape.as_ref());
+            let (d, p1, p2) = gap(&pa, a.shape.as_ref(), &pb, b.shape.as_ref(), rest / trust)?;
+            let safe = d * trust;
             if d <= 0.0 {
                 let p = if swapped { p2 } else { p1 };
                 return Some(Contact {
@@ -981,12 +989,15 @@ impl Collider {
 }
 
 /// The gap between two placed shapes (m; negative: the depth they overlap by) and the
-/// point of each nearest the other.
+/// point of each nearest the other, if the gap is at most `within` (a bounded query: parry
+/// stops early when the shapes are farther apart).
 ///
 /// Capsules and balls (most links of the built-in robots) are measured here from their
-/// axis segments ([`capsule_gap`]): exact, and faster than GJK. Other shapes go to parry:
-/// its `distance`, and when that is 0 its `contact` for the depth and points (when apart,
-/// the points are the shapes' origins).
+/// axis segments ([`capsule_gap`]): exact, and faster than GJK. Other shapes go to parry's
+/// bounded `closest_points`, and when they intersect to its `contact` for the depth and
+/// points (its `contact` alone missed touching cylinders: "no contact" at a boundary where
+/// they overlapped; without a depth the contact is reported at depth 0 and the shapes'
+/// origins).
 ///
 /// parry is the f64 build (`parry3d-f64`): in f32, its GJK's relative tolerance made
 /// gaps of curved shapes mm too large (up to 11.5 mm on random capsules 0.1–0.6 m apart),
@@ -999,19 +1010,35 @@ fn gap(
     a: &dyn parry3d::shape::Shape,
     pb: &Pose,
     b: &dyn parry3d::shape::Shape,
-) -> (f64, V3, V3) {
+    within: f64,
+) -> Option<(f64, V3, V3)> {
     if let (Some(ca), Some(cb)) = (Capsule::of(a), Capsule::of(b)) {
-        return capsule_gap(pa, &ca, pb, &cb);
+        let found = capsule_gap(pa, &ca, pb, &cb);
+        return (found.0 <= within).then_some(found);
     }
+    use parry3d::query::ClosestPoints;
     let v = |p: parry3d::math::Vector| [p.x, p.y, p.z];
-    let d = parry3d::query::distance(pa, a, pb, b).map_or(0.0, |d| d.distance);
-    if d > 0.0 {
-        return (d, v(pa.translation), v(pb.translation));
+    match parry3d::query::closest_points(pa, a, pb, b, within.max(0.0)) {
+        Ok(ClosestPoints::WithinMargin(p1, p2)) => Some(((p2 - p1).length(), v(p1), v(p2))),
+        Ok(ClosestPoints::Intersecting) => Some(match parry3d::query::contact(pa, a, pb, b, 0.0) {
+            Ok(Some(c)) => (c.dist.min(0.0), v(c.point1), v(c.point2)),
+            _ => (0.0, v(pa.translation), v(pb.translation)),
+        }),
+        _ => None,
     }
-    match parry3d::query::contact(pa, a, pb, b, 0.0) {
-        Ok(Some(c)) => (c.dist.min(0.0), v(c.point1), v(c.point2)),
-        _ => (0.0, v(pa.translation), v(pb.translation)),
+}
+
+/// The distance between two placed shapes (m; 0 when they overlap), unbounded.
+fn distance(
+    pa: &Pose,
+    a: &dyn parry3d::shape::Shape,
+    pb: &Pose,
+    b: &dyn parry3d::shape::Shape,
+) -> f64 {
+    if let (Some(ca), Some(cb)) = (Capsule::of(a), Capsule::of(b)) {
+        return capsule_gap(pa, &ca, pb, &cb).0.max(0.0);
     }
+    parry3d::query::distance(pa, a, pb, b).map_or(0.0, |d| d.distance)
 }
 
 /// How much of a gap parry measured is relied on when skipping time (all of it for
@@ -1225,7 +1252,8 @@ mod tests {
                 place(&pb, cb.b),
             );
             let oracle = axes - ca.radius - cb.radius;
-            let (ours, p1, p2) = gap(&pa, a.as_ref(), &pb, b.as_ref());
+            let (ours, p1, p2) = gap(&pa, a.as_ref(), &pb, b.as_ref(), 10.0).unwrap();
+            assert_eq!(distance(&pa, a.as_ref(), &pb, b.as_ref()), ours.max(0.0));
             assert!((ours - oracle).abs() < 1e-9, "{k}: {ours} vs {oracle}");
             if ours > 0.0 {
                 apart += 1;
@@ -1256,7 +1284,7 @@ mod tests {
                 Vector::new(0.1 + apart, 0.0, 0.0),
                 parry3d::math::Rotation::from_rotation_y(1e-5f64.to_radians()),
             );
-            let (d, _, _) = gap(&pa, c.as_ref(), &pb, c.as_ref());
+            let (d, _, _) = gap(&pa, c.as_ref(), &pb, c.as_ref(), 1.0).unwrap();
             // The tilt moves the closer end of b by 0.15 m × 1e-5° in x.
             let tilt = 0.15 * (1e-5f64).to_radians().sin();
             let expected = apart - tilt;
