@@ -183,7 +183,7 @@ pub struct RunResult {
     pub log_error: Option<String>,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Entry {
     /// The robot's next event (robot, generation).
     Vm(usize, u64),
@@ -193,13 +193,45 @@ enum Entry {
     CheckWhen(usize, u32),
 }
 
+impl Entry {
+    /// The entry in 64 bits: kind (2 bits), robot (22 bits), generation or global (40
+    /// bits), so that a queued entry is 24 bytes.
+    fn pack(self) -> u64 {
+        let (kind, r, payload) = match self {
+            Entry::Vm(r, g) => (0, r, g),
+            Entry::CheckWait(r, g) => (1, r, u64::from(g)),
+            Entry::CheckWhen(r, g) => (2, r, u64::from(g)),
+        };
+        (payload << 24) | ((r as u64 & 0x3f_ffff) << 2) | kind
+    }
+
+    fn unpack(x: u64) -> Entry {
+        let (r, payload) = (((x >> 2) & 0x3f_ffff) as usize, x >> 24);
+        match x & 3 {
+            0 => Entry::Vm(r, payload),
+            1 => Entry::CheckWait(r, payload as u32),
+            _ => Entry::CheckWhen(r, payload as u32),
+        }
+    }
+}
+
+/// An event-queue entry: the earliest time first, then by `key` (the robot's tie rank,
+/// then the order queued), 24 bytes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+struct Queued {
+    time: i64,
+    /// Tie rank (high 20 bits) and sequence number (low 44 bits).
+    key: u64,
+    entry: u64,
+}
+
 /// A running simulation of a cell.
 #[derive(Debug)]
 pub struct Simulation {
     cell: Arc<Cell>,
     vms: Vec<Vm>,
     files: Vec<Arc<str>>,
-    queue: BinaryHeap<Reverse<(i64, u64, u64, Entry)>>,
+    queue: BinaryHeap<Reverse<Queued>>,
     seq: u64,
     /// Tie-break rank per robot for same-time entries of different robots (all 0 normally:
     /// first queued, first served). Tests permute it to prove the results do not depend on it.
@@ -441,7 +473,7 @@ impl Simulation {
                     self.step(None);
                     return self.outcome.is_none();
                 }
-                Some(Reverse((next, ..))) if *next <= t => {
+                Some(Reverse(q)) if q.time <= t => {
                     self.step(None);
                 }
                 Some(_) => break,
@@ -527,15 +559,18 @@ impl Simulation {
         let robot = match entry {
             Entry::Vm(r, _) | Entry::CheckWait(r, _) | Entry::CheckWhen(r, _) => r,
         };
-        self.queue
-            .push(Reverse((time, self.rank[robot], self.seq, entry)));
+        self.queue.push(Reverse(Queued {
+            time,
+            key: (self.rank[robot] << 44) | (self.seq & ((1 << 44) - 1)),
+            entry: entry.pack(),
+        }));
     }
 
     /// Breaks ties between robots' same-time entries by `rank` (a permutation) instead of
     /// queueing order. Each robot's own entries keep their order. For testing that no
     /// result depends on tie order.
     pub fn set_tie_ranks(&mut self, rank: Vec<u64>) {
-        if rank.len() == self.rank.len() {
+        if rank.len() == self.rank.len() && rank.iter().all(|r| *r < 1 << 20) {
             self.rank = rank;
         }
     }
@@ -646,7 +681,7 @@ impl Simulation {
             self.outcome = Some(Outcome::Interrupted);
             return false;
         }
-        let Some(Reverse((t, _, _, entry))) = self.queue.pop() else {
+        let Some(Reverse(Queued { time: t, entry, .. })) = self.queue.pop() else {
             self.end_without_events();
             return false;
         };
@@ -666,7 +701,7 @@ impl Simulation {
             return false;
         }
         self.time = t;
-        match entry {
+        match Entry::unpack(entry) {
             Entry::Vm(r, g) => {
                 if g != self.generation[r] {
                     return true;
@@ -777,11 +812,7 @@ impl Simulation {
             // With nothing queued before the next boundary and nothing moving, skip ahead.
             // (Not when a log records every boundary.)
             if self.log.is_none() && !self.moving.iter().any(|m| *m) {
-                let next_event = self
-                    .queue
-                    .peek()
-                    .map_or(t, |Reverse((nt, _, _, _))| *nt)
-                    .min(t);
+                let next_event = self.queue.peek().map_or(t, |Reverse(q)| q.time).min(t);
                 if next_event > self.next_boundary {
                     let skip = (next_event - self.next_boundary) / c;
                     self.next_boundary += skip * c;
@@ -1227,5 +1258,24 @@ impl<T: Ord + Copy> SortedSet<T> {
 
     fn len(&self) -> usize {
         self.0.len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Entry;
+
+    #[test]
+    fn queue_entries_pack_into_64_bits_and_back() {
+        for e in [
+            Entry::Vm(0, 0),
+            Entry::Vm(3, 1 << 39),
+            Entry::Vm((1 << 22) - 1, 12_345),
+            Entry::CheckWait(7, u32::MAX),
+            Entry::CheckWhen(63, 5),
+            Entry::CheckWait(0, 0),
+        ] {
+            assert_eq!(Entry::unpack(e.pack()), e);
+        }
     }
 }

@@ -809,7 +809,6 @@ impl Vm {
     /// Runs zero-time code of the main thread (or the handler thread) up to its next event
     /// instruction and describes that event.
     fn run_segment(&mut self, in_handler: bool, t: i64) -> Event {
-        let m = Arc::clone(&self.m);
         loop {
             let mut thread = std::mem::take(if in_handler {
                 &mut self.handler
@@ -824,7 +823,7 @@ impl Vm {
                 self.main = thread;
             }
             // A finished thread's pc is past its last `Ret`: report the `Ret`.
-            let pos = m.pos_of(if matches!(stop, Ok(Stop::Finished)) {
+            let pos = self.m.pos_of(if matches!(stop, Ok(Stop::Finished)) {
                 pc.saturating_sub(1)
             } else {
                 pc
@@ -1682,8 +1681,7 @@ impl Vm {
 
     /// Evaluates condition `c` with the locals it captures from the main thread's frame.
     fn eval_cond(&mut self, c: u32, t: i64) -> bool {
-        let m = Arc::clone(&self.m);
-        let cond = &m.conds[c as usize];
+        let cond = &self.m.conds[c as usize];
         let base = self.main.frames.last().map_or(0, |f| f.base as usize);
         let mut args = [0u64; 64];
         let mut n = 0;
@@ -1700,16 +1698,16 @@ impl Vm {
                 }
             }
         }
-        self.eval_cond_with(cond.func, &args[..n], t)
+        let func = cond.func;
+        self.eval_cond_with(func, &args[..n], t)
     }
 
     /// Runs a thread's zero-time code at time `t` over this VM's module variables.
     fn run_thread(&mut self, th: &mut Thread, t: i64) -> Result<Stop, RuntimeError> {
-        let m = Arc::clone(&self.m);
         let mut budget = self.cfg.budget;
         let mut vars = std::mem::take(&mut self.vars);
         let r = th.run(
-            &m,
+            &self.m,
             &View { vm: self, t },
             &mut vars,
             &mut budget,
@@ -1721,9 +1719,8 @@ impl Vm {
 
     /// Runs condition function `func` with `args`; false if it fails.
     fn eval_cond_with(&mut self, func: u32, args: &[u64], t: i64) -> bool {
-        let m = Arc::clone(&self.m);
         let mut th = std::mem::take(&mut self.cond_thread);
-        th.start(&m, func, args);
+        th.start(&self.m, func, args);
         let r = self.run_thread(&mut th, t);
         let value = matches!(r, Ok(Stop::Finished)) && th.stack.last().copied().unwrap_or(0) != 0;
         self.cond_thread = th;
