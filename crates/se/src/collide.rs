@@ -79,6 +79,23 @@ struct BodyRef {
     reach: Vec<(usize, f64)>,
 }
 
+impl BodyRef {
+    /// The body's box at `pose`: exact where parry computes it in closed form (capsules,
+    /// balls, boxes), else the bounding sphere's (cylinders, hulls: their exact boxes need
+    /// support-map searches).
+    fn bounding_box(&self, pose: &Pose) -> Aabb {
+        let shape = self.shape.as_ref();
+        if shape.as_capsule().is_some() || shape.as_ball().is_some() || shape.as_cuboid().is_some()
+        {
+            shape.compute_aabb(pose)
+        } else {
+            let c = pose.translation;
+            let r = parry3d::math::Vector::splat(self.radius);
+            Aabb::new(c - r, c + r)
+        }
+    }
+}
+
 /// The smallest step of conservative advancement (ns): near contact, where the safe step
 /// `d / v` shrinks towards 0, the sweep steps by this. A contact is reported at most this
 /// late; a body would have to be thinner than its speed × 1 µs (3 µm at 3 m/s) to be
@@ -501,19 +518,7 @@ impl Collider {
                 _ => continue,
             };
             self.poses[i] = owner_pose * b.local;
-            // The broadphase box: exact where parry computes it in closed form (capsules,
-            // balls, boxes), else the bounding sphere (cylinders, hulls: their exact boxes
-            // need support-map searches).
-            self.aabbs[i] = if b.shape.as_capsule().is_some()
-                || b.shape.as_ball().is_some()
-                || b.shape.as_cuboid().is_some()
-            {
-                b.shape.compute_aabb(&self.poses[i]).loosened(margin)
-            } else {
-                let c = self.poses[i].translation;
-                let r = parry3d::math::Vector::splat(b.radius + margin);
-                Aabb::new(c - r, c + r)
-            };
+            self.aabbs[i] = b.bounding_box(&self.poses[i]).loosened(margin);
         }
         self.checked_at = Some(t);
         // Adaptive checking: each joint's speed bound under the current motions.
@@ -745,14 +750,15 @@ impl Collider {
         }
         let mut found = Vec::new();
         let nb = self.bodies.len();
-        // Broadphase: each body's bounding sphere grown by how far it can move, swept along
+        // Broadphase: each body's bounding box grown by how far it can move, swept along
         // x; only overlapping pairs go further.
         sw.reach_box.clear();
         for (i, b) in self.bodies.iter().enumerate() {
-            let r = b.radius + sw.bound[i];
-            let c = sw.start[i].translation;
-            sw.reach_box
-                .push(([c.x - r, c.y - r, c.z - r], [c.x + r, c.y + r, c.z + r]));
+            let bx = b.bounding_box(&sw.start[i]).loosened(sw.bound[i]);
+            sw.reach_box.push((
+                [bx.mins.x, bx.mins.y, bx.mins.z],
+                [bx.maxs.x, bx.maxs.y, bx.maxs.z],
+            ));
         }
         // The order of the last sweep is nearly sorted already: sorting it is near linear.
         if sw.order.len() != nb {
