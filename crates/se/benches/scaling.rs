@@ -1,7 +1,11 @@
 //! Cells built for benchmarking (issue 8): N irb120 arms on a grid, each looping between
 //! two poses. Prints, once:
-//! - (b) a 60-simulated-second program of 4 robots with 4 ms cycles and collision checks,
-//!   without and with the full log: wall time and × real time;
+//! - (a) the cost per cycle of `bench/cells/grid4` (4 robots) with every pair the
+//!   broadphase keeps queried at every boundary (no sweep, no adaptive checking): joint
+//!   interpolation, FK and collision checks — what `bench/compare.py` sets against
+//!   Pinocchio+coal and PyBullet;
+//! - (b) a 60-simulated-second program of 4 robots with 4 ms cycles and collision checks
+//!   (`bench/cells/grid4`), without and with the full log: wall time and × real time;
 //! - (d) the cost per cycle for 1, 4, 16 and 64 robots (4 simulated seconds each), and the
 //!   ratio of 64 to 4.
 //!
@@ -51,8 +55,36 @@ fn scaling(c: &mut Criterion) {
     let bench = std::env::args().any(|a| a == "--bench");
     let runs = if bench { 5 } else { 1 };
     let tmp = std::env::temp_dir().join(format!("vworks-scaling-{}", std::process::id()));
-    // (b) Four robots for a simulated minute.
-    let minute = grid_cell(&tmp.join("minute"), 4, 21);
+    // (b) Four robots for a simulated minute: the committed cell is the generator's.
+    let grid4 = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../bench/cells/grid4");
+    let generated = grid_cell(&tmp.join("minute"), 4, 21);
+    let minute = Arc::new(load(&grid4.join("cell.toml")).unwrap_or_else(|e| panic!("{e}")));
+    assert_eq!(
+        std::fs::read_to_string(grid4.join("arm.wsl")).unwrap(),
+        std::fs::read_to_string(tmp.join("minute/arm.wsl")).unwrap()
+    );
+    assert_eq!(
+        (minute.robots.len(), minute.cycle_ns),
+        (generated.robots.len(), generated.cycle_ns)
+    );
+    // (a) Every kept pair at every boundary, over the first 4 simulated seconds.
+    let until = Some(4_000_000_000);
+    let exhaustive = || {
+        Simulation::new(Arc::clone(&minute))
+            .with_sweep(false)
+            .with_adaptive(false)
+            .run(until)
+    };
+    let probe = exhaustive();
+    let wall = seconds(runs, || {
+        std::hint::black_box(exhaustive());
+    });
+    println!(
+        "(a) 4 robots, every kept pair at every boundary: {:.2} µs per cycle ({} cycles, {:.1} queries per cycle)",
+        wall / probe.cycles as f64 * 1e6,
+        probe.cycles,
+        probe.queries as f64 / probe.cycles as f64
+    );
     let probe = Simulation::new(Arc::clone(&minute)).run(None);
     let sim_s = probe.end_time_ns as f64 / 1e9;
     let plain = seconds(runs, || {

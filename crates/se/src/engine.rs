@@ -849,7 +849,7 @@ impl Simulation {
         match &e.kind {
             EventKind::MotionStart { .. } => {
                 // Speed bounds behind skipped collision queries change with the motion.
-                self.collider.motions_changed();
+                self.collider.motion_started(r);
                 self.stats[r].motions += 1;
                 self.moving_since[r] = Some(e.time);
             }
