@@ -227,7 +227,13 @@ impl RobotModel {
     /// frame. `q` has one value per axis; joints off the tool chain stay at 0.
     /// `frames` must have `links.len()` entries (see [`RobotModel::frames_buffer`]).
     pub fn fk_into(&self, q: &[f64], frames: &mut [Iso]) {
-        frames[0] = Iso::IDENTITY;
+        self.fk_into_from(&Iso::IDENTITY, q, frames);
+    }
+
+    /// [`RobotModel::fk_into`] with the root link placed at `base`: every frame in the
+    /// cell at once, without a second pass multiplying each by the base.
+    pub fn fk_into_from(&self, base: &Iso, q: &[f64], frames: &mut [Iso]) {
+        frames[0] = *base;
         for j in &self.joints {
             let parent = frames[j.parent];
             let at = parent.mul(&j.origin);

@@ -558,10 +558,9 @@ impl Collider {
                 continue;
             }
             let q = &self.frames_q[r][..robot.model.dof()];
-            robot.model.fk_into(q, &mut self.frames[r]);
-            for f in self.frames[r].iter_mut() {
-                *f = robot.base.mul(f);
-            }
+            robot
+                .model
+                .fk_into_from(&robot.base, q, &mut self.frames[r]);
         }
         let updated = |r: usize| r >= update.len() || update[r];
         let margin = cell.clearance;
@@ -1002,10 +1001,9 @@ impl Collider {
     fn robot_frame_at(&self, cell: &Cell, vms: &[Vm], r: usize, t: i64, out: &mut [Iso]) {
         let robot = &cell.robots[r];
         let q = vms[r].joints_at(t);
-        robot.model.fk_into(&q[..robot.model.dof()], out);
-        for f in out.iter_mut() {
-            *f = robot.base.mul(f);
-        }
+        robot
+            .model
+            .fk_into_from(&robot.base, &q[..robot.model.dof()], out);
     }
 
     /// Body `i`'s pose in the cell, its robot's link frames being `frames`.
