@@ -5,7 +5,9 @@
 //! - `vworks build FILE [-o OUT.wslb]`: compile one program to bytecode.
 //! - `vworks disasm FILE.wslb|FILE.wsl`: list the bytecode with the source beside it.
 //!
-//! `run`, `log` and `report` arrive with the simulation engine.
+//! - `vworks run CELL [--log run.mcap]`: simulate a workcell and print the summary.
+//! - `vworks log info|events FILE.mcap`: read a run's log.
+//! - `vworks report FILE.mcap [-o report.html]`: the run's HTML report.
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -70,6 +72,15 @@ enum Command {
         /// Log the state of every N-th cycle only (events are never thinned).
         #[arg(long, default_value_t = 1)]
         log_every: u64,
+    },
+    /// Write a run's report, one self-contained HTML file: a Gantt chart per robot, cycle
+    /// times, collisions, warnings and the event table.
+    Report {
+        /// The MCAP log of the run (`vworks run CELL --log run.mcap`).
+        log: PathBuf,
+        /// The HTML file to write (default: the log's name with extension .html).
+        #[arg(short, long)]
+        output: Option<PathBuf>,
     },
     /// Read an MCAP log written by `vworks run --log`.
     Log {
@@ -213,6 +224,34 @@ fn read_log(what: LogCommand) -> Result<ExitCode, String> {
              The run was probably killed: `mcap recover {} -o fixed.mcap` (the mcap CLI) rebuilds the index, or run the cell again.",
             file.display(),
             file.display()
+        );
+        return Ok(ExitCode::FAILURE);
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn write_report(log: &Path, output: Option<PathBuf>) -> Result<ExitCode, String> {
+    let contents = vworks_se::mcaplog::read_log(log).map_err(|e| e.to_string())?;
+    let report = vworks_se::report::Report::from_log(&contents);
+    let page = vworks_se::report::html(&report, &contents.events, &log.display().to_string());
+    let out = output.unwrap_or_else(|| log.with_extension("html"));
+    std::fs::write(&out, page).map_err(|e| {
+        format!(
+            "cannot write `{}`: {e}; check that its folder exists and is writable, or choose another with -o",
+            out.display()
+        )
+    })?;
+    eprintln!(
+        "wrote {} ({} robots, {} events, {} collisions)",
+        out.display(),
+        report.timelines.len(),
+        contents.events.len(),
+        report.collisions.len()
+    );
+    if let Some((read, e)) = contents.damage {
+        eprintln!(
+            "warning: {} is unfinished or damaged after {read} messages ({e}); the report shows what was read",
+            log.display()
         );
         return Ok(ExitCode::FAILURE);
     }
@@ -434,6 +473,7 @@ fn run(cmd: Command, color: bool) -> Result<ExitCode, String> {
             log_every,
         ),
         Command::Log { what } => read_log(what),
+        Command::Report { log, output } => write_report(&log, output),
         Command::Disasm { file } => {
             let bytes = std::fs::read(&file)
                 .map_err(|e| format!("cannot read `{}`: {e}", file.display()))?;

@@ -6,6 +6,7 @@
 //!   boundaries, races, deadlocks, statistics: [`engine::Simulation`].
 //! - [`collide`]: collision checks at cycle boundaries (parry3d).
 //! - [`mcaplog`]: the MCAP log of a run, playable in Foxglove.
+//! - [`report`]: the run report, one self-contained HTML file made from a log.
 //!
 //! ```no_run
 //! let cell = std::sync::Arc::new(vworks_se::workcell::load("workcells/handoff/cell.toml".as_ref()).unwrap());
@@ -16,6 +17,7 @@
 pub mod collide;
 pub mod engine;
 pub mod mcaplog;
+pub mod report;
 pub mod workcell;
 
 pub use vworks_wslc::link;

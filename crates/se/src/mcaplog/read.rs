@@ -65,6 +65,9 @@ pub struct LogContents {
     /// If the file is unfinished or damaged: how many messages were read before the
     /// damage, and what the damage is. Everything before it is above.
     pub damage: Option<(u64, String)>,
+    /// The `vworks` metadata record: the version, the cell's name, its robots (comma
+    /// separated), the cycle, the workcell file (empty if the record was not found).
+    pub metadata: BTreeMap<String, String>,
 }
 
 /// Reads the log at `path`.
@@ -88,6 +91,19 @@ pub fn read_log_bytes(file: &str, bytes: &[u8]) -> Result<LogContents, LogError>
     };
     let stream = mcap::MessageStream::new(bytes).map_err(|e| invalid(e.to_string()))?;
     let mut out = LogContents::default();
+    // The metadata record sits before the first chunk; a damaged tail does not hide it.
+    if let Ok(records) = mcap::read::LinearReader::new(bytes) {
+        for record in records {
+            match record {
+                Ok(mcap::records::Record::Metadata(m)) if m.name == "vworks" => {
+                    out.metadata = m.metadata;
+                    break;
+                }
+                Ok(_) => {}
+                Err(_) => break,
+            }
+        }
+    }
     for (read, m) in (0u64..).zip(stream) {
         let m = match m {
             Ok(m) => m,

@@ -1,0 +1,614 @@
+//! The run report: one self-contained HTML file (no network, no external files) made from
+//! a run's MCAP log — what `vworks report run.mcap -o report.html` writes.
+//!
+//! - a Gantt chart per robot over simulated time: moving, waiting, in a handler, idle
+//!   (the rest), with collisions (red lines across every row) and signals (ticks on the
+//!   sender's row) marked, as an inline SVG;
+//! - the cycle time of each robot (its `end` event) and its time moving, waiting, idle and
+//!   in handlers;
+//! - the collisions and the warnings and errors;
+//! - the event table, filterable by text, robot and kind (a few lines of inline
+//!   JavaScript; without it the whole table shows).
+//!
+//! Everything is derived from the `/events` topic, so a log thinned with `--log-every`
+//! gives the same report.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+use crate::mcaplog::{LogContents, LoggedEvent};
+
+/// Events in the table at most (the rest are counted; `vworks log events` lists them).
+pub const TABLE_LIMIT: usize = 20_000;
+
+/// What a robot does over an interval, as the chart colours it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Activity {
+    /// A motion (`motion_start` to `motion_end`).
+    Moving,
+    /// A `wait_until`, `wait_signal` or `join` (to its `wait_end`).
+    Waiting,
+    /// A `when` handler runs (`when_fire` to `when_end`).
+    Handler,
+}
+
+impl Activity {
+    fn name(self) -> &'static str {
+        match self {
+            Activity::Moving => "moving",
+            Activity::Waiting => "waiting",
+            Activity::Handler => "in handler",
+        }
+    }
+
+    fn colour(self) -> &'static str {
+        match self {
+            Activity::Moving => "#2f6fdf",
+            Activity::Waiting => "#f0a030",
+            Activity::Handler => "#9b59b6",
+        }
+    }
+}
+
+/// One robot's timeline, derived from its events.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Timeline {
+    /// The robot's name.
+    pub robot: String,
+    /// (activity, start ns, end ns), in order of start.
+    pub intervals: Vec<(Activity, i64, i64)>,
+    /// When its program ended (its `end` event), if it did.
+    pub ended_ns: Option<i64>,
+    /// Signals it sent: (time ns, `receiver.name`).
+    pub signals: Vec<(i64, String)>,
+    /// Number of motions.
+    pub motions: u64,
+}
+
+impl Timeline {
+    /// Total time in `activity` (ns).
+    pub fn total(&self, activity: Activity) -> i64 {
+        self.intervals
+            .iter()
+            .filter(|(a, ..)| *a == activity)
+            .map(|(_, s, e)| e - s)
+            .sum()
+    }
+}
+
+/// Everything the report shows, derived from a log.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Report {
+    /// The cell's name (from the log's metadata; `?` if it has none).
+    pub cell: String,
+    /// The simulated span: the last event's time (ns).
+    pub end_ns: i64,
+    /// Per robot, in the workcell's order (the metadata's), else in order of appearance.
+    pub timelines: Vec<Timeline>,
+    /// Collisions: (start ns, end ns if it ended, `body body`, details).
+    pub collisions: Vec<(i64, Option<i64>, String, String)>,
+    /// Warnings and errors: (time ns, `warning`/`error`, robot, message).
+    pub issues: Vec<(i64, String, Option<String>, String)>,
+}
+
+impl Report {
+    /// Derives the report from a log's events and metadata.
+    pub fn from_log(log: &LogContents) -> Report {
+        let mut order: Vec<String> = log
+            .metadata
+            .get("robots")
+            .map(|r| {
+                r.split(',')
+                    .filter(|s| !s.is_empty())
+                    .map(str::to_string)
+                    .collect()
+            })
+            .unwrap_or_default();
+        for e in &log.events {
+            if let Some(r) = &e.robot
+                && !order.contains(r)
+            {
+                order.push(r.clone());
+            }
+        }
+        let index: BTreeMap<&str, usize> = order
+            .iter()
+            .enumerate()
+            .map(|(i, r)| (r.as_str(), i))
+            .collect();
+        let mut timelines: Vec<Timeline> = order
+            .iter()
+            .map(|r| Timeline {
+                robot: r.clone(),
+                ..Timeline::default()
+            })
+            .collect();
+        // Open intervals per robot and activity.
+        let mut open: Vec<[Option<i64>; 3]> = vec![[None; 3]; order.len()];
+        let slot = |a: Activity| match a {
+            Activity::Moving => 0,
+            Activity::Waiting => 1,
+            Activity::Handler => 2,
+        };
+        let end_ns = log.events.iter().map(|e| e.time_ns).max().unwrap_or(0);
+        let mut collisions = Vec::new();
+        let mut open_collisions: BTreeMap<String, usize> = BTreeMap::new();
+        let mut issues = Vec::new();
+        for e in &log.events {
+            let r = e.robot.as_deref().and_then(|r| index.get(r)).copied();
+            let start = |a: Activity| (a, true);
+            let stop = |a: Activity| (a, false);
+            let change = match e.kind.as_str() {
+                "motion_start" => Some(start(Activity::Moving)),
+                "motion_end" => Some(stop(Activity::Moving)),
+                "wait_until" | "wait_signal" | "join" => Some(start(Activity::Waiting)),
+                "wait_end" => Some(stop(Activity::Waiting)),
+                "when_fire" => Some(start(Activity::Handler)),
+                "when_end" => Some(stop(Activity::Handler)),
+                _ => None,
+            };
+            if let (Some(r), Some((activity, begins))) = (r, change) {
+                let o = &mut open[r][slot(activity)];
+                if begins {
+                    o.get_or_insert(e.time_ns);
+                    if activity == Activity::Moving {
+                        timelines[r].motions += 1;
+                    }
+                } else if let Some(s) = o.take() {
+                    timelines[r].intervals.push((activity, s, e.time_ns));
+                }
+            }
+            match (e.kind.as_str(), r) {
+                ("end", Some(r)) => timelines[r].ended_ns = Some(e.time_ns),
+                ("signal", Some(r)) => timelines[r].signals.push((e.time_ns, e.details.clone())),
+                ("collision_start", _) => {
+                    let pair = pair_of(&e.details);
+                    open_collisions.insert(pair.clone(), collisions.len());
+                    collisions.push((e.time_ns, None, pair, e.details.clone()));
+                }
+                ("collision_end", _) => {
+                    if let Some(i) = open_collisions.remove(&pair_of(&e.details)) {
+                        collisions[i].1 = Some(e.time_ns);
+                    }
+                }
+                ("warning" | "error", _) => issues.push((
+                    e.time_ns,
+                    e.kind.clone(),
+                    e.robot.clone(),
+                    e.details.trim_matches('"').to_string(),
+                )),
+                _ => {}
+            }
+        }
+        // What is still open runs to the end of the log.
+        for (r, o) in open.iter().enumerate() {
+            for activity in [Activity::Moving, Activity::Waiting, Activity::Handler] {
+                if let Some(s) = o[slot(activity)] {
+                    timelines[r].intervals.push((activity, s, end_ns));
+                }
+            }
+            timelines[r]
+                .intervals
+                .sort_by_key(|(a, s, _)| (*s, slot(*a)));
+        }
+        Report {
+            cell: log
+                .metadata
+                .get("cell")
+                .cloned()
+                .unwrap_or_else(|| "?".into()),
+            end_ns,
+            timelines,
+            collisions,
+            issues,
+        }
+    }
+}
+
+/// The two bodies of a collision event's details (`a b depth=… point=…` or `a b`).
+fn pair_of(details: &str) -> String {
+    let mut words = details.split(' ');
+    let (a, b) = (words.next().unwrap_or(""), words.next().unwrap_or(""));
+    format!("{a} {b}")
+}
+
+/// Escapes text for HTML.
+fn esc(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&#39;"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+fn secs(ns: i64) -> String {
+    format!("{:.3} s", ns as f64 / 1e9)
+}
+
+/// A tick step (s) giving about 8–12 ticks over `span` seconds: 1, 2 or 5 × 10^k.
+fn tick_step(span: f64) -> f64 {
+    let raw = (span / 10.0).max(1e-9);
+    let mag = 10f64.powf(raw.log10().floor());
+    [1.0, 2.0, 5.0, 10.0]
+        .into_iter()
+        .map(|m| m * mag)
+        .find(|s| *s >= raw)
+        .unwrap_or(10.0 * mag)
+}
+
+/// The Gantt chart as an SVG element.
+fn gantt(report: &Report) -> String {
+    const LEFT: f64 = 140.0;
+    const WIDTH: f64 = 1000.0;
+    const ROW: f64 = 34.0;
+    const TOP: f64 = 24.0;
+    let span = report.end_ns.max(1) as f64;
+    let x = |ns: i64| LEFT + WIDTH * (ns as f64 / span);
+    let rows = report.timelines.len().max(1) as f64;
+    let height = TOP + rows * ROW + 30.0;
+    let mut s = String::new();
+    let _ = write!(
+        s,
+        r#"<svg id="gantt" xmlns="http://www.w3.org/2000/svg" viewBox="0 0 {w} {height}" width="100%" role="img" aria-label="Gantt chart of every robot over simulated time">"#,
+        w = LEFT + WIDTH + 20.0
+    );
+    // Time axis and grid.
+    let step = tick_step(span / 1e9);
+    let mut t = 0.0;
+    while t <= span / 1e9 + 1e-9 {
+        let xt = x((t * 1e9) as i64);
+        let _ = write!(
+            s,
+            r##"<line x1="{xt:.1}" y1="{TOP}" x2="{xt:.1}" y2="{y2:.1}" stroke="#ddd"/><text x="{xt:.1}" y="{ty:.1}" font-size="11" text-anchor="middle" fill="#555">{t}</text>"##,
+            y2 = TOP + rows * ROW,
+            ty = TOP + rows * ROW + 16.0,
+            t = format_tick(t, step)
+        );
+        t += step;
+    }
+    let _ = write!(
+        s,
+        r##"<text x="{xl:.1}" y="{ty:.1}" font-size="11" fill="#555">s</text>"##,
+        xl = LEFT + WIDTH + 6.0,
+        ty = TOP + rows * ROW + 16.0
+    );
+    for (i, tl) in report.timelines.iter().enumerate() {
+        let y = TOP + i as f64 * ROW;
+        let _ = write!(
+            s,
+            r##"<g class="row" data-robot="{name}"><text x="{tx}" y="{ty:.1}" font-size="13" text-anchor="end" fill="#222">{name}</text><rect class="idle" x="{LEFT}" y="{yb:.1}" width="{wi:.1}" height="22" fill="#e8e8e8"><title>{name}: idle</title></rect>"##,
+            name = esc(&tl.robot),
+            tx = LEFT - 8.0,
+            ty = y + 20.0,
+            yb = y + 4.0,
+            wi = x(tl.ended_ns.unwrap_or(report.end_ns)) - LEFT,
+        );
+        for (activity, start, end) in &tl.intervals {
+            let (yb, h) = if *activity == Activity::Handler {
+                (y + 4.0, 7.0) // a thin band over the main thread's activity
+            } else {
+                (y + 4.0, 22.0)
+            };
+            let _ = write!(
+                s,
+                r#"<rect class="{cls}" x="{x0:.2}" y="{yb:.1}" width="{w:.2}" height="{h}" fill="{fill}"><title>{name}: {what} {a} – {b}</title></rect>"#,
+                cls = activity.name().replace(' ', "-"),
+                x0 = x(*start),
+                w = (x(*end) - x(*start)).max(0.5),
+                fill = activity.colour(),
+                name = esc(&tl.robot),
+                what = activity.name(),
+                a = secs(*start),
+                b = secs(*end),
+            );
+        }
+        for (t, to) in &tl.signals {
+            let xs = x(*t);
+            let _ = write!(
+                s,
+                r##"<path class="signal" d="M{xs:.1} {y0:.1} l-4 -6 h8 z" fill="#1a9e55"><title>{name} signals {to} at {at}</title></path>"##,
+                y0 = y + 4.0,
+                name = esc(&tl.robot),
+                to = esc(to),
+                at = secs(*t),
+            );
+        }
+        if let Some(end) = tl.ended_ns {
+            let _ = write!(
+                s,
+                r##"<line class="end" x1="{xe:.1}" y1="{y0:.1}" x2="{xe:.1}" y2="{y1:.1}" stroke="#222" stroke-width="2"><title>{name} ends at {at}</title></line>"##,
+                xe = x(end),
+                y0 = y + 2.0,
+                y1 = y + 28.0,
+                name = esc(&tl.robot),
+                at = secs(end),
+            );
+        }
+        s.push_str("</g>");
+    }
+    for (start, _, pair, details) in &report.collisions {
+        let xc = x(*start);
+        let _ = write!(
+            s,
+            r##"<line class="collision" x1="{xc:.1}" y1="{TOP}" x2="{xc:.1}" y2="{y1:.1}" stroke="#d62728" stroke-width="2"><title>collision at {at}: {d}</title></line>"##,
+            y1 = TOP + rows * ROW,
+            at = secs(*start),
+            d = esc(if details.is_empty() { pair } else { details }),
+        );
+    }
+    s.push_str("</svg>");
+    s
+}
+
+fn format_tick(t: f64, step: f64) -> String {
+    if step >= 1.0 {
+        format!("{t:.0}")
+    } else {
+        let digits = (-step.log10()).ceil() as usize;
+        format!("{t:.digits$}")
+    }
+}
+
+/// The report as one HTML document. `source` names the log in the heading.
+pub fn html(report: &Report, events: &[LoggedEvent], source: &str) -> String {
+    let mut s = String::new();
+    let title = format!("vworks report: {}", report.cell);
+    let _ = write!(
+        s,
+        r#"<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
+<title>{t}</title>
+<style>
+body {{ font: 14px/1.4 system-ui, -apple-system, "Segoe UI", sans-serif; margin: 24px; color: #222; }}
+h1 {{ font-size: 22px; margin: 0 0 4px; }} h2 {{ font-size: 17px; margin: 28px 0 8px; }}
+.sub {{ color: #666; margin-bottom: 16px; }}
+table {{ border-collapse: collapse; }} th, td {{ padding: 3px 10px; border-bottom: 1px solid #eee; text-align: left; }}
+th {{ background: #f6f6f6; position: sticky; top: 0; }} td.num, th.num {{ text-align: right; font-variant-numeric: tabular-nums; }}
+.legend span {{ display: inline-block; margin-right: 16px; }} .legend i {{ display: inline-block; width: 14px; height: 10px; margin-right: 5px; vertical-align: middle; }}
+#filters input, #filters select {{ margin-right: 8px; padding: 3px 6px; }}
+#events {{ font-family: ui-monospace, monospace; font-size: 12px; }} .none {{ color: #888; }}
+</style></head><body>
+<h1>{t}</h1>
+<div class="sub">{src} · simulated span {span} · {n} events</div>
+"#,
+        t = esc(&title),
+        src = esc(source),
+        span = secs(report.end_ns),
+        n = events.len()
+    );
+    // Cycle times.
+    s.push_str("<h2>Cycle time per robot</h2>\n<table id=\"cycle-times\"><tr><th>robot</th><th class=\"num\">cycle time</th><th class=\"num\">moving</th><th class=\"num\">waiting</th><th class=\"num\">in handlers</th><th class=\"num\">idle</th><th class=\"num\">motions</th></tr>\n");
+    for tl in &report.timelines {
+        let end = tl.ended_ns.unwrap_or(report.end_ns);
+        let (moving, waiting) = (tl.total(Activity::Moving), tl.total(Activity::Waiting));
+        let idle = (end - moving - waiting).max(0);
+        let _ = writeln!(
+            s,
+            "<tr><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td></tr>",
+            esc(&tl.robot),
+            match tl.ended_ns {
+                Some(e) => secs(e),
+                None => format!("did not end ({})", secs(report.end_ns)),
+            },
+            secs(moving),
+            secs(waiting),
+            secs(tl.total(Activity::Handler)),
+            secs(idle),
+            tl.motions
+        );
+    }
+    s.push_str("</table>\n");
+    // Gantt.
+    s.push_str("<h2>Timeline</h2>\n<div class=\"legend\">");
+    for a in [Activity::Moving, Activity::Waiting, Activity::Handler] {
+        let _ = write!(
+            s,
+            "<span><i style=\"background:{}\"></i>{}</span>",
+            a.colour(),
+            a.name()
+        );
+    }
+    s.push_str("<span><i style=\"background:#e8e8e8\"></i>idle</span><span><i style=\"background:#d62728\"></i>collision</span><span><i style=\"background:#1a9e55\"></i>signal sent</span><span><i style=\"background:#222\"></i>program end</span></div>\n");
+    s.push_str(&gantt(report));
+    s.push('\n');
+    // Collisions and issues.
+    s.push_str("<h2>Collisions</h2>\n");
+    if report.collisions.is_empty() {
+        s.push_str("<p class=\"none\" id=\"collisions\">No collision.</p>\n");
+    } else {
+        s.push_str("<table id=\"collisions\"><tr><th class=\"num\">start</th><th class=\"num\">end</th><th>bodies</th><th>details</th></tr>\n");
+        for (start, end, pair, details) in &report.collisions {
+            let _ = writeln!(
+                s,
+                "<tr><td class=\"num\">{}</td><td class=\"num\">{}</td><td>{}</td><td>{}</td></tr>",
+                secs(*start),
+                end.map_or("–".into(), secs),
+                esc(pair),
+                esc(details)
+            );
+        }
+        s.push_str("</table>\n");
+    }
+    s.push_str("<h2>Warnings and errors</h2>\n");
+    if report.issues.is_empty() {
+        s.push_str("<p class=\"none\" id=\"issues\">None.</p>\n");
+    } else {
+        s.push_str("<table id=\"issues\"><tr><th class=\"num\">time</th><th>kind</th><th>robot</th><th>message</th></tr>\n");
+        for (t, kind, robot, message) in &report.issues {
+            let _ = writeln!(
+                s,
+                "<tr><td class=\"num\">{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                secs(*t),
+                esc(kind),
+                esc(robot.as_deref().unwrap_or("–")),
+                esc(message)
+            );
+        }
+        s.push_str("</table>\n");
+    }
+    // Events.
+    let robots: Vec<&str> = report.timelines.iter().map(|t| t.robot.as_str()).collect();
+    let mut kinds: Vec<&str> = events.iter().map(|e| e.kind.as_str()).collect();
+    kinds.sort_unstable();
+    kinds.dedup();
+    s.push_str("<h2>Events</h2>\n<div id=\"filters\"><input id=\"text\" type=\"search\" placeholder=\"filter: any text\" aria-label=\"filter events by text\">");
+    s.push_str("<select id=\"robot\" aria-label=\"robot\"><option value=\"\">every robot</option>");
+    for r in &robots {
+        let _ = write!(s, "<option>{}</option>", esc(r));
+    }
+    s.push_str("<option value=\"-\">(cell)</option></select><select id=\"kind\" aria-label=\"kind\"><option value=\"\">every kind</option>");
+    for k in &kinds {
+        let _ = write!(s, "<option>{}</option>", esc(k));
+    }
+    let shown = events.len().min(TABLE_LIMIT);
+    let _ = writeln!(
+        s,
+        "</select><span id=\"count\">{shown} of {} events</span></div>",
+        events.len()
+    );
+    s.push_str("<table id=\"events\"><thead><tr><th class=\"num\">time (s)</th><th>robot</th><th>kind</th><th>details</th><th>source</th></tr></thead><tbody>\n");
+    for e in &events[..shown] {
+        let pos = match &e.file {
+            Some(f) => format!(
+                "{}:{}:{}",
+                std::path::Path::new(f)
+                    .file_name()
+                    .map_or(f.clone(), |n| n.to_string_lossy().into_owned()),
+                e.line,
+                e.col
+            ),
+            None => String::new(),
+        };
+        let robot = e.robot.as_deref().unwrap_or("-");
+        let _ = writeln!(
+            s,
+            "<tr data-robot=\"{r}\" data-kind=\"{k}\"><td class=\"num\">{t:.6}</td><td>{r}</td><td>{k}</td><td>{d}</td><td>{p}</td></tr>",
+            r = esc(robot),
+            k = esc(&e.kind),
+            t = e.time_ns as f64 / 1e9,
+            d = esc(&e.details),
+            p = esc(&pos)
+        );
+    }
+    s.push_str("</tbody></table>\n");
+    if events.len() > shown {
+        let _ = writeln!(
+            s,
+            "<p class=\"none\">The first {shown} of {} events; `vworks log events` lists them all.</p>",
+            events.len()
+        );
+    }
+    s.push_str(
+        r##"<script>
+(function () {
+  var text = document.getElementById("text"), robot = document.getElementById("robot"),
+      kind = document.getElementById("kind"), count = document.getElementById("count");
+  var rows = Array.prototype.slice.call(document.querySelectorAll("#events tbody tr"));
+  function apply() {
+    var t = text.value.toLowerCase(), r = robot.value, k = kind.value, n = 0;
+    rows.forEach(function (row) {
+      var show = (!r || row.dataset.robot === r) && (!k || row.dataset.kind === k) &&
+                 (!t || row.textContent.toLowerCase().indexOf(t) >= 0);
+      row.style.display = show ? "" : "none";
+      if (show) n++;
+    });
+    count.textContent = n + " of " + rows.length + " events shown";
+  }
+  [text, robot, kind].forEach(function (el) { el.addEventListener("input", apply); });
+  apply();
+})();
+</script>
+</body></html>
+"##,
+    );
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ev(t: i64, robot: Option<&str>, kind: &str, details: &str) -> LoggedEvent {
+        LoggedEvent {
+            time_ns: t,
+            robot: robot.map(str::to_string),
+            kind: kind.into(),
+            details: details.into(),
+            file: None,
+            line: 0,
+            col: 0,
+        }
+    }
+
+    #[test]
+    fn intervals_come_from_start_and_end_events() {
+        let log = LogContents {
+            events: vec![
+                ev(0, Some("a"), "motion_start", "move_j duration=5"),
+                ev(5, Some("a"), "motion_end", ""),
+                ev(5, Some("a"), "wait_until", "condition(g)"),
+                ev(7, Some("b"), "signal", "a.go"),
+                ev(8, Some("a"), "wait_end", "released"),
+                ev(
+                    8,
+                    None,
+                    "collision_start",
+                    "a.link_1 b.link_2 depth=0mm point=(0, 0, 0)",
+                ),
+                ev(9, None, "collision_end", "a.link_1 b.link_2"),
+                ev(9, Some("a"), "when_fire", "h"),
+                ev(10, Some("a"), "end", ""),
+                ev(
+                    12,
+                    None,
+                    "warning",
+                    "\"near miss: x and y come within 1mm\"",
+                ),
+            ],
+            ..LogContents::default()
+        };
+        let r = Report::from_log(&log);
+        assert_eq!(r.end_ns, 12);
+        let a = &r.timelines[0];
+        assert_eq!(
+            a.intervals,
+            vec![
+                (Activity::Moving, 0, 5),
+                (Activity::Waiting, 5, 8),
+                (Activity::Handler, 9, 12)
+            ]
+        );
+        assert_eq!((a.ended_ns, a.motions), (Some(10), 1));
+        assert_eq!(r.timelines[1].signals, vec![(7, "a.go".to_string())]);
+        assert_eq!(r.collisions[0].0..r.collisions[0].1.unwrap(), 8..9);
+        assert_eq!(r.issues[0].3, "near miss: x and y come within 1mm");
+        let page = html(&r, &log.events, "x.mcap");
+        assert!(page.contains("<svg id=\"gantt\""));
+        assert!(page.contains("class=\"collision\""));
+        // Self-contained: nothing loaded from elsewhere.
+        assert!(!page.contains(" src=") && !page.contains("<link"));
+    }
+
+    #[test]
+    fn text_is_escaped() {
+        assert_eq!(
+            esc("<a href=\"x\">&'"),
+            "&lt;a href=&quot;x&quot;&gt;&amp;&#39;"
+        );
+    }
+
+    #[test]
+    fn ticks_are_round_numbers() {
+        assert_eq!(tick_step(63.4), 10.0);
+        assert_eq!(tick_step(17.8), 2.0);
+        assert_eq!(tick_step(0.4), 0.05);
+        assert_eq!(format_tick(0.15, 0.05), "0.15");
+    }
+}
