@@ -8,6 +8,8 @@
 //! - `vworks run CELL [--log run.mcap]`: simulate a workcell and print the summary.
 //! - `vworks log info|events FILE.mcap`: read a run's log.
 //! - `vworks report FILE.mcap [-o report.html]`: the run's HTML report.
+//! - `vworks new NAME`: a new workcell folder, ready to run.
+//! - `vworks completions SHELL`: a shell completion script.
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -72,6 +74,9 @@ enum Command {
         /// Log the state of every N-th cycle only (events are never thinned).
         #[arg(long, default_value_t = 1)]
         log_every: u64,
+        /// No progress bar (it shows on a terminal for runs longer than a second).
+        #[arg(short, long)]
+        quiet: bool,
     },
     /// Write a run's report, one self-contained HTML file: a Gantt chart per robot, cycle
     /// times, collisions, warnings and the event table.
@@ -81,6 +86,16 @@ enum Command {
         /// The HTML file to write (default: the log's name with extension .html).
         #[arg(short, long)]
         output: Option<PathBuf>,
+    },
+    /// Create a new workcell folder: one robot, its program and a README, ready to run.
+    New {
+        /// The folder to create (its name becomes the cell's name).
+        name: PathBuf,
+    },
+    /// Print a shell completion script (e.g. `vworks completions bash > ~/.local/share/bash-completion/completions/vworks`).
+    Completions {
+        /// The shell.
+        shell: clap_complete::Shell,
     },
     /// Read an MCAP log written by `vworks run --log`.
     Log {
@@ -230,6 +245,81 @@ fn read_log(what: LogCommand) -> Result<ExitCode, String> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// The files `vworks new` writes: (name, text); `{name}` is the cell's name.
+const NEW_CELL: &[(&str, &str)] = &[
+    (
+        "cell.toml",
+        r#"# A workcell: its robots, devices and parts. See docs/engine.md for every key.
+name = "{name}"
+cycle = "4ms"          # collision checks at every 4 ms boundary (and between them)
+clearance = "5mm"      # closer than this is a near-miss warning
+
+[[robot]]
+name = "r1"
+model = "irb120"       # built in: irb120, kr6r900, lrmate200id, ur5, turntable, track
+program = "r1.wsl"
+home = ["0deg", "-30deg", "30deg", "0deg", "60deg", "0deg"]
+
+[[device]]
+name = "table"
+box = ["600mm", "800mm", "20mm"]
+pose = { xyz = ["500mm", "0mm", "-10mm"] }
+"#,
+    ),
+    (
+        "r1.wsl",
+        r#"// r1's program: two straight-line moves above the table, three times.
+const above = pose(400mm, -150mm, 300mm, 180deg, 0deg, 0deg);
+
+proc main() {
+    var i = 0;
+    while i < 3 {
+        move_l above speed 250mm/s;
+        move_l offset(above, 0mm, 300mm, 0mm) speed 250mm/s;
+        i += 1;
+    }
+    log "done";
+}
+"#,
+    ),
+    (
+        "README.md",
+        "# {name}\n\nA vworks workcell: `vworks run {name}/cell.toml --log run.mcap`, then `vworks report run.mcap`.\n",
+    ),
+];
+
+fn new_cell(dir: &Path) -> Result<ExitCode, String> {
+    let name = dir
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .filter(|n| !n.is_empty() && !n.starts_with('.'))
+        .ok_or_else(|| {
+            format!(
+                "`{}` is not a folder name for a new cell; write e.g. `vworks new mycell`",
+                dir.display()
+            )
+        })?;
+    if dir.exists() && std::fs::read_dir(dir).map_or(true, |mut entries| entries.next().is_some()) {
+        return Err(format!(
+            "`{}` already exists and is not empty; choose another name, or delete it first",
+            dir.display()
+        ));
+    }
+    std::fs::create_dir_all(dir)
+        .map_err(|e| format!("cannot create the folder `{}`: {e}", dir.display()))?;
+    for (file, text) in NEW_CELL {
+        let path = dir.join(file);
+        std::fs::write(&path, text.replace("{name}", &name))
+            .map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
+    }
+    eprintln!(
+        "created {}: cell.toml (one irb120 and a table), r1.wsl, README.md\nrun it: vworks run {}",
+        dir.display(),
+        dir.join("cell.toml").display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
 fn write_report(log: &Path, output: Option<PathBuf>) -> Result<ExitCode, String> {
     let contents = vworks_se::mcaplog::read_log(log).map_err(|e| e.to_string())?;
     let report = vworks_se::report::Report::from_log(&contents);
@@ -258,6 +348,55 @@ fn write_report(log: &Path, output: Option<PathBuf>) -> Result<ExitCode, String>
     Ok(ExitCode::SUCCESS)
 }
 
+/// Runs the simulation to its end (or `until`). With `progress` (the run's start), a bar on
+/// stderr shows the simulated time done and the speed, once the run has taken a second:
+/// against `until` when there is one, else as a spinner (the end is not known ahead).
+fn simulate(
+    mut sim: vworks_se::engine::Simulation,
+    until: Option<i64>,
+    progress: Option<std::time::Instant>,
+) -> vworks_se::engine::RunResult {
+    let Some(started) = progress else {
+        return sim.run(until);
+    };
+    let mut bar: Option<indicatif::ProgressBar> = None;
+    let mut steps = 0u32;
+    while sim.step(until) {
+        steps = steps.wrapping_add(1);
+        // The clock is read every few thousand steps: the bar costs nothing measurable.
+        if !steps.is_multiple_of(4096) {
+            continue;
+        }
+        let wall = started.elapsed().as_secs_f64();
+        if wall < 1.0 {
+            continue;
+        }
+        let done = sim.time().max(0) as u64;
+        let bar = bar.get_or_insert_with(|| {
+            let style = |template: &str| {
+                indicatif::ProgressStyle::with_template(template)
+                    .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+            };
+            match until {
+                Some(u) => indicatif::ProgressBar::new(u.max(1) as u64)
+                    .with_style(style("{spinner} [{bar:30}] {msg}")),
+                None => indicatif::ProgressBar::new_spinner().with_style(style("{spinner} {msg}")),
+            }
+        });
+        bar.set_position(done);
+        bar.set_message(format!(
+            "simulated {:.1} s, {:.0}x real time",
+            done as f64 / 1e9,
+            done as f64 / 1e9 / wall
+        ));
+        bar.tick();
+    }
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    sim.into_result()
+}
+
 fn run_cell(
     path: &Path,
     until: Option<&str>,
@@ -265,6 +404,7 @@ fn run_cell(
     trace: bool,
     log: Option<&Path>,
     log_every: u64,
+    progress: bool,
 ) -> Result<ExitCode, String> {
     let until = until.map(parse_time).transpose()?;
     let cell = match vworks_se::workcell::load(path) {
@@ -287,7 +427,7 @@ fn run_cell(
                 .map_err(|e| e.to_string())?,
         );
     }
-    let r = sim.run(until);
+    let r = simulate(sim, until, progress.then_some(started));
     if let Some(e) = &r.log_error {
         eprintln!("error: {e}");
     }
@@ -464,6 +604,7 @@ fn run(cmd: Command, color: bool) -> Result<ExitCode, String> {
             trace,
             log,
             log_every,
+            quiet,
         } => run_cell(
             &cell,
             until.as_deref(),
@@ -471,9 +612,19 @@ fn run(cmd: Command, color: bool) -> Result<ExitCode, String> {
             trace,
             log.as_deref(),
             log_every,
+            !quiet && std::io::stderr().is_terminal(),
         ),
         Command::Log { what } => read_log(what),
         Command::Report { log, output } => write_report(&log, output),
+        Command::New { name } => new_cell(&name),
+        Command::Completions { shell } => {
+            use clap::CommandFactory as _;
+            let mut cmd = Cli::command();
+            let mut buf = Vec::new();
+            clap_complete::generate(shell, &mut cmd, "vworks", &mut buf);
+            out!("{}", String::from_utf8_lossy(&buf).trim_end());
+            Ok(ExitCode::SUCCESS)
+        }
         Command::Disasm { file } => {
             let bytes = std::fs::read(&file)
                 .map_err(|e| format!("cannot read `{}`: {e}", file.display()))?;
