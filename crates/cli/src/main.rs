@@ -60,7 +60,7 @@ enum Command {
         /// The workcell file (cell.toml).
         cell: PathBuf,
         /// Stop at this simulated time ("10s", "250ms", or seconds).
-        #[arg(long)]
+        #[arg(long, allow_hyphen_values = true)]
         until: Option<String>,
         /// Print the result as one JSON object.
         #[arg(long)]
@@ -72,7 +72,7 @@ enum Command {
         #[arg(long)]
         log: Option<PathBuf>,
         /// Log the state of every N-th cycle only (events are never thinned).
-        #[arg(long, default_value_t = 1)]
+        #[arg(long, default_value_t = 1, value_parser = every_nth)]
         log_every: u64,
         /// No progress bar (it shows on a terminal for runs longer than a second).
         #[arg(short, long)]
@@ -124,6 +124,16 @@ enum LogCommand {
     },
 }
 
+/// `--log-every N`: a whole number, 1 or more.
+fn every_nth(s: &str) -> Result<u64, String> {
+    match s.parse::<u64>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err(format!(
+            "`{s}` is not a whole number of cycles from 1 up; write 1 to log every cycle, 10 for every 10th"
+        )),
+    }
+}
+
 /// `println!` that ends the process quietly when stdout is gone (`vworks log events … | head`)
 /// instead of panicking.
 macro_rules! out {
@@ -149,7 +159,17 @@ fn main() -> ExitCode {
 }
 
 fn read(path: &Path) -> Result<String, String> {
-    std::fs::read_to_string(path).map_err(|e| format!("cannot read `{}`: {e}", path.display()))
+    std::fs::read_to_string(path).map_err(|e| cannot_read(path, &e))
+}
+
+/// "cannot read FILE: why; what to do" for a file named on the command line.
+fn cannot_read(path: &Path, e: &std::io::Error) -> String {
+    let hint = match e.kind() {
+        std::io::ErrorKind::NotFound => "; check the path (relative to the current folder)",
+        std::io::ErrorKind::PermissionDenied => "; check the file's permissions",
+        _ => "",
+    };
+    format!("cannot read `{}`: {e}{hint}", path.display())
 }
 
 fn display(path: &Path) -> String {
@@ -176,6 +196,11 @@ fn compile_file(path: &Path, color: bool) -> Result<(Option<Module>, usize, usiz
 }
 
 fn parse_time(s: &str) -> Result<i64, String> {
+    if s.trim().starts_with('-') {
+        return Err(format!(
+            "--until `{s}` is before the run starts; give a time from 0, e.g. 10s"
+        ));
+    }
     let mut diags = Vec::new();
     let toks = vworks_wslc::lexer::lex(s.trim(), &mut diags);
     use vworks_wslc::lexer::TokKind;
@@ -189,6 +214,11 @@ fn parse_time(s: &str) -> Result<i64, String> {
             ));
         }
     };
+    if secs < 0.0 || !secs.is_finite() {
+        return Err(format!(
+            "--until `{s}` is before the run starts; give a time from 0, e.g. 10s"
+        ));
+    }
     Ok((secs * 1e9).round() as i64)
 }
 
@@ -626,10 +656,14 @@ fn run(cmd: Command, color: bool) -> Result<ExitCode, String> {
             Ok(ExitCode::SUCCESS)
         }
         Command::Disasm { file } => {
-            let bytes = std::fs::read(&file)
-                .map_err(|e| format!("cannot read `{}`: {e}", file.display()))?;
+            let bytes = std::fs::read(&file).map_err(|e| cannot_read(&file, &e))?;
             let (module, source) = if bytes.starts_with(&vworks_vm::bytecode::MAGIC) {
-                let m = Module::decode(&bytes).map_err(|e| format!("{}: {e}", file.display()))?;
+                let m = Module::decode(&bytes).map_err(|e| {
+                    format!(
+                        "{}: {e}; the file is damaged or from another vworks version: build it again with `vworks build PROGRAM.wsl`",
+                        file.display()
+                    )
+                })?;
                 // The source beside the listing, if it is where the module says.
                 let near = file
                     .parent()

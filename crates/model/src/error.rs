@@ -16,7 +16,9 @@ pub enum ModelError {
         reason: String,
     },
     /// The file is not well-formed URDF XML.
-    #[error("`{file}` is not a valid URDF: {reason}")]
+    #[error(
+        "`{file}` is not a valid URDF: {reason}; a URDF is XML with one <robot> element holding <link> and <joint> elements"
+    )]
     Parse {
         /// The file.
         file: String,

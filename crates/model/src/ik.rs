@@ -34,7 +34,7 @@ pub const MAX_AXES: usize = 12;
 pub enum IkError {
     /// The position is beyond the arm's reach.
     #[error(
-        "the pose (x {x:.4} m, y {y:.4} m, z {z:.4} m) is out of reach of {robot}: the wrist centre is {excess:.4} m beyond what the arm can reach"
+        "the pose (x {x:.4} m, y {y:.4} m, z {z:.4} m) is out of reach of {robot}: the wrist centre is {excess:.4} m beyond what the arm can reach; bring the target closer or move the robot's base"
     )]
     OutOfReach {
         /// Robot name.

@@ -330,7 +330,7 @@ impl Ctx<'_> {
             let bytes = std::fs::read(&path).map_err(|e| {
                 self.bad(
                     &format!("{key}.mesh"),
-                    format!("cannot read `{}`: {e}", path.display()),
+                    format!("cannot read `{}`: {e}{}", path.display(), read_hint(&e)),
                 )
             })?;
             let s = b.scale.unwrap_or(1.0);
@@ -371,21 +371,42 @@ pub fn same_link(a: &str, b: &str) -> bool {
     a == b || norm(a) == norm(b)
 }
 
+/// What to do about a file that cannot be read.
+fn read_hint(e: &std::io::Error) -> &'static str {
+    match e.kind() {
+        std::io::ErrorKind::NotFound => {
+            "; check the path: it is relative to the workcell file's folder"
+        }
+        std::io::ErrorKind::PermissionDenied => "; check the file's permissions",
+        _ => "",
+    }
+}
+
 /// Loads a workcell file: models, programs (compiled and linked), shapes.
 pub fn load(path: &Path) -> Result<Cell, CellError> {
     let file = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|e| CellError::Read {
         file: file.clone(),
-        reason: e.to_string(),
+        reason: match e.kind() {
+            std::io::ErrorKind::NotFound => format!(
+                "{e}; check the path (relative to the current folder); `vworks new NAME` creates a workcell"
+            ),
+            _ => format!("{e}{}", read_hint(&e)),
+        },
     })?;
     let cx = Ctx { file: &file };
     let cf: CellFile = toml::from_str(&text).map_err(|e| {
         let msg = e.message().to_string();
         let place = e.span().map(|s| {
-            let line = text[..s.start.min(text.len())].matches('\n').count() + 1;
-            format!("line {line}")
+            let before = &text[..s.start.min(text.len())];
+            let line = before.matches('\n').count() + 1;
+            let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+            format!("line {line}, column {col}")
         });
-        cx.bad(&place.unwrap_or_else(|| "file".into()), msg)
+        cx.bad(
+            &place.unwrap_or_else(|| "file".into()),
+            format!("{msg}; the workcell format, key by key, is in docs/engine.md"),
+        )
     })?;
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let cycle = match &cf.cycle {
@@ -484,7 +505,7 @@ pub fn load(path: &Path) -> Result<Cell, CellError> {
                 let src = std::fs::read_to_string(&ppath).map_err(|e| {
                     cx.bad(
                         &format!("{key}.program"),
-                        format!("cannot read `{pname}`: {e}"),
+                        format!("cannot read `{pname}`: {e}{}", read_hint(&e)),
                     )
                 })?;
                 render_sources.add(&pname, &src);

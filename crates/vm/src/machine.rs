@@ -1054,13 +1054,25 @@ impl Vm {
             for (i, g) in goal.iter().enumerate().take(n) {
                 let j = self.model.axis(i);
                 if *g < j.lower - 1e-9 || *g > j.upper + 1e-9 {
+                    // In the units a programmer writes: degrees, or millimetres for a
+                    // prismatic axis.
+                    let (k, unit) = if j.kind == vworks_model::model::JointKind::Prismatic {
+                        (1e3, "mm")
+                    } else {
+                        (180.0 / std::f64::consts::PI, "deg")
+                    };
                     return Err(format!(
-                        "joint limit exceeded: axis {} `{}` target {:.3} is outside {:.3}..{:.3}",
+                        "joint limit exceeded: axis {} `{}` would go to {:.1}{unit}, outside its range {:.1}{unit} to {:.1}{unit}; choose a target within the range{}",
                         i + 1,
                         j.name,
-                        g,
-                        j.lower,
-                        j.upper
+                        g * k,
+                        j.lower * k,
+                        j.upper * k,
+                        if target.len() == MAX_AXES {
+                            ""
+                        } else {
+                            " (this pose needs it: try another wrist configuration or approach)"
+                        }
                     ));
                 }
             }

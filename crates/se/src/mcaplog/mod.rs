@@ -315,7 +315,25 @@ impl McapLog {
             file: file.clone(),
             reason: error_chain(e),
         };
-        let f = BufWriter::new(File::create(path).map_err(|e| io(&e))?);
+        let f = BufWriter::new(File::create(path).map_err(|e| {
+            let hint = match e.kind() {
+                std::io::ErrorKind::NotFound => match path.parent() {
+                    Some(dir) if !dir.as_os_str().is_empty() => format!(
+                        "; the folder `{}` does not exist: create it, or write the log elsewhere",
+                        dir.display()
+                    ),
+                    _ => String::new(),
+                },
+                std::io::ErrorKind::PermissionDenied => {
+                    "; this folder is not writable: write the log elsewhere".into()
+                }
+                _ => String::new(),
+            };
+            LogError::Io {
+                file: file.clone(),
+                reason: format!("{}{hint}", error_chain(&e)),
+            }
+        })?);
         let cell = Arc::clone(cell);
         let encoding = options.encoding;
         let open = move || {

@@ -75,7 +75,12 @@ pub fn read_log(path: &Path) -> Result<LogContents, LogError> {
     let file = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| LogError::Read {
         file: file.clone(),
-        reason: e.to_string(),
+        reason: match e.kind() {
+            std::io::ErrorKind::NotFound => format!(
+                "{e}; check the path, or write the log first: `vworks run CELL --log {file}`"
+            ),
+            _ => e.to_string(),
+        },
     })?;
     read_log_bytes(&file, &bytes)
 }
