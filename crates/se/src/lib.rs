@@ -21,3 +21,8 @@ pub mod report;
 pub mod workcell;
 
 pub use vworks_wslc::link;
+
+/// The README's Rust example, compiled by `cargo test --doc` so that it stays true.
+#[cfg(doctest)]
+#[doc = include_str!("../../../README.md")]
+pub struct ReadmeExamples;
