@@ -108,3 +108,17 @@ def test_a_missing_log_is_an_error_that_names_it(tmp_path):
     out = subprocess.run([VWORKS, "report", str(tmp_path / "nope.mcap")], capture_output=True, text=True)
     assert out.returncode == 1
     assert "nope.mcap" in out.stderr
+
+
+def test_python_writes_the_same_report(tmp_path):
+    import vworks
+
+    log = tmp_path / "handoff.mcap"
+    vworks.load_cell(str(ROOT / "workcells" / "handoff" / "cell.toml")).run(log=str(log))
+    written = vworks.write_report(log)
+    assert written == tmp_path / "handoff.html"
+    cli = tmp_path / "cli.html"
+    subprocess.run([VWORKS, "report", str(log), "-o", str(cli)], check=True, capture_output=True)
+    assert written.read_text() == cli.read_text()
+    with pytest.raises(vworks.Error, match="not an MCAP file"):
+        vworks.write_report(ROOT / "README.md", tmp_path / "x.html")

@@ -3,7 +3,8 @@
 //! ./crates/py`, or `maturin develop` in a virtualenv).
 //!
 //! What Python sees: `compile` → `Module`; `load_cell` → `Cell`; `Cell.run` → `Result`;
-//! `Cell.simulation` → `Simulation` (stepping, robot state, globals, events); `read_log`.
+//! `Cell.simulation` → `Simulation` (stepping, robot state, globals, events); `read_log`;
+//! `write_report`.
 //! Times are seconds (floats) with `_ns` twins (integers); lengths metres, angles
 //! radians. Errors are `vworks.Error` and its subclasses, never a crash: the library
 //! does not panic on input, and a panic that slipped through would surface as pyo3's
@@ -1060,6 +1061,25 @@ fn read_log(py: Python<'_>, path: PathBuf) -> PyResult<EventList> {
     })
 }
 
+/// Writes the HTML report of a run from its MCAP log: a Gantt chart per robot, cycle
+/// times, collisions, warnings and the filterable event table, in one self-contained file
+/// (what `vworks report` writes). `output` defaults to the log's path with `.html`; returns
+/// the path written. Raises `Error` for a file that is not a vworks log or an output that
+/// cannot be written.
+#[pyfunction]
+#[pyo3(signature = (log, output=None))]
+fn write_report(py: Python<'_>, log: PathBuf, output: Option<PathBuf>) -> PyResult<PathBuf> {
+    let out = output.unwrap_or_else(|| log.with_extension("html"));
+    py.detach(|| {
+        let contents = vworks_se::mcaplog::read_log(&log).map_err(|e| e.to_string())?;
+        let report = vworks_se::report::Report::from_log(&contents);
+        let page = vworks_se::report::html(&report, &contents.events, &log.display().to_string());
+        std::fs::write(&out, page).map_err(|e| format!("cannot write `{}`: {e}", out.display()))
+    })
+    .map_err(Error::new_err)?;
+    Ok(out)
+}
+
 /// The `vworks._vworks` extension module.
 #[pymodule]
 fn _vworks(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -1068,6 +1088,7 @@ fn _vworks(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(compile, m)?)?;
     m.add_function(wrap_pyfunction!(load_cell, m)?)?;
     m.add_function(wrap_pyfunction!(read_log, m)?)?;
+    m.add_function(wrap_pyfunction!(write_report, m)?)?;
     m.add_class::<Module>()?;
     m.add_class::<Diagnostic>()?;
     m.add_class::<Cell>()?;

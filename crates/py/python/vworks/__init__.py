@@ -33,6 +33,7 @@ from ._vworks import (
     compile,
     load_cell,
     read_log,
+    write_report,
 )
 
 __all__ = [
@@ -56,4 +57,5 @@ __all__ = [
     "compile",
     "load_cell",
     "read_log",
+    "write_report",
 ]

@@ -30,6 +30,7 @@ __all__ = [
     "compile",
     "load_cell",
     "read_log",
+    "write_report",
 ]
 
 class Error(Exception):
@@ -101,6 +102,11 @@ def load_cell(path: Union[str, os.PathLike[str]]) -> Cell:
 
 def read_log(path: Union[str, os.PathLike[str]]) -> EventList:
     """The events of an MCAP log written by vworks."""
+
+def write_report(
+    log: Union[str, os.PathLike[str]], output: Optional[Union[str, os.PathLike[str]]] = None
+) -> pathlib.Path:
+    """Writes the run's HTML report from its log; returns the path written."""
 
 @final
 class Cell:
