@@ -475,17 +475,7 @@ th {{ background: #f6f6f6; position: sticky; top: 0; }} td.num, th.num {{ text-a
     );
     s.push_str("<table id=\"events\"><thead><tr><th class=\"num\">time (s)</th><th>robot</th><th>kind</th><th>details</th><th>source</th></tr></thead><tbody>\n");
     for e in &events[..shown] {
-        let pos = match &e.file {
-            Some(f) => format!(
-                "{}:{}:{}",
-                std::path::Path::new(f)
-                    .file_name()
-                    .map_or(f.clone(), |n| n.to_string_lossy().into_owned()),
-                e.line,
-                e.col
-            ),
-            None => String::new(),
-        };
+        let pos = e.position().unwrap_or_default();
         let robot = e.robot.as_deref().unwrap_or("-");
         let _ = writeln!(
             s,

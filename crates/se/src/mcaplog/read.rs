@@ -27,6 +27,15 @@ pub struct LoggedEvent {
 }
 
 impl LoggedEvent {
+    /// `file:line:col` with the file's name only, if the event has a source position.
+    pub fn position(&self) -> Option<String> {
+        let f = self.file.as_ref()?;
+        let name = Path::new(f)
+            .file_name()
+            .map_or(f.clone(), |n| n.to_string_lossy().into_owned());
+        Some(format!("{name}:{}:{}", self.line, self.col))
+    }
+
     /// The event as a trace line, `time_ns robot kind details file:line:col` with `-` for
     /// an empty field and the file's name only: the golden traces' format.
     pub fn line(&self) -> String {
@@ -35,15 +44,7 @@ impl LoggedEvent {
         } else {
             &self.details
         };
-        let pos = match &self.file {
-            Some(f) => {
-                let name = Path::new(f)
-                    .file_name()
-                    .map_or(f.clone(), |n| n.to_string_lossy().into_owned());
-                format!("{name}:{}:{}", self.line, self.col)
-            }
-            None => "-".into(),
-        };
+        let pos = self.position().unwrap_or_else(|| "-".into());
         format!(
             "{} {} {} {details} {pos}",
             self.time_ns,
