@@ -242,14 +242,16 @@ pub struct Simulation {
     globals: Vec<(u64, Type)>,
     /// Per robot: cell global index → module global index.
     to_module: Vec<Vec<Option<u32>>>,
-    /// Per cell global: last set (time, robot, pos) and last condition read at a wait start.
-    /// A set also has a number (`sets` counts them).
+    /// Per cell global: the last set and the last condition read at a wait start that
+    /// passed at once: (time, robot, pos, the robot's own clock entry at that action).
     last_set: Vec<Option<(i64, usize, SrcPos, u64)>>,
-    sets: u64,
-    /// Per robot: the set (time, cell global, number) whose check_wait released its last
-    /// wait. Its actions at that instant follow that set, so they do not race with it.
-    released_by: Vec<Option<(i64, u32, u64)>>,
-    last_read: Vec<Option<(i64, usize, SrcPos)>>,
+    last_read: Vec<Option<(i64, usize, SrcPos, u64)>>,
+    /// Happens-before, for race warnings: a vector clock per robot (`clock[r * n + q]`: how
+    /// many of robot q's actions robot r has seen, directly or through others). A robot
+    /// sees another's actions when that robot's set, signal or remote work releases it.
+    clock: Vec<u64>,
+    /// Per cell global: the setter's clock at the last set (what a robot it releases sees).
+    set_clock: Vec<u64>,
     /// The paper's WAIT list: per cell global, the robots whose wait condition reads it.
     wait_list: Vec<SortedSet<usize>>,
     /// The paper's WHEN list: per cell global, the (robot, handler procedure) of each
@@ -376,9 +378,9 @@ impl Simulation {
             generation: vec![0; n],
             queued_at: vec![None; n],
             last_set: vec![None; globals.len()],
-            sets: 0,
-            released_by: vec![None; n],
             last_read: vec![None; globals.len()],
+            clock: vec![0; n * n],
+            set_clock: vec![0; globals.len() * n],
             globals,
             to_module,
             wait_list: vec![Default::default(); cell.linked.globals.len()],
@@ -713,9 +715,13 @@ impl Simulation {
                 self.record(t, Some(r), "check_wait", Detail::Global(cg), None);
                 if self.vms[r].check_wait(t) {
                     // What r does next follows the set that released it.
-                    self.released_by[r] = self.last_set[cg as usize]
-                        .filter(|s| s.0 == t)
-                        .map(|s| (t, cg, s.3));
+                    let n = self.vms.len();
+                    let cg = cg as usize;
+                    for q in 0..n {
+                        let seen = self.set_clock[cg * n + q];
+                        let mine = &mut self.clock[r * n + q];
+                        *mine = (*mine).max(seen);
+                    }
                     self.requeue(r);
                 }
             }
@@ -889,11 +895,12 @@ impl Simulation {
                 // at once: a wait that blocks is re-tested by that set's check_wait at the
                 // same instant, so either order releases it at the same time.
                 let passed = !self.vms[r].waits();
+                let stamp = self.tick(r);
                 for g in &cell.robots[r].module.conds[*cond as usize].globals {
                     let cg = cell.linked.robots[r].globals[*g as usize] as usize;
                     self.check_race(cg, r, t, e.pos, false);
                     if passed {
-                        self.last_read[cg] = Some((t, r, e.pos));
+                        self.last_read[cg] = Some((t, r, e.pos, stamp));
                     }
                     self.wait_list[cg].insert(r);
                 }
@@ -930,6 +937,9 @@ impl Simulation {
                 if let Some(idx) = idx
                     && self.vms[target].deliver_signal_index(idx, t)
                 {
+                    // The receiver, released, has seen what the sender had.
+                    self.tick(r);
+                    self.merge_clock(target, r);
                     self.requeue(target);
                 }
             }
@@ -944,6 +954,8 @@ impl Simulation {
             }
             EventKind::RemoteEnd { .. } => {
                 if let Some((caller, req)) = self.serving[r].pop_front() {
+                    self.tick(r);
+                    self.merge_clock(caller, r);
                     self.vms[caller].remote_done(req, t);
                     self.requeue(caller);
                 }
@@ -965,13 +977,35 @@ impl Simulation {
         }
     }
 
+    /// Robot `r` acts: its own clock entry advances; returns it (the action's stamp).
+    fn tick(&mut self, r: usize) -> u64 {
+        let n = self.vms.len();
+        self.clock[r * n + r] += 1;
+        self.clock[r * n + r]
+    }
+
+    /// Robot `r` has seen everything robot `q` had seen, and `q`'s own actions.
+    fn merge_clock(&mut self, r: usize, q: usize) {
+        let n = self.vms.len();
+        for k in 0..n {
+            let seen = self.clock[q * n + k];
+            let mine = &mut self.clock[r * n + k];
+            *mine = (*mine).max(seen);
+        }
+    }
+
+    /// Warns of a race when another robot set (or, for a set, read in a wait that passed)
+    /// global `cg` at this same instant and robot `r` has not seen that action: their order
+    /// is only the queue's tie order. An action `r` has seen (it was released, directly or
+    /// through others, by what followed it) comes first in every order: a handshake.
     fn check_race(&mut self, cg: usize, r: usize, t: i64, pos: SrcPos, is_set: bool) {
-        let set = self.last_set[cg]
-            .filter(|s| self.released_by[r] != Some((s.0, cg as u32, s.3)))
-            .map(|(t, r, pos, _)| (t, r, pos));
-        let others = [set, if is_set { self.last_read[cg] } else { None }];
-        for (ot, or, opos) in others.into_iter().flatten() {
-            if ot == t && or != r {
+        let n = self.vms.len();
+        let others = [
+            self.last_set[cg],
+            if is_set { self.last_read[cg] } else { None },
+        ];
+        for (ot, or, opos, stamp) in others.into_iter().flatten() {
+            if ot == t && or != r && self.clock[r * n + or] < stamp {
                 let name = &self.cell.linked.globals[cg].name;
                 let a = &self.cell.robots[or].name;
                 let b = &self.cell.robots[r].name;
@@ -999,8 +1033,10 @@ impl Simulation {
     fn on_set(&mut self, r: usize, g: u32, value: u64, t: i64, pos: SrcPos) {
         let cg = self.cell.linked.robots[r].globals[g as usize] as usize;
         self.check_race(cg, r, t, pos, true);
-        self.sets += 1;
-        self.last_set[cg] = Some((t, r, pos, self.sets));
+        let stamp = self.tick(r);
+        self.last_set[cg] = Some((t, r, pos, stamp));
+        let n = self.vms.len();
+        self.set_clock[cg * n..(cg + 1) * n].copy_from_slice(&self.clock[r * n..(r + 1) * n]);
         self.globals[cg].0 = value;
         for q in 0..self.vms.len() {
             if let Some(mg) = self.to_module[q][cg] {
