@@ -16,8 +16,8 @@
 //! and its reach from each joint (precomputed), so two bodies at distance `d` cannot
 //! touch for `d / (v_a + v_b)` seconds. Stepping by that (at least [`SWEEP_MIN_STEP_NS`])
 //! until they intersect, no contact is stepped over and the first contact is reported at
-//! most one minimum step late. Capsules and balls are measured exactly here ([`gap`]);
-//! other shapes by parry's f64 build (f32 GJK was mm off, see [`gap`]).
+//! most one minimum step late. Capsules and balls are measured exactly here (`gap`);
+//! other shapes by parry's f64 build (f32 GJK was mm off, see `gap`).
 
 use std::collections::BTreeSet;
 

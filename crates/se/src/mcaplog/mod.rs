@@ -20,7 +20,7 @@
 //!
 //! The simulation's thread only appends records to batches: per logged boundary the
 //! joints, TCPs and part poses, per event its JSON message. The log's writer thread
-//! ([`writer`]) opens the file's MCAP structure, builds `/state`, `/tf` ([`cycles`]) and
+//! (`writer`) opens the file's MCAP structure, builds `/state`, `/tf` (`cycles`) and
 //! `/scene`, frames, compresses and writes. The file is finished (summary, CRCs) when
 //! [`McapLog::finish`] runs, which the engine does for every outcome, or when the log is
 //! dropped.
