@@ -238,6 +238,9 @@ pub struct Simulation {
     rank: Vec<u64>,
     generation: Vec<u64>,
     queued_at: Vec<Option<i64>>,
+    /// Per robot: the event its queue entry stands for, as its VM gave it at the requeue
+    /// (so performing it does not ask the VM again).
+    pending: Vec<Option<Event>>,
     /// Cell globals: value bits and type.
     globals: Vec<(u64, Type)>,
     /// Per robot: cell global index → module global index.
@@ -377,6 +380,7 @@ impl Simulation {
             rank: vec![0; n],
             generation: vec![0; n],
             queued_at: vec![None; n],
+            pending: vec![None; n],
             last_set: vec![None; globals.len()],
             last_read: vec![None; globals.len()],
             clock: vec![0; n * n],
@@ -585,6 +589,10 @@ impl Simulation {
             self.queued_at[r] = Some(e.time);
             let g = self.generation[r];
             self.push(e.time, Entry::Vm(r, g));
+            // Kept for `perform`: the VM's next event cannot change without a requeue.
+            self.pending[r] = Some(e);
+        } else {
+            self.pending[r] = None;
         }
     }
 
@@ -829,7 +837,7 @@ impl Simulation {
     }
 
     fn perform(&mut self, r: usize) {
-        let Next::Event(e) = self.vms[r].next_event() else {
+        let Some(e) = self.pending[r].take() else {
             return;
         };
         self.vms[r].perform();
