@@ -947,6 +947,7 @@ impl Collider {
             Owner::Device => None,
         };
         let (ri, rj) = (robot_of(self, i), robot_of(self, j));
+        let trust = trust(self.bodies[i].shape.as_ref(), self.bodies[j].shape.as_ref());
         let mut now = from;
         for _ in 0..100_000 {
             let (pa, pb) = if now == from {
@@ -976,7 +977,6 @@ impl Collider {
             // first body.
             // The part of a gap relied on is `trust` of it: farther apart than `rest /
             // trust`, they cannot touch in the rest of the interval.
-            let trust = trust(a.shape.as_ref(), b.shape.as_ref());
             let (d, p1, p2) = gap(&pa, a.shape.as_ref(), &pb, b.shape.as_ref(), rest / trust)?;
             let safe = d * trust;
             if d <= 0.0 {

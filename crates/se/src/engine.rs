@@ -723,13 +723,7 @@ impl Simulation {
                 self.record(t, Some(r), "check_wait", Detail::Global(cg), None);
                 if self.vms[r].check_wait(t) {
                     // What r does next follows the set that released it.
-                    let n = self.vms.len();
-                    let cg = cg as usize;
-                    for q in 0..n {
-                        let seen = self.set_clock[cg * n + q];
-                        let mine = &mut self.clock[r * n + q];
-                        *mine = (*mine).max(seen);
-                    }
+                    self.merge_clock(r, Seen::Set(cg as usize));
                     self.requeue(r);
                 }
             }
@@ -947,7 +941,7 @@ impl Simulation {
                 {
                     // The receiver, released, has seen what the sender had.
                     self.tick(r);
-                    self.merge_clock(target, r);
+                    self.merge_clock(target, Seen::Robot(r));
                     self.requeue(target);
                 }
             }
@@ -963,7 +957,7 @@ impl Simulation {
             EventKind::RemoteEnd { .. } => {
                 if let Some((caller, req)) = self.serving[r].pop_front() {
                     self.tick(r);
-                    self.merge_clock(caller, r);
+                    self.merge_clock(caller, Seen::Robot(r));
                     self.vms[caller].remote_done(req, t);
                     self.requeue(caller);
                 }
@@ -992,11 +986,15 @@ impl Simulation {
         self.clock[r * n + r]
     }
 
-    /// Robot `r` has seen everything robot `q` had seen, and `q`'s own actions.
-    fn merge_clock(&mut self, r: usize, q: usize) {
+    /// Robot `r` has now seen what `from` records: what a robot had seen (its own actions
+    /// included), or what the setter of a global had seen at its last set.
+    fn merge_clock(&mut self, r: usize, from: Seen) {
         let n = self.vms.len();
         for k in 0..n {
-            let seen = self.clock[q * n + k];
+            let seen = match from {
+                Seen::Robot(q) => self.clock[q * n + k],
+                Seen::Set(cg) => self.set_clock[cg * n + k],
+            };
             let mine = &mut self.clock[r * n + k];
             *mine = (*mine).max(seen);
         }
@@ -1270,6 +1268,15 @@ fn vm_details(kind: &EventKind, m: &vworks_vm::bytecode::Module) -> String {
         }
         _ => String::new(),
     }
+}
+
+/// Whose vector clock a released robot takes in (see [`Simulation::merge_clock`]).
+#[derive(Clone, Copy, Debug)]
+enum Seen {
+    /// A robot's, now.
+    Robot(usize),
+    /// The setter's, at the last set of this cell global.
+    Set(usize),
 }
 
 /// A small ordered set kept as a sorted `Vec`: iterated by index while the simulation

@@ -356,6 +356,36 @@ fn format_tick(t: f64, step: f64) -> String {
     }
 }
 
+/// A titled table (`id`) of `rows` (cells already escaped) under `columns` (name, whether
+/// numeric), or the `none` line when there are no rows.
+fn list(
+    s: &mut String,
+    (title, id, none): (&str, &str, &str),
+    columns: &[(&str, bool)],
+    rows: impl Iterator<Item = Vec<String>>,
+) {
+    let _ = writeln!(s, "<h2>{title}</h2>");
+    let num = |numeric: bool| if numeric { " class=\"num\"" } else { "" };
+    let mut rows = rows.peekable();
+    if rows.peek().is_none() {
+        let _ = writeln!(s, "<p class=\"none\" id=\"{id}\">{none}</p>");
+        return;
+    }
+    let _ = write!(s, "<table id=\"{id}\"><tr>");
+    for (name, numeric) in columns {
+        let _ = write!(s, "<th{}>{name}</th>", num(*numeric));
+    }
+    s.push_str("</tr>\n");
+    for row in rows {
+        s.push_str("<tr>");
+        for (cell, (_, numeric)) in row.iter().zip(columns) {
+            let _ = write!(s, "<td{}>{cell}</td>", num(*numeric));
+        }
+        s.push_str("</tr>\n");
+    }
+    s.push_str("</table>\n");
+}
+
 /// The report as one HTML document. `source` names the log in the heading.
 pub fn html(report: &Report, events: &[LoggedEvent], source: &str) -> String {
     let mut s = String::new();
@@ -419,40 +449,44 @@ th {{ background: #f6f6f6; position: sticky; top: 0; }} td.num, th.num {{ text-a
     s.push_str(&gantt(report));
     s.push('\n');
     // Collisions and issues.
-    s.push_str("<h2>Collisions</h2>\n");
-    if report.collisions.is_empty() {
-        s.push_str("<p class=\"none\" id=\"collisions\">No collision.</p>\n");
-    } else {
-        s.push_str("<table id=\"collisions\"><tr><th class=\"num\">start</th><th class=\"num\">end</th><th>bodies</th><th>details</th></tr>\n");
-        for (start, end, pair, details) in &report.collisions {
-            let _ = writeln!(
-                s,
-                "<tr><td class=\"num\">{}</td><td class=\"num\">{}</td><td>{}</td><td>{}</td></tr>",
-                secs(*start),
-                end.map_or("–".into(), secs),
-                esc(pair),
-                esc(details)
-            );
-        }
-        s.push_str("</table>\n");
-    }
-    s.push_str("<h2>Warnings and errors</h2>\n");
-    if report.issues.is_empty() {
-        s.push_str("<p class=\"none\" id=\"issues\">None.</p>\n");
-    } else {
-        s.push_str("<table id=\"issues\"><tr><th class=\"num\">time</th><th>kind</th><th>robot</th><th>message</th></tr>\n");
-        for (t, kind, robot, message) in &report.issues {
-            let _ = writeln!(
-                s,
-                "<tr><td class=\"num\">{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-                secs(*t),
-                esc(kind),
-                esc(robot.as_deref().unwrap_or("–")),
-                esc(message)
-            );
-        }
-        s.push_str("</table>\n");
-    }
+    let collisions = report.collisions.iter().map(|(start, end, pair, details)| {
+        vec![
+            secs(*start),
+            end.map_or("–".into(), secs),
+            esc(pair),
+            esc(details),
+        ]
+    });
+    list(
+        &mut s,
+        ("Collisions", "collisions", "No collision."),
+        &[
+            ("start", true),
+            ("end", true),
+            ("bodies", false),
+            ("details", false),
+        ],
+        collisions,
+    );
+    let issues = report.issues.iter().map(|(t, kind, robot, message)| {
+        vec![
+            secs(*t),
+            esc(kind),
+            esc(robot.as_deref().unwrap_or("–")),
+            esc(message),
+        ]
+    });
+    list(
+        &mut s,
+        ("Warnings and errors", "issues", "None."),
+        &[
+            ("time", true),
+            ("kind", false),
+            ("robot", false),
+            ("message", false),
+        ],
+        issues,
+    );
     // Events.
     let robots: Vec<&str> = report.timelines.iter().map(|t| t.robot.as_str()).collect();
     let mut kinds: Vec<&str> = events.iter().map(|e| e.kind.as_str()).collect();
