@@ -107,10 +107,9 @@ impl BodyRef {
 /// A broadphase: the pairs of overlapping boxes, by sort and sweep along x. The order of the
 /// last call is nearly sorted already, so sorting is near linear (the unstable sort
 /// measured 2 % faster on the 4-robot minute; ties are broken by index, so the order is
-/// the same). (A uniform grid over x
-/// and y was tried for large cells: on an 8 × 8 grid of arms it cost 106 µs per cycle
-/// against the sweep's 87 µs, though the sweep compares each box with every box in its
-/// strip.)
+/// the same). A uniform grid over x and y was tried for large cells: on an 8 × 8 grid of
+/// arms it cost 106 µs per cycle against the sweep's 87 µs, though the sweep compares each
+/// box with every box in its strip.
 #[derive(Debug, Default)]
 struct SweepAndPrune {
     /// The boxes in the order of their lower x.
@@ -219,7 +218,7 @@ struct SweepScratch {
     start: Vec<Pose>,
     /// The broadphase: per body its box grown by its bound, and the overlapping pairs.
     reach_box: Vec<Aabb>,
-    grid: SweepAndPrune,
+    broadphase: SweepAndPrune,
     pairs: Vec<(usize, usize)>,
 }
 
@@ -229,7 +228,7 @@ pub struct Collider {
     poses: Vec<Pose>,
     aabbs: Vec<Aabb>,
     /// The boundary check's broadphase and the pairs it keeps (reused).
-    grid: SweepAndPrune,
+    broadphase: SweepAndPrune,
     pairs: Vec<(usize, usize)>,
     /// Pairs never checked, as a dense matrix (`i * n + j`, both orders).
     skip_dense: Vec<bool>,
@@ -408,7 +407,7 @@ impl Collider {
             unshared,
             poses: vec![Pose::IDENTITY; n],
             aabbs: vec![Aabb::new_invalid(); n],
-            grid: SweepAndPrune::default(),
+            broadphase: SweepAndPrune::default(),
             pairs: Vec::new(),
             touching: BTreeSet::new(),
             near: BTreeSet::new(),
@@ -603,7 +602,7 @@ impl Collider {
         // Sort and sweep along x.
         let aabbs = &self.aabbs;
         let mut pairs = std::mem::take(&mut self.pairs);
-        self.grid.overlapping(aabbs, &mut pairs);
+        self.broadphase.overlapping(aabbs, &mut pairs);
         let mut touching = BTreeSet::new();
         let mut near: Vec<((usize, usize), f64)> = Vec::new();
         let mut starts = Vec::new();
@@ -825,7 +824,7 @@ impl Collider {
             sw.reach_box
                 .push(b.bounding_box(&sw.start[i]).loosened(sw.bound[i]));
         }
-        sw.grid.overlapping(&sw.reach_box, &mut sw.pairs);
+        sw.broadphase.overlapping(&sw.reach_box, &mut sw.pairs);
         // (Pairs are advanced independently; the contacts found are sorted below.)
         let pairs = std::mem::take(&mut sw.pairs);
         for &(i, j) in &pairs {
@@ -1326,7 +1325,7 @@ mod tests {
     #[test]
     fn the_broadphase_finds_every_overlapping_pair_once() {
         let mut g = Lcg(9);
-        let mut grid = SweepAndPrune::default();
+        let mut broadphase = SweepAndPrune::default();
         let mut out = Vec::new();
         for round in 0..60 {
             let n = 1 + round * 5;
@@ -1345,7 +1344,7 @@ mod tests {
                     Aabb::new(c - e, c + e)
                 })
                 .collect();
-            grid.overlapping(&boxes, &mut out);
+            broadphase.overlapping(&boxes, &mut out);
             out.sort_unstable();
             let mut all = Vec::new();
             for i in 0..n {
