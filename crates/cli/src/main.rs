@@ -427,24 +427,70 @@ fn simulate(
     sim.into_result()
 }
 
-fn run_cell(
-    path: &Path,
-    until: Option<&str>,
+/// How `vworks run` was asked to run a cell.
+struct RunOptions<'a> {
+    until: Option<&'a str>,
     json: bool,
     trace: bool,
-    log: Option<&Path>,
+    log: Option<&'a Path>,
     log_every: u64,
+    /// Show a progress bar (stderr is a terminal and not `--quiet`).
     progress: bool,
-) -> Result<ExitCode, String> {
-    let until = until.map(parse_time).transpose()?;
+    color: bool,
+}
+
+fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
+    let RunOptions {
+        until,
+        json,
+        trace,
+        log,
+        log_every,
+        progress,
+        color,
+    } = opts;
+    // With --json, a run that cannot start is still one JSON object on stdout.
+    let json_error = |errors: Vec<serde_json::Value>| {
+        if json {
+            let v = serde_json::json!({"outcome": "error", "errors": errors});
+            out!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+        }
+    };
+    let plain_error = |kind: &str, message: &str, file: Option<String>| serde_json::json!({"kind": kind, "message": message, "robot": null, "file": file, "line": 0, "col": 0});
+    let until = match until.map(parse_time).transpose() {
+        Ok(u) => u,
+        Err(e) => {
+            json_error(vec![plain_error("usage", &e, None)]);
+            return Err(e);
+        }
+    };
     let cell = match vworks_se::workcell::load(path) {
         Ok(c) => std::sync::Arc::new(c),
-        Err(vworks_se::workcell::CellError::Program { rendered, .. }) => {
+        Err(vworks_se::workcell::CellError::Program {
+            rendered,
+            diagnostics,
+        }) => {
             eprint!("{rendered}");
+            json_error(
+                diagnostics
+                    .iter()
+                    .filter(|d| d.is_error())
+                    .map(|d| serde_json::json!({"kind": d.code.as_str(), "message": d.message, "robot": null, "file": d.at.file, "line": d.at.line, "col": d.at.col}))
+                    .collect(),
+            );
             return Err(format!("{}: the programs have errors", path.display()));
         }
-        Err(e) => return Err(e.to_string()),
+        Err(e) => {
+            json_error(vec![plain_error(
+                "workcell",
+                &e.to_string(),
+                Some(display(path)),
+            )]);
+            return Err(e.to_string());
+        }
     };
+    // Compile and link warnings, as `vworks check` prints them.
+    eprint!("{}", cell.render_warnings(color));
     let started = std::time::Instant::now();
     // Ctrl-C ends the run between two events, so the summary prints and the log is finished.
     let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
@@ -452,10 +498,17 @@ fn run_cell(
     let _ = ctrlc::set_handler(move || flag.store(true, std::sync::atomic::Ordering::Relaxed));
     let mut sim = vworks_se::engine::Simulation::new(std::sync::Arc::clone(&cell)).with_stop(stop);
     if let Some(path) = log {
-        sim = sim.with_log(
-            vworks_se::mcaplog::McapLog::create(path, &cell, log_every)
-                .map_err(|e| e.to_string())?,
-        );
+        match vworks_se::mcaplog::McapLog::create(path, &cell, log_every) {
+            Ok(l) => sim = sim.with_log(l),
+            Err(e) => {
+                json_error(vec![plain_error(
+                    "log",
+                    &e.to_string(),
+                    Some(display(path)),
+                )]);
+                return Err(e.to_string());
+            }
+        }
     }
     let r = simulate(sim, until, progress.then_some(started));
     if let Some(e) = &r.log_error {
@@ -535,7 +588,8 @@ fn run_cell(
                 c.depth * 1e3
             );
         }
-        for w in &r.warnings {
+        // (Compile and link warnings, W…, were printed with their source lines.)
+        for w in r.warnings.iter().filter(|w| !w.kind.starts_with('W')) {
             out!("warning[{}]: {}", w.kind, w.message);
         }
         for e in &r.errors {
@@ -637,12 +691,15 @@ fn run(cmd: Command, color: bool) -> Result<ExitCode, String> {
             quiet,
         } => run_cell(
             &cell,
-            until.as_deref(),
-            json,
-            trace,
-            log.as_deref(),
-            log_every,
-            !quiet && std::io::stderr().is_terminal(),
+            RunOptions {
+                until: until.as_deref(),
+                json,
+                trace,
+                log: log.as_deref(),
+                log_every,
+                progress: !quiet && std::io::stderr().is_terminal(),
+                color,
+            },
         ),
         Command::Log { what } => read_log(what),
         Command::Report { log, output } => write_report(&log, output),

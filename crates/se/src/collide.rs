@@ -238,6 +238,10 @@ pub struct Collider {
     unshared: Vec<(u8, u8)>,
     touching: BTreeSet<(usize, usize)>,
     near: BTreeSet<(usize, usize)>,
+    /// Pairs touching when a part was gripped or released (a part resting on a table, a
+    /// gripper closed on its part): not a collision until they are farther apart than
+    /// the clearance, as MoveIt's touch links of an attached object.
+    exempt: BTreeSet<(usize, usize)>,
     /// Per part: the robot holding it and the part's pose in that robot's tool-link frame.
     held: Vec<Option<(usize, Iso)>>,
     /// Per part: pose in the cell when not held.
@@ -411,6 +415,7 @@ impl Collider {
             pairs: Vec::new(),
             touching: BTreeSet::new(),
             near: BTreeSet::new(),
+            exempt: BTreeSet::new(),
             held: vec![None; cell.parts.len()],
             part_pose: cell.parts.iter().map(|p| p.pose).collect(),
             frames: cell
@@ -470,16 +475,24 @@ impl Collider {
         robot.base.mul(&robot.model.flange(&q[..robot.model.dof()]))
     }
 
+    /// The robot holding part `p`, if one does.
+    pub fn holder(&self, p: usize) -> Option<usize> {
+        self.held.get(p).copied().flatten().map(|(r, _)| r)
+    }
+
     /// Robot `r` grips part `p` at time `t`: from now on the part moves with its tool link.
-    pub fn grip(&mut self, p: usize, r: usize, vm: &Vm, cell: &Cell, t: i64) {
-        let tool = Collider::tool_world(cell, vm, r, t);
-        let pose = self.current_part_pose(p, cell, t, None);
+    /// Pairs of the part touching at that instant are exempt until they separate.
+    pub fn grip(&mut self, p: usize, r: usize, vms: &[Vm], cell: &Cell, t: i64) {
+        let tool = Collider::tool_world(cell, &vms[r], r, t);
+        let pose = self.part_pose[p];
         self.held[p] = Some((r, tool.inverse().mul(&pose)));
         self.dirty = true;
         self.motions_changed();
+        self.exempt_touching(p, cell, vms, t);
     }
 
-    /// Part `p` is released at time `t` and stays where it is.
+    /// Part `p` is released at time `t` and stays where it is. Pairs of the part touching
+    /// at that instant are exempt until they separate.
     pub fn release(&mut self, p: usize, vms: &[Vm], cell: &Cell, t: i64) {
         if let Some((r, offset)) = self.held[p] {
             let tool = Collider::tool_world(cell, &vms[r], r, t);
@@ -488,6 +501,50 @@ impl Collider {
         self.held[p] = None;
         self.dirty = true;
         self.motions_changed();
+        self.exempt_touching(p, cell, vms, t);
+    }
+
+    /// Exempts every checked pair of part `p`'s bodies that touches at time `t`.
+    fn exempt_touching(&mut self, p: usize, cell: &Cell, vms: &[Vm], t: i64) {
+        let mut frames = self.frames.clone();
+        for (r, f) in frames.iter_mut().enumerate() {
+            self.robot_frame_at(cell, vms, r, t, f);
+        }
+        let n = self.bodies.len();
+        for i in 0..n {
+            if !matches!(self.bodies[i].owner, Owner::Part(q) if q == p) {
+                continue;
+            }
+            let pi = self.body_pose(cell, i, &frames);
+            for j in 0..n {
+                let pair = (i.min(j), i.max(j));
+                let (a, b) = (self.bodies[pair.0].owner, self.bodies[pair.1].owner);
+                let never = !matches!(a, Owner::Link { .. })
+                    && !matches!(b, Owner::Link { .. })
+                    && !self.is_held(a)
+                    && !self.is_held(b);
+                if j == i
+                    || never
+                    || self.skip_dense[pair.0 * n + pair.1]
+                    || self.held_by(pair, cell)
+                {
+                    continue;
+                }
+                let pj = self.body_pose(cell, j, &frames);
+                let touching = gap(
+                    &pi,
+                    self.bodies[i].shape.as_ref(),
+                    &pj,
+                    self.bodies[j].shape.as_ref(),
+                    0.0,
+                )
+                .is_some_and(|(d, _, _)| d <= 0.0);
+                // (A pair already reported as a collision stays one.)
+                if touching && !self.touching.contains(&pair) {
+                    self.exempt.insert(pair);
+                }
+            }
+        }
     }
 
     /// Every robot's link frames in the cell as of the last [`Collider::check`] (which
@@ -509,10 +566,6 @@ impl Collider {
             Some((r, offset)) => self.frames[r][cell.robots[r].model.tool_link].mul(&offset),
             None => self.part_pose[p],
         }));
-    }
-
-    fn current_part_pose(&self, p: usize, _cell: &Cell, _t: i64, _vm: Option<&Vm>) -> Iso {
-        self.part_pose[p]
     }
 
     /// Checks the cell at boundary time `t`; `moving[r]` says whether robot r moves.
@@ -650,6 +703,13 @@ impl Collider {
                     } else {
                         i64::MIN
                     };
+                }
+                if self.exempt.contains(&pair) {
+                    // Touching since a grip or release: exempt until they separate.
+                    if found.is_none_or(|(d, _, _)| d > cell.clearance) {
+                        self.exempt.remove(&pair);
+                    }
+                    continue;
                 }
                 let Some((dist, point, _)) = found else {
                     continue;
@@ -840,6 +900,7 @@ impl Collider {
                 let gap = centres - a.radius - b.radius;
                 if gap > sw.bound[i] + sw.bound[j]
                     || self.touching.contains(&(i, j))
+                    || self.exempt.contains(&(i, j))
                     || self.held_by((i, j), cell)
                 {
                     continue;

@@ -293,7 +293,29 @@ pub struct Simulation {
     sweep: bool,
     /// Set from outside to stop the run between two events.
     stop: Option<Arc<AtomicBool>>,
+    /// The instant being simulated, the queue entries handled at it, and how many the
+    /// cell may handle at one instant ([`Simulation::with_instant_limit`]).
+    instant: i64,
+    instant_entries: u64,
+    instant_limit: u64,
+    /// Reads of globals a robot's segment made (reused; see [`Vm::take_reads`]).
+    reads: Vec<(u32, SrcPos)>,
+    /// Per robot: the last remote request made to it (time, caller, position, stamp).
+    last_request: Vec<Option<(i64, usize, SrcPos, u64)>>,
+    /// Per robot: the last signal sent to it (time, sender, position, stamp), and the
+    /// last time one of its signal waits timed out (time, position).
+    last_signal: Vec<Option<(i64, usize, SrcPos, u64)>>,
+    signal_timeout: Vec<Option<(i64, SrcPos)>>,
+    /// Per cell global: the last wait on it that timed out (time, robot, position).
+    last_timeout: Vec<Option<(i64, usize, SrcPos)>>,
+    /// Per robot: the signal wait it is in (its signal name's string index), if one.
+    signal_wait: Vec<Option<u32>>,
 }
+
+/// How many queue entries the cell may handle at one simulated instant by default: far
+/// more than any program needs, few enough to stop a zero-time livelock of several
+/// robots in well under a second.
+pub const INSTANT_LIMIT: u64 = 1_000_000;
 
 fn format_value(v: u64, ty: Type) -> String {
     match ty {
@@ -371,6 +393,19 @@ impl Simulation {
             })
             .collect();
         let collider = Collider::new(&cell);
+        // The programs' compile and link warnings open the run's warnings (kind: the code).
+        let warnings = cell
+            .warnings
+            .iter()
+            .map(|d| Issue {
+                kind: d.code.as_str().to_string(),
+                message: d.message.clone(),
+                robot: None,
+                file: Some(d.at.file.clone()),
+                line: d.at.line,
+                col: d.at.col,
+            })
+            .collect();
         Simulation {
             vms,
             signal_to,
@@ -397,7 +432,7 @@ impl Simulation {
             next_boundary: 0,
             time: 0,
             trace: Vec::new(),
-            warnings: Vec::new(),
+            warnings,
             errors: Vec::new(),
             collisions: Vec::new(),
             outcome: None,
@@ -410,6 +445,15 @@ impl Simulation {
             sweep: true,
             log_parts: Vec::new(),
             stop: None,
+            instant: -1,
+            instant_entries: 0,
+            instant_limit: INSTANT_LIMIT,
+            reads: Vec::new(),
+            last_request: vec![None; n],
+            last_signal: vec![None; n],
+            signal_timeout: vec![None; n],
+            last_timeout: vec![None; cell.linked.globals.len()],
+            signal_wait: vec![None; n],
             cell,
         }
     }
@@ -435,6 +479,15 @@ impl Simulation {
     /// are the same (tested); for comparison and testing.
     pub fn with_adaptive(mut self, adaptive: bool) -> Simulation {
         self.collider.set_adaptive(adaptive);
+        self
+    }
+
+    /// How many queue entries (every robot's events, `check_wait`, `check_when`) the cell
+    /// may handle at one simulated instant before the run stops with an error (default
+    /// [`INSTANT_LIMIT`]). Each robot is bounded on its own too
+    /// ([`VmConfig::instant_events`]).
+    pub fn with_instant_limit(mut self, limit: u64) -> Simulation {
+        self.instant_limit = limit.max(1);
         self
     }
 
@@ -585,7 +638,9 @@ impl Simulation {
     fn requeue(&mut self, r: usize) {
         self.generation[r] += 1;
         self.queued_at[r] = None;
-        if let Next::Event(e) = self.vms[r].next_event() {
+        let next = self.vms[r].next_event();
+        self.note_reads(r);
+        if let Next::Event(e) = next {
             self.queued_at[r] = Some(e.time);
             let g = self.generation[r];
             self.push(e.time, Entry::Vm(r, g));
@@ -695,6 +750,13 @@ impl Simulation {
             self.end_without_events();
             return false;
         };
+        // A stale entry (the robot's next event changed since) is dropped unseen: it must
+        // not move the clock (a wait released early leaves its deadline behind).
+        if let Entry::Vm(r, g) = Entry::unpack(entry)
+            && g != self.generation[r]
+        {
+            return true;
+        }
         if let Some(u) = until
             && t > u
         {
@@ -711,11 +773,17 @@ impl Simulation {
             return false;
         }
         self.time = t;
+        if t != self.instant {
+            self.instant = t;
+            self.instant_entries = 0;
+        }
+        self.instant_entries += 1;
+        if self.instant_entries > self.instant_limit {
+            self.livelock(t);
+            return false;
+        }
         match Entry::unpack(entry) {
-            Entry::Vm(r, g) => {
-                if g != self.generation[r] {
-                    return true;
-                }
+            Entry::Vm(r, _) => {
                 self.queued_at[r] = None;
                 self.perform(r);
             }
@@ -730,6 +798,8 @@ impl Simulation {
             Entry::CheckWhen(r, cg) => {
                 self.record(t, Some(r), "check_when", Detail::Global(cg), None);
                 if self.vms[r].check_when(t) > 0 {
+                    // The handlers it fires follow the set that made them fire.
+                    self.merge_clock(r, Seen::Set(cg as usize));
                     self.requeue(r);
                 }
             }
@@ -874,8 +944,16 @@ impl Simulation {
                     self.stats[r].waiting_ns += e.time - s;
                 }
             }
-            EventKind::End | EventKind::Error { .. } => self.stats[r].end_time_ns = e.time,
-            EventKind::RemoteEnd { .. } => self.stats[r].end_time_ns = e.time,
+            EventKind::End | EventKind::Error { .. } | EventKind::RemoteEnd { .. } => {
+                self.stats[r].end_time_ns = e.time;
+                // `stop` in a handler ends a motion or a wait where it is.
+                if let Some(s) = self.moving_since[r].take() {
+                    self.stats[r].moving_ns += e.time - s;
+                }
+                if let Some(s) = self.waiting_since[r].take() {
+                    self.stats[r].waiting_ns += e.time - s;
+                }
+            }
             _ => {}
         }
     }
@@ -891,6 +969,10 @@ impl Simulation {
         );
         match &e.kind {
             EventKind::Set { global, value, .. } => self.on_set(r, *global, *value, t, e.pos),
+            EventKind::WaitSignal { name, .. } => {
+                // The receiver knows the signal by the string index of its own module.
+                self.signal_wait[r] = Some(*name);
+            }
             EventKind::WaitUntil { cond, .. } => {
                 let cell = Arc::clone(&self.cell);
                 // A later set at this instant races with this read only if the wait passed
@@ -907,10 +989,11 @@ impl Simulation {
                     self.wait_list[cg].insert(r);
                 }
             }
-            EventKind::WaitEnd { .. } => {
-                for w in &mut self.wait_list {
-                    w.remove(&r);
+            EventKind::WaitEnd { timed_out } => {
+                if *timed_out {
+                    self.timed_out_race(r, t, e.pos);
                 }
+                self.clear_waits(r);
             }
             EventKind::EnableWhen { handler } => {
                 let m = self.vms[r].module();
@@ -933,14 +1016,29 @@ impl Simulation {
                 for w in &mut self.when_list {
                     w.retain(|(q, _)| *q != r);
                 }
+                // (`stop` in a handler may end a wait.)
+                self.clear_waits(r);
             }
             EventKind::Signal { site } => {
                 let (target, idx) = self.signal_to[r][*site as usize];
+                let stamp = self.tick(r);
+                let timing_out = self.vms[target].wait_deadline() == Some(t)
+                    && idx.is_some()
+                    && self.signal_wait[target] == idx;
+                let timed_out = self.signal_timeout[target]
+                    .filter(|(ot, _)| *ot == t)
+                    .map(|(_, p)| p);
+                let waiting = timing_out
+                    .then(|| self.vms[target].waiting_for().map(|(_, p)| p))
+                    .flatten();
+                if let Some(wpos) = timed_out.or(waiting) {
+                    self.race(t, (target, wpos), (r, e.pos), "on a signal", "time out a wait for it and send it at the same instant; whether the signal releases the wait depends on their order");
+                }
+                self.last_signal[target] = Some((t, r, e.pos, stamp));
                 if let Some(idx) = idx
                     && self.vms[target].deliver_signal_index(idx, t)
                 {
                     // The receiver, released, has seen what the sender had.
-                    self.tick(r);
                     self.merge_clock(target, Seen::Robot(r));
                     self.requeue(target);
                 }
@@ -948,6 +1046,19 @@ impl Simulation {
             EventKind::RemoteCall { site, req, args } => {
                 let (target, proc) = self.cell.linked.robots[r].remotes[*site as usize];
                 let target = target as usize;
+                // Two requests to one robot at one instant: which it serves first is only
+                // the queue's tie order (a request made after seeing the other's is not).
+                let stamp = self.tick(r);
+                let n = self.vms.len();
+                if let Some((ot, or, opos, ostamp)) = self.last_request[target]
+                    && ot == t
+                    && or != r
+                    && self.clock[r * n + or] < ostamp
+                {
+                    let subject = format!("for {}'s remote work", self.cell.robots[target].name);
+                    self.race(t, (or, opos), (r, e.pos), &subject, "ask for it at the same instant; which request it serves first depends on their order");
+                }
+                self.last_request[target] = Some((t, r, e.pos, stamp));
                 self.vms[target].request_remote(proc, args.clone(), t);
                 self.serving[target].push_back((r, *req));
                 if self.queued_at[target].is_none() {
@@ -955,6 +1066,9 @@ impl Simulation {
                 }
             }
             EventKind::RemoteEnd { .. } => {
+                // The handlers the remote work enabled ended with it.
+                self.sync_when_list(r);
+                self.clear_waits(r);
                 if let Some((caller, req)) = self.serving[r].pop_front() {
                     self.tick(r);
                     self.merge_clock(caller, Seen::Robot(r));
@@ -964,11 +1078,43 @@ impl Simulation {
             }
             EventKind::Grip { site } => {
                 let part = self.cell.linked.robots[r].parts[*site as usize] as usize;
-                self.collider.grip(part, r, &self.vms[r], &self.cell, t);
+                let name = &self.cell.parts[part].name;
+                match self.collider.holder(part) {
+                    None => self.collider.grip(part, r, &self.vms, &self.cell, t),
+                    Some(h) if h == r => {
+                        let m = format!(
+                            "`{name}` is already in this robot's gripper; release it before gripping it again"
+                        );
+                        self.runtime_error(r, t, e.pos, m);
+                    }
+                    Some(h) => {
+                        let m = format!(
+                            "`{name}` is held by {}; it must release the part before this robot can grip it",
+                            self.cell.robots[h].name
+                        );
+                        self.runtime_error(r, t, e.pos, m);
+                    }
+                }
             }
             EventKind::Release { site } => {
                 let part = self.cell.linked.robots[r].parts[*site as usize] as usize;
-                self.collider.release(part, &self.vms, &self.cell, t);
+                let name = &self.cell.parts[part].name;
+                match self.collider.holder(part) {
+                    Some(h) if h == r => self.collider.release(part, &self.vms, &self.cell, t),
+                    Some(h) => {
+                        let m = format!(
+                            "this robot does not hold `{name}`: {} does; only the robot holding a part can release it",
+                            self.cell.robots[h].name
+                        );
+                        self.runtime_error(r, t, e.pos, m);
+                    }
+                    None => {
+                        let m = format!(
+                            "this robot does not hold `{name}` (no robot does); grip it before releasing it"
+                        );
+                        self.runtime_error(r, t, e.pos, m);
+                    }
+                }
             }
             EventKind::Error { message } => {
                 let issue = self.issue("runtime", message.clone(), Some(r), Some(e.pos));
@@ -977,6 +1123,77 @@ impl Simulation {
             }
             _ => {}
         }
+    }
+
+    /// Robot `r`'s wait timed out at `t`: a race with a set (of a global its condition
+    /// reads) or a signal (that it waits for) at the same instant, which would have
+    /// released it had it come first. Remembers the timeout for a set or signal that
+    /// comes after it at this instant.
+    fn timed_out_race(&mut self, r: usize, t: i64, pos: SrcPos) {
+        if self.signal_wait[r].is_some() {
+            if let Some((st, sender, spos, _)) = self.last_signal[r]
+                && st == t
+            {
+                self.race(t, (sender, spos), (r, pos), "on a signal", "send it and time out a wait for it at the same instant; whether the signal releases the wait depends on their order");
+            }
+            self.signal_timeout[r] = Some((t, pos));
+            return;
+        }
+        let n = self.vms.len();
+        for cg in 0..self.wait_list.len() {
+            if !self.wait_list[cg].0.contains(&r) {
+                continue;
+            }
+            if let Some((st, setter, spos, stamp)) = self.last_set[cg]
+                && st == t
+                && setter != r
+                && self.clock[r * n + setter] < stamp
+            {
+                let name = &self.cell.linked.globals[cg].name;
+                let subject = format!("on `{name}`");
+                self.race(t, (setter, spos), (r, pos), &subject, "set it and time out a wait on it at the same instant; whether the set releases the wait depends on their order");
+            }
+            self.last_timeout[cg] = Some((t, r, pos));
+        }
+    }
+
+    /// Robot `r`'s entries in the WHEN list, made anew from its VM's enabled handlers.
+    fn sync_when_list(&mut self, r: usize) {
+        for w in &mut self.when_list {
+            w.retain(|(q, _)| *q != r);
+        }
+        let cell = Arc::clone(&self.cell);
+        for (target, globals) in self.vms[r].condition_handlers() {
+            for g in globals {
+                let cg = cell.linked.robots[r].globals[*g as usize] as usize;
+                self.when_list[cg].insert((r, target));
+            }
+        }
+    }
+
+    /// Robot `r` no longer waits: off the WAIT list.
+    fn clear_waits(&mut self, r: usize) {
+        for w in &mut self.wait_list {
+            w.remove(&r);
+        }
+        self.signal_wait[r] = None;
+    }
+
+    /// A runtime error the SE finds in robot `r`'s event at `t` (a part gripped twice):
+    /// an `error` event at the statement, and the run stops.
+    fn runtime_error(&mut self, r: usize, t: i64, pos: SrcPos, message: String) {
+        self.record(
+            t,
+            Some(r),
+            "error",
+            Detail::Text(format!("{message:?}")),
+            Some(pos),
+        );
+        let issue = self.issue("runtime", message, Some(r), Some(pos));
+        self.errors.push(issue);
+        self.stats[r].end_time_ns = t;
+        self.vms[r].halt();
+        self.outcome = Some(Outcome::Error);
     }
 
     /// Robot `r` acts: its own clock entry advances; returns it (the action's stamp).
@@ -1013,32 +1230,78 @@ impl Simulation {
         for (ot, or, opos, stamp) in others.into_iter().flatten() {
             if ot == t && or != r && self.clock[r * n + or] < stamp {
                 let name = &self.cell.linked.globals[cg].name;
-                let a = &self.cell.robots[or].name;
-                let b = &self.cell.robots[r].name;
-                let m = format!(
-                    "race on `{name}` at {}: {a} ({}:{}) and {b} ({}:{}) touch it at the same instant; the outcome depends on their order",
-                    fmt_quantity(t as f64 / 1e9, vworks_vm::Dim::TIME),
-                    self.short(or),
-                    opos,
-                    self.short(r),
-                    pos
-                );
-                self.record(
+                let subject = format!("on `{name}`");
+                self.race(
                     t,
-                    Some(r),
-                    "warning",
-                    Detail::Text(format!("{m:?}")),
-                    Some(pos),
+                    (or, opos),
+                    (r, pos),
+                    &subject,
+                    "touch it at the same instant; the outcome depends on their order",
                 );
-                let issue = self.issue("race", m, Some(r), Some(pos));
-                self.warnings.push(issue);
             }
         }
+    }
+
+    /// Reports a race at `t` between robot `first`'s statement and robot `second`'s (the
+    /// one acting now): `race SUBJECT at T: A (file:pos) and B (file:pos) WHAT`.
+    fn race(
+        &mut self,
+        t: i64,
+        first: (usize, SrcPos),
+        second: (usize, SrcPos),
+        subject: &str,
+        what: &str,
+    ) {
+        let ((or, opos), (r, pos)) = (first, second);
+        let m = format!(
+            "race {subject} at {}: {} ({}:{}) and {} ({}:{}) {what}",
+            fmt_quantity(t as f64 / 1e9, vworks_vm::Dim::TIME),
+            self.cell.robots[or].name,
+            self.short(or),
+            opos,
+            self.cell.robots[r].name,
+            self.short(r),
+            pos
+        );
+        self.record(
+            t,
+            Some(r),
+            "warning",
+            Detail::Text(format!("{m:?}")),
+            Some(pos),
+        );
+        let issue = self.issue("race", m, Some(r), Some(pos));
+        self.warnings.push(issue);
+    }
+
+    /// The globals robot `r`'s last segment read at this instant: a race with a set of
+    /// another robot at the same instant that `r` has not seen (either order), as for
+    /// `wait_until` conditions.
+    fn note_reads(&mut self, r: usize) {
+        let mut reads = std::mem::take(&mut self.reads);
+        self.vms[r].take_reads(&mut reads);
+        let (t, n) = (self.time, self.vms.len());
+        for (mg, pos) in reads.drain(..) {
+            let cg = self.cell.linked.robots[r].globals[mg as usize] as usize;
+            self.check_race(cg, r, t, pos, false);
+            // Seen by whoever has seen r's next action.
+            let stamp = self.clock[r * n + r] + 1;
+            self.last_read[cg] = Some((t, r, pos, stamp));
+        }
+        self.reads = reads;
     }
 
     fn on_set(&mut self, r: usize, g: u32, value: u64, t: i64, pos: SrcPos) {
         let cg = self.cell.linked.robots[r].globals[g as usize] as usize;
         self.check_race(cg, r, t, pos, true);
+        if let Some((ot, q, qpos)) = self.last_timeout[cg]
+            && ot == t
+            && q != r
+        {
+            let name = &self.cell.linked.globals[cg].name;
+            let subject = format!("on `{name}`");
+            self.race(t, (q, qpos), (r, pos), &subject, "time out a wait and set it at the same instant; whether the set releases the wait depends on their order");
+        }
         let stamp = self.tick(r);
         self.last_set[cg] = Some((t, r, pos, stamp));
         let n = self.vms.len();
@@ -1063,6 +1326,41 @@ impl Simulation {
                 self.push(t, Entry::CheckWhen(q, cg as u32));
             }
         }
+    }
+
+    /// The cell handled more than `instant_limit` entries at instant `t`: robots that
+    /// keep waking each other without time passing. Stops the run with an error naming
+    /// the busiest robots and their loops.
+    fn livelock(&mut self, t: i64) {
+        let mut busy: Vec<(u64, usize)> = (0..self.vms.len())
+            .map(|r| (self.vms[r].events_at(t), r))
+            .filter(|(k, _)| *k > 0)
+            .collect();
+        busy.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
+        let parts: Vec<String> = busy
+            .iter()
+            .take(4)
+            .map(|&(k, r)| {
+                format!(
+                    "{} ({k} events, the loop at {}:{})",
+                    self.cell.robots[r].name,
+                    self.short(r),
+                    self.vms[r].loop_position()
+                )
+            })
+            .collect();
+        let m = format!(
+            "zero-time livelock: the cell handled {} events at {} without time passing: {}; add a motion, a delay or a wait that blocks inside these loops",
+            self.instant_limit,
+            fmt_quantity(t as f64 / 1e9, vworks_vm::Dim::TIME),
+            parts.join(", ")
+        );
+        let robot = busy.first().map(|&(_, r)| r);
+        let pos = robot.map(|r| self.vms[r].loop_position());
+        self.record(t, robot, "error", Detail::Text(format!("{m:?}")), pos);
+        let issue = self.issue("runtime", m, robot, pos);
+        self.errors.push(issue);
+        self.outcome = Some(Outcome::Error);
     }
 
     /// The queue ran dry: everyone ended, or a deadlock.

@@ -185,6 +185,25 @@ pub struct Cell {
     pub sources: Vec<(String, String)>,
     /// Every other file the run read: each URDF and each mesh, (path, bytes), in load order.
     pub files: Vec<(String, Vec<u8>)>,
+    /// The programs' compile warnings (in robot order, each program once) and the link
+    /// warnings: `vworks run` prints them as `vworks check` does, and every run's result
+    /// lists them ([`crate::engine::RunResult::warnings`]).
+    pub warnings: Vec<Diagnostic>,
+}
+
+impl Cell {
+    /// The compile and link warnings, rendered with their source lines as `vworks check`
+    /// prints them (empty if there are none).
+    pub fn render_warnings(&self, color: bool) -> String {
+        if self.warnings.is_empty() {
+            return String::new();
+        }
+        let mut sources = Sources::new();
+        for (path, text) in &self.sources {
+            sources.add(path, text);
+        }
+        vworks_wslc::render(&self.warnings, &sources, color)
+    }
 }
 
 struct Ctx<'a> {
@@ -463,6 +482,7 @@ pub fn load(path: &Path) -> Result<Cell, CellError> {
     let mut robots = Vec::new();
     let mut modules: Vec<(String, Arc<Module>)> = Vec::new();
     let mut diagnostics = Vec::new();
+    let mut warnings = Vec::new();
     let mut render_sources = Sources::new();
     for (i, r) in cf.robot.iter().enumerate() {
         let key = format!("robot[{i}] `{}`", r.name);
@@ -512,6 +532,7 @@ pub fn load(path: &Path) -> Result<Cell, CellError> {
                 sources.push((pname.clone(), src.clone()));
                 match vworks_wslc::compile(&pname, &src) {
                     Ok(out) => {
+                        warnings.extend(out.warnings);
                         let m = Arc::new(out.module);
                         modules.push((pname.clone(), Arc::clone(&m)));
                         m
@@ -670,8 +691,12 @@ pub fn load(path: &Path) -> Result<Cell, CellError> {
         devices,
         parts,
         allowed,
-        linked,
         sources,
         files,
+        warnings: warnings
+            .into_iter()
+            .chain(linked.warnings.iter().cloned())
+            .collect(),
+        linked,
     })
 }

@@ -58,8 +58,8 @@ pub struct RuntimeError {
 
 /// What zero-time code may read from the robot and the cell.
 pub trait Reader {
-    /// The value of module global `g` (slot bits).
-    fn global(&self, g: u32) -> u64;
+    /// The value of module global `g` (slot bits), read by the instruction at `pc`.
+    fn global(&self, g: u32, pc: u32) -> u64;
     /// Simulated time (s).
     fn now_s(&self) -> f64;
     /// Cycle count.
@@ -174,7 +174,7 @@ impl Thread {
             self.pc = pc + 1;
             let base = self.frame().base as usize;
             match ins {
-                Instr::Nop | Instr::ParBegin => {}
+                Instr::Nop => {}
                 Instr::PushBool(v) => self.stack.push(u64::from(v)),
                 Instr::PushInt(i) => self.stack.push(i as u64),
                 Instr::PushNum(x) => self.stack.push(b(x)),
@@ -230,7 +230,7 @@ impl Thread {
                     let i = self.joint_index(i, r.axes()).map_err(|e| err(pc, e))?;
                     vars[s as usize + i] = v;
                 }
-                Instr::LoadGlobal(g) => self.stack.push(r.global(g)),
+                Instr::LoadGlobal(g) => self.stack.push(r.global(g, pc)),
                 Instr::AddI | Instr::SubI | Instr::MulI | Instr::DivI | Instr::ModI => {
                     let y = self.pop() as i64;
                     let x = self.pop() as i64;
@@ -462,7 +462,7 @@ impl Thread {
                     self.stack.extend(p.iter().map(|x| b(*x)));
                 }
                 _ => {
-                    // An event: stop before it.
+                    // An event (or `ParBegin`, which the machine tracks): stop before it.
                     self.pc = pc;
                     *budget += 1;
                     return Ok(Stop::Event(ins));

@@ -18,11 +18,21 @@ use crate::exec::{Reader, RuntimeError, Stop, Thread};
 use crate::motion::{NS, Path, Profile, cartesian_at};
 use crate::types::{Dim, Type, fmt_quantity};
 
+/// The latest simulated time an event may have: 2^62 ns, about 146 years. A delay, a
+/// timeout, a motion or a handler period that would end later is a runtime error at its
+/// statement, so that event times never overflow.
+pub const TIME_LIMIT_NS: i64 = 1 << 62;
+
 /// Settings of one VM.
 #[derive(Clone, Debug)]
 pub struct VmConfig {
-    /// Instructions a segment may run without time passing (default 10 million).
+    /// Instructions the robot may run at one simulated instant without time passing,
+    /// over all its segments at that instant (default 10 million).
     pub budget: u64,
+    /// Events the robot may perform at one simulated instant (default 100,000): a
+    /// zero-time loop that emits events (`g = g + 1;`, a `log`, a handshake with another
+    /// robot that never lets time pass) becomes a runtime error naming the loop.
+    pub instant_events: u64,
     /// Deepest call nesting (default 256).
     pub max_depth: usize,
     /// The cycle period (ns), for `cycle()`.
@@ -41,6 +51,7 @@ impl Default for VmConfig {
     fn default() -> VmConfig {
         VmConfig {
             budget: 10_000_000,
+            instant_events: 100_000,
             max_depth: 256,
             cycle_ns: 4_000_000,
             default_speed: 0.25,
@@ -300,10 +311,12 @@ enum State {
         deadline: Option<i64>,
         pos: SrcPos,
     },
-    /// Released from a wait at `time`.
+    /// Released from a wait at `time`; `timed`: the wait had a timeout (only those set
+    /// `timed_out()`).
     Released {
         time: i64,
         timed_out: bool,
+        timed: bool,
         pos: SrcPos,
     },
     /// Waiting for the remote work of the `parallel` block at this depth.
@@ -328,6 +341,9 @@ enum Firing {
 struct Enabled {
     handler: u32,
     target: u32,
+    /// The activation that enabled it: 0 for the program, a remote request's number
+    /// (from 1) for remote work. It is disabled when that activation ends.
+    owner: u64,
     /// Captured slots for the action and for the condition.
     args: Vec<u64>,
     cond_args: Vec<u64>,
@@ -393,15 +409,39 @@ pub struct Vm {
     globals: Vec<u64>,
     /// Warnings to report (e.g. a move slowed by an axis speed limit).
     warnings: Vec<(i64, SrcPos, String)>,
+    /// The activation running on the main thread: 0 for the program, then one number
+    /// per remote request served (from 1).
+    activation: u64,
+    activations: u64,
+    /// The simulated instant the budgets below count for, the instructions left at it and
+    /// the events performed at it.
+    instant: i64,
+    instant_budget: u64,
+    instant_events: u64,
+    /// Per module global: the instant the main program or a handler last read it, and
+    /// where (for race warnings); `reads` lists the globals first read at this instant
+    /// since the SE last took them.
+    read_at: Vec<std::cell::Cell<i64>>,
+    reads: std::cell::RefCell<Vec<(u32, SrcPos)>>,
 }
 
 struct View<'a> {
     vm: &'a Vm,
     t: i64,
+    /// Whether reads of globals count for race warnings: those of the main program and
+    /// of handlers, not of conditions (which `check_wait`/`check_when` re-test).
+    record_reads: bool,
 }
 
 impl Reader for View<'_> {
-    fn global(&self, g: u32) -> u64 {
+    fn global(&self, g: u32, pc: u32) -> u64 {
+        if self.record_reads
+            && let Some(at) = self.vm.read_at.get(g as usize)
+            && at.get() != self.t
+        {
+            at.set(self.t);
+            self.vm.reads.borrow_mut().push((g, self.vm.m.pos_of(pc)));
+        }
         self.vm.globals.get(g as usize).copied().unwrap_or(0)
     }
     fn now_s(&self) -> f64 {
@@ -426,6 +466,19 @@ impl Reader for View<'_> {
     }
 }
 
+/// `secs` seconds from instant `t` in whole nanoseconds (rounded), if they end by
+/// [`TIME_LIMIT_NS`]; else what is wrong with `what`. `secs` is not negative.
+fn span_ns(secs: f64, t: i64, what: &str) -> Result<i64, String> {
+    let ns = (secs * NS).round();
+    if ns.is_nan() || ns > (TIME_LIMIT_NS - t) as f64 {
+        return Err(format!(
+            "{what} of {} would end after the last instant the simulator can represent (2^62 ns, about 146 years); use a shorter time",
+            fmt_quantity(secs, Dim::TIME)
+        ));
+    }
+    Ok(ns as i64)
+}
+
 fn to_iso(p: &[u64]) -> Iso {
     let v = |i: usize| f64::from_bits(p[i]);
     Iso::from_xyz_rpy([v(0), v(1), v(2)], [v(3), v(4), v(5)])
@@ -441,7 +494,7 @@ impl Vm {
             v.init
                 .write_slots(&mut vars[v.slot as usize..v.slot as usize + w]);
         }
-        let globals = m
+        let globals: Vec<u64> = m
             .globals
             .iter()
             .map(|g| {
@@ -489,8 +542,17 @@ impl Vm {
             serving: None,
             source: Source::None,
             signals: Vec::new(),
+            read_at: (0..globals.len())
+                .map(|_| std::cell::Cell::new(-1))
+                .collect(),
+            reads: std::cell::RefCell::new(Vec::with_capacity(4)),
             globals,
             warnings: Vec::new(),
+            activation: 0,
+            activations: 0,
+            instant: -1,
+            instant_budget: 0,
+            instant_events: 0,
         }
     }
 
@@ -535,6 +597,50 @@ impl Vm {
                 "the remote work of its `parallel` block (join)".into(),
                 *pos,
             )),
+            _ => None,
+        }
+    }
+
+    /// Moves into `out` the globals (module indices) that the main program or a handler
+    /// read for the first time at the current instant since the last call, with the
+    /// reading statement's position: the SE warns of a race when another robot sets one
+    /// at the same instant.
+    pub fn take_reads(&mut self, out: &mut Vec<(u32, SrcPos)>) {
+        out.append(self.reads.get_mut());
+    }
+
+    /// Stops the VM for good: the SE found a runtime error in the event it just performed
+    /// (a part gripped twice). Its next event is [`Next::Done`].
+    pub fn halt(&mut self) {
+        self.state = State::Done;
+        self.hrun = None;
+        self.hstate = State::Done;
+        self.enabled.clear();
+        self.fires.clear();
+    }
+
+    /// How many events the robot performed at instant `t` (0 unless its last events were
+    /// at `t`).
+    pub fn events_at(&self, t: i64) -> u64 {
+        if self.instant == t {
+            self.instant_events
+        } else {
+            0
+        }
+    }
+
+    /// Where the main program is, for a report of a zero-time loop: the innermost loop
+    /// around its current statement (or around the call that leads there), else the
+    /// statement.
+    pub fn loop_position(&self) -> SrcPos {
+        let e = self.zero_time_loop(self.main.pc, &self.main, String::new());
+        e.pos
+    }
+
+    /// The deadline of the wait the robot is blocked in, if it has a timeout.
+    pub fn wait_deadline(&self) -> Option<i64> {
+        match self.state {
+            State::Waiting { deadline, .. } => deadline,
             _ => None,
         }
     }
@@ -739,8 +845,8 @@ impl Vm {
             .iter()
             .enumerate()
             .filter_map(|(i, e)| match e.firing {
-                Firing::Timer { next, .. } => Some((next, i)),
-                Firing::Edge { .. } => None,
+                Firing::Timer { next, .. } if next <= TIME_LIMIT_NS => Some((next, i)),
+                _ => None,
             });
         timers.chain(self.fires.iter().copied()).min()
     }
@@ -776,6 +882,7 @@ impl Vm {
                 time,
                 timed_out,
                 pos,
+                ..
             } => Next::Event(Event {
                 robot: self.cfg.robot,
                 time: *time,
@@ -809,13 +916,27 @@ impl Vm {
     /// Runs zero-time code of the main thread (or the handler thread) up to its next event
     /// instruction and describes that event.
     fn run_segment(&mut self, in_handler: bool, t: i64) -> Event {
+        self.enter_instant(t);
+        if self.instant_events >= self.cfg.instant_events {
+            let th = self.thread(in_handler);
+            let e = self.zero_time_loop(
+                th.pc,
+                th,
+                format!(
+                    "{} events at {}",
+                    self.cfg.instant_events,
+                    fmt_quantity(t as f64 / NS, Dim::TIME)
+                ),
+            );
+            return self.error_event(&e, t);
+        }
         loop {
             let mut thread = std::mem::take(if in_handler {
                 &mut self.handler
             } else {
                 &mut self.main
             });
-            let stop = self.run_thread(&mut thread, t);
+            let stop = self.run_thread(&mut thread, t, true);
             let pc = thread.pc;
             if in_handler {
                 self.handler = thread;
@@ -842,6 +963,13 @@ impl Vm {
                     self.par_depth += 1;
                     self.main.pc = pc + 1;
                     continue;
+                }
+                // `stop` in a handler: the handler ends first (`when_end`), then the
+                // program (`end`, see `perform_handler`).
+                Ok(Stop::Event(Instr::Stop)) if in_handler && self.hrun.is_some() => {
+                    EventKind::WhenEnd {
+                        handler: self.hrun_handler,
+                    }
                 }
                 Ok(Stop::Event(ins)) => match self.describe(ins, t, in_handler) {
                     Ok(k) => k,
@@ -899,7 +1027,12 @@ impl Vm {
                 value: self.top(in_handler, 0),
                 ty: self.m.globals[g as usize].ty,
             },
-            Instr::When(h) => EventKind::EnableWhen { handler: h },
+            Instr::When(h) => {
+                if self.m.handlers[h as usize].trigger.has_operand() {
+                    self.check_trigger(h, self.top(in_handler, 0), t)?;
+                }
+                EventKind::EnableWhen { handler: h }
+            }
             Instr::Disable(p) => EventKind::DisableWhen { proc: p },
             Instr::Remote(r) => {
                 let w = self.m.remotes[r as usize].arg_width() as usize;
@@ -913,6 +1046,9 @@ impl Vm {
             Instr::ParJoin => EventKind::Join,
             Instr::MoveJ(_) | Instr::MoveL(_) | Instr::MoveC(_) => {
                 let (traj, dur) = self.plan(ins)?;
+                if dur < 0 || dur > TIME_LIMIT_NS - t {
+                    return Err("the motion would end after the last instant the simulator can represent (2^62 ns, about 146 years); check its speed".into());
+                }
                 self.pending_motion = Some(traj);
                 EventKind::MotionStart {
                     command: match ins {
@@ -932,7 +1068,7 @@ impl Vm {
                     ));
                 }
                 EventKind::Delay {
-                    duration_ns: (d * NS).round() as i64,
+                    duration_ns: span_ns(d, t, "the delay")?,
                 }
             }
             Instr::WaitUntil(c, timeout) => EventKind::WaitUntil {
@@ -954,7 +1090,11 @@ impl Vm {
                     EventKind::Log { text }
                 }
             }
-            Instr::Stop => EventKind::End,
+            // `stop` in remote work ends the remote work (the caller's join goes on).
+            Instr::Stop => match self.serving {
+                Some(proc) if !in_handler => EventKind::RemoteEnd { proc },
+                _ => EventKind::End,
+            },
             other => {
                 return Err(format!(
                     "`{}` is not supported by this VM yet",
@@ -1230,7 +1370,52 @@ impl Vm {
                 fmt_quantity(d, Dim::TIME)
             ));
         }
-        Ok(Some(t + (d * NS).round() as i64))
+        Ok(Some(t + span_ns(d, t, "the timeout")?))
+    }
+
+    /// Checks the operand of a `when` trigger before the handler is enabled at `t`: a
+    /// period of at least 1 ns (`every T`), a count of at least 1 (`every N cycles`), a
+    /// delay that is not negative (`after T`), all ending within the time limit.
+    fn check_trigger(&self, h: u32, operand: u64, t: i64) -> Result<(), String> {
+        use crate::bytecode::Trigger;
+        match self.m.handlers[h as usize].trigger {
+            Trigger::EveryCycles => {
+                let n = operand as i64;
+                if n < 1 {
+                    return Err(format!(
+                        "`every {n} cycles` needs a count of at least 1; a handler every 0 or fewer cycles could never fire"
+                    ));
+                }
+                let c = self.cfg.cycle_ns.max(1);
+                if n > TIME_LIMIT_NS / c {
+                    return Err(format!(
+                        "`every {n} cycles` is longer than the simulator's time range (about 146 years)"
+                    ));
+                }
+            }
+            Trigger::Every => {
+                let p = f64::from_bits(operand);
+                if p.is_nan() || p * NS < 0.5 {
+                    return Err(format!(
+                        "`every {}` needs a period of at least 1 ns; a period of zero or less would fire without end",
+                        fmt_quantity(p, Dim::TIME)
+                    ));
+                }
+                span_ns(p, t, "the period")?;
+            }
+            Trigger::After => {
+                let p = f64::from_bits(operand);
+                if p.is_nan() || p < 0.0 {
+                    return Err(format!(
+                        "`after {}`: the delay cannot be negative",
+                        fmt_quantity(p, Dim::TIME)
+                    ));
+                }
+                span_ns(p, t, "the delay")?;
+            }
+            Trigger::Condition(_) => {}
+        }
+        Ok(())
     }
 
     /// The text of a `log`/`fail` message whose values are on top of the stack.
@@ -1292,8 +1477,10 @@ impl Vm {
             Source::Main => self.perform_main(),
             Source::Handler => self.perform_handler(),
             Source::Fire(i) => self.perform_fire(i),
-            Source::None => {}
+            Source::None => return,
         }
+        self.enter_instant(self.time);
+        self.instant_events += 1;
     }
 
     fn perform_fire(&mut self, i: usize) {
@@ -1306,8 +1493,9 @@ impl Vm {
             return;
         };
         if let Firing::Timer { next, period } = &mut e.firing {
+            // Past the time limit a timer never fires again (see `next_fire`).
             match period {
-                Some(p) => *next += *p,
+                Some(p) => *next = next.saturating_add(*p),
                 None => *next = i64::MAX,
             }
         }
@@ -1326,6 +1514,8 @@ impl Vm {
         let ins = self.m.code.get(pc as usize).copied().unwrap_or(Instr::Stop);
         match e.kind {
             EventKind::WhenEnd { .. } => {
+                // The handler stopped at `stop`: the program ends after it.
+                let stopping = !self.handler.frames.is_empty() && ins == Instr::Stop;
                 // An `after` handler is gone once it has run.
                 if let Some((i, _)) = self.hrun
                     && matches!(
@@ -1337,6 +1527,9 @@ impl Vm {
                 }
                 self.hrun = None;
                 self.hstate = State::Done;
+                if stopping {
+                    self.stop_program(e.time, e.pos);
+                }
                 return;
             }
             EventKind::Error { .. } => {
@@ -1447,6 +1640,7 @@ impl Vm {
             }
         };
         self.enabled.push(Enabled {
+            owner: self.activation,
             handler: h,
             target: info.target,
             args,
@@ -1492,6 +1686,51 @@ impl Vm {
         self.state = State::Idle;
     }
 
+    /// `stop` ran in a handler at `t`: whatever the main thread was doing (a motion, a
+    /// wait) is abandoned, the robot holds still where it is, and the program ends (`end`)
+    /// — or, in remote work, the remote work ends (`remote_end`).
+    fn stop_program(&mut self, t: i64, pos: SrcPos) {
+        if self.motion.is_some() {
+            self.rest = self.joints_at(t);
+            self.motion = None;
+        }
+        self.pending_motion = None;
+        let kind = match self.serving {
+            Some(proc) => EventKind::RemoteEnd { proc },
+            None => EventKind::End,
+        };
+        self.state = State::At(Event {
+            robot: self.cfg.robot,
+            time: t,
+            kind,
+            pos,
+        });
+    }
+
+    /// The remote work being served ended: the handlers it enabled go with it.
+    fn end_activation(&mut self) {
+        let a = self.activation;
+        if a != 0 {
+            self.remove_enabled(|_, e| e.owner == a);
+        }
+        self.activation = 0;
+        self.serving = None;
+        self.state = State::Idle;
+    }
+
+    /// The enabled condition handlers: (handler procedure, the module globals the
+    /// condition reads), for the SE's when list.
+    pub fn condition_handlers(&self) -> impl Iterator<Item = (u32, &[u32])> + '_ {
+        self.enabled
+            .iter()
+            .filter_map(|e| match self.m.handlers[e.handler as usize].trigger {
+                crate::bytecode::Trigger::Condition(c) => {
+                    Some((e.target, self.m.conds[c as usize].globals.as_slice()))
+                }
+                _ => None,
+            })
+    }
+
     fn perform_main(&mut self) {
         let state = std::mem::replace(&mut self.state, State::Run);
         match state {
@@ -1509,8 +1748,7 @@ impl Vm {
                         return;
                     }
                     EventKind::RemoteEnd { .. } => {
-                        self.serving = None;
-                        self.state = State::Idle;
+                        self.end_activation();
                         return;
                     }
                     EventKind::MotionStart { duration_ns, .. } => {
@@ -1536,11 +1774,11 @@ impl Vm {
                         if deadline.is_some() {
                             self.main.stack.pop();
                         }
-                        self.timed_out = false;
                         self.state = if self.eval_cond(*cond, e.time) {
                             State::Released {
                                 time: e.time,
                                 timed_out: false,
+                                timed: deadline.is_some(),
                                 pos: e.pos,
                             }
                         } else {
@@ -1556,13 +1794,13 @@ impl Vm {
                         if deadline.is_some() {
                             self.main.stack.pop();
                         }
-                        self.timed_out = false;
                         let have = self.signals.iter_mut().find(|(n, c)| n == name && *c > 0);
                         self.state = if let Some((_, c)) = have {
                             *c -= 1;
                             State::Released {
                                 time: e.time,
                                 timed_out: false,
+                                timed: deadline.is_some(),
                                 pos: e.pos,
                             }
                         } else {
@@ -1592,6 +1830,7 @@ impl Vm {
                             State::Released {
                                 time: e.time,
                                 timed_out: false,
+                                timed: false,
                                 pos: e.pos,
                             }
                         };
@@ -1602,6 +1841,8 @@ impl Vm {
                         };
                         self.main.start(&self.m, *proc, &r.args);
                         self.serving = Some(*proc);
+                        self.activations += 1;
+                        self.activation = self.activations;
                         self.state = State::Run;
                         return;
                     }
@@ -1630,10 +1871,16 @@ impl Vm {
                 self.timed_out = true;
             }
             State::Released {
-                time, timed_out, ..
+                time,
+                timed_out,
+                timed,
+                ..
             } => {
                 self.time = time;
-                self.timed_out = timed_out;
+                // `timed_out()` reports the most recent *timed* wait.
+                if timed {
+                    self.timed_out = timed_out;
+                }
             }
             other => self.state = other,
         }
@@ -1686,6 +1933,7 @@ impl Vm {
             self.state = State::Released {
                 time: t,
                 timed_out: false,
+                timed: false,
                 pos,
             };
         }
@@ -1714,26 +1962,95 @@ impl Vm {
         self.eval_cond_with(func, &args[..n], t)
     }
 
-    /// Runs a thread's zero-time code at time `t` over this VM's module variables.
-    fn run_thread(&mut self, th: &mut Thread, t: i64) -> Result<Stop, RuntimeError> {
-        let mut budget = self.cfg.budget;
+    /// Runs a thread's zero-time code at time `t` over this VM's module variables, within
+    /// what is left of the instant's instruction budget. `record_reads`: the thread is the
+    /// main program or a handler (see [`Vm::take_reads`]).
+    fn run_thread(
+        &mut self,
+        th: &mut Thread,
+        t: i64,
+        record_reads: bool,
+    ) -> Result<Stop, RuntimeError> {
+        self.enter_instant(t);
+        let mut budget = self.instant_budget;
         let mut vars = std::mem::take(&mut self.vars);
         let r = th.run(
             &self.m,
-            &View { vm: self, t },
+            &View {
+                vm: self,
+                t,
+                record_reads,
+            },
             &mut vars,
             &mut budget,
             self.cfg.max_depth,
         );
+        self.instant_budget = budget;
         self.vars = vars;
-        r
+        match r {
+            Err(e) if budget == 0 => Err(self.zero_time_loop(
+                e.pc,
+                th,
+                format!(
+                    "{} instructions at {}",
+                    self.cfg.budget,
+                    fmt_quantity(t as f64 / NS, Dim::TIME)
+                ),
+            )),
+            other => other,
+        }
+    }
+
+    /// Starts counting the budgets of instant `t` if it is a new one.
+    fn enter_instant(&mut self, t: i64) {
+        if t != self.instant {
+            self.instant = t;
+            self.instant_budget = self.cfg.budget;
+            self.instant_events = 0;
+        }
+    }
+
+    /// The error of a zero-time loop at `pc` of `th`: it names the innermost loop around
+    /// `pc` (or around the call that leads there), or the statement if there is none.
+    fn zero_time_loop(&self, pc: u32, th: &Thread, what: String) -> RuntimeError {
+        let calls = th.frames.iter().rev().map(|f| f.ret_pc);
+        let found = std::iter::once(pc)
+            .chain(calls)
+            .find_map(|at| self.loop_around(at));
+        let (at, place) = match found {
+            Some(start) => (start, "this loop"),
+            None => (pc, "this statement"),
+        };
+        RuntimeError {
+            message: format!(
+                "{place} never lets time pass ({what}): an endless zero-time loop; add a motion, a delay or a wait that blocks inside it"
+            ),
+            pc: at,
+            pos: self.m.pos_of(at),
+        }
+    }
+
+    /// The start of the innermost loop around absolute instruction `pc`: the target of the
+    /// shortest backward jump of the same procedure that spans it.
+    fn loop_around(&self, pc: u32) -> Option<u32> {
+        let p = &self.m.procs[self.m.proc_at(pc)? as usize];
+        let code = p.code(&self.m);
+        let rel = pc - p.code_start;
+        code.iter()
+            .enumerate()
+            .filter_map(|(j, ins)| {
+                let t = ins.jump_target()?;
+                (t <= rel && rel <= j as u32).then(|| (j as u32 - t, t))
+            })
+            .min()
+            .map(|(_, t)| p.code_start + t)
     }
 
     /// Runs condition function `func` with `args`; false if it fails.
     fn eval_cond_with(&mut self, func: u32, args: &[u64], t: i64) -> bool {
         let mut th = std::mem::take(&mut self.cond_thread);
         th.start(&self.m, func, args);
-        let r = self.run_thread(&mut th, t);
+        let r = self.run_thread(&mut th, t, false);
         let value = matches!(r, Ok(Stop::Finished)) && th.stack.last().copied().unwrap_or(0) != 0;
         self.cond_thread = th;
         value
@@ -1748,7 +2065,10 @@ impl Vm {
     /// Returns true if the VM is released (its next event becomes `wait_end` at `t`).
     pub fn check_wait(&mut self, t: i64) -> bool {
         let State::Waiting {
-            cond: Some(c), pos, ..
+            cond: Some(c),
+            pos,
+            deadline,
+            ..
         } = self.state
         else {
             return false;
@@ -1757,6 +2077,7 @@ impl Vm {
             self.state = State::Released {
                 time: t,
                 timed_out: false,
+                timed: deadline.is_some(),
                 pos,
             };
             return true;
@@ -1789,6 +2110,7 @@ impl Vm {
         if let State::Waiting {
             signal: Some(s),
             pos,
+            deadline,
             ..
         } = self.state
             && s == idx
@@ -1796,6 +2118,7 @@ impl Vm {
             self.state = State::Released {
                 time: t,
                 timed_out: false,
+                timed: deadline.is_some(),
                 pos,
             };
             return true;

@@ -322,7 +322,7 @@ instruction_set! {
     0x75 WaitSignal(s: u32, t: bool);
     /// EVENT `signal`: sends the signal of signal site `s`.
     0x76 Signal(s: u32);
-    /// Opens a `parallel` block.
+    /// Opens a `parallel` block: the interpreter stops at it so that the machine opens a join group (no event).
     0x77 ParBegin;
     /// EVENT `remote_start`: pops the arguments of remote site `r` and asks its robot to run it.
     0x78 Remote(r: u32);

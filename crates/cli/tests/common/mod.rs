@@ -1,0 +1,64 @@
+//! What the data-driven CLI tests share: a `.case` file (a command and the files it
+//! works on) and running it in a fresh folder.
+
+#![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used, dead_code)] // tests fail by panicking
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The repository's root.
+pub fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// A command (`$ vworks …`) and its files (`--- NAME` then the text).
+pub struct Case {
+    /// The arguments after `vworks`.
+    pub args: Vec<String>,
+    /// (path, text) of each file.
+    pub files: Vec<(String, String)>,
+}
+
+/// Reads a `.case` file's text (lines before the command are comments).
+pub fn parse(text: &str) -> Case {
+    let mut args = Vec::new();
+    let mut files: Vec<(String, String)> = Vec::new();
+    for line in text.lines() {
+        if let Some(cmd) = line.strip_prefix("$ vworks") {
+            args = cmd.split_whitespace().map(str::to_string).collect();
+        } else if let Some(path) = line.strip_prefix("--- ") {
+            files.push((path.to_string(), String::new()));
+        } else if let Some((_, body)) = files.last_mut() {
+            body.push_str(line);
+            body.push('\n');
+        }
+    }
+    Case { args, files }
+}
+
+/// Runs the case in a fresh folder: (exit code, stdout, stderr), the folder's path
+/// written as `$DIR`.
+pub fn run(name: &str, case: &Case) -> (i32, String, String) {
+    let dir = std::env::temp_dir().join(format!("vworks-errors-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    for (path, body) in &case.files {
+        let p = dir.join(path);
+        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+        std::fs::write(p, body).unwrap();
+    }
+    let out = Command::new(env!("CARGO_BIN_EXE_vworks"))
+        .args(&case.args)
+        .current_dir(&dir)
+        .env("NO_COLOR", "1")
+        .output()
+        .unwrap();
+    let dir_text = dir.display().to_string();
+    let clean = |b: &[u8]| String::from_utf8_lossy(b).replace(&dir_text, "$DIR");
+    let _ = std::fs::remove_dir_all(&dir);
+    (
+        out.status.code().unwrap_or(-1),
+        clean(&out.stdout),
+        clean(&out.stderr),
+    )
+}
