@@ -159,7 +159,8 @@ fn main() -> ExitCode {
 }
 
 fn read(path: &Path) -> Result<String, String> {
-    std::fs::read_to_string(path).map_err(|e| cannot_read(path, &e))
+    let bytes = std::fs::read(path).map_err(|e| cannot_read(path, &e))?;
+    vworks_wslc::source_text(bytes).map_err(|e| format!("{}: {e}", path.display()))
 }
 
 /// "cannot read FILE: why; what to do" for a file named on the command line.
@@ -520,7 +521,13 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
             out!("{}", e.line(&cell));
         }
     }
-    let issue = |i: &vworks_se::engine::Issue| serde_json::json!({"kind": i.kind, "message": i.message, "robot": i.robot, "file": i.file, "line": i.line, "col": i.col});
+    let issue = |i: &vworks_se::engine::Issue| {
+        let mut v = serde_json::json!({"kind": i.kind, "message": i.message, "robot": i.robot, "file": i.file, "line": i.line, "col": i.col});
+        if let Some(d) = i.distance_m {
+            v["distance_m"] = d.into();
+        }
+        v
+    };
     if json {
         let v = serde_json::json!({
             "cell": cell.name,

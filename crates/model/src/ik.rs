@@ -338,11 +338,20 @@ impl RobotModel {
                 let cur = current.get(i).copied().unwrap_or(0.0);
                 // Whole turns toward the current value, then into the limits if possible.
                 let mut v = *qi + (2.0 * PI) * ((cur - *qi) / (2.0 * PI)).round();
-                while v > j.upper + 1e-9 && v - 2.0 * PI >= j.lower - 1e-9 {
-                    v -= 2.0 * PI;
+                // In closed form, not a loop of single turns: with joints far out of range
+                // (`v - 2π == v` past 1e16) such a loop never ends.
+                let tau = 2.0 * PI;
+                if v > j.upper + 1e-9 {
+                    let w = v - tau * ((v - j.upper - 1e-9) / tau).ceil();
+                    if w >= j.lower - 1e-9 {
+                        v = w;
+                    }
                 }
-                while v < j.lower - 1e-9 && v + 2.0 * PI <= j.upper + 1e-9 {
-                    v += 2.0 * PI;
+                if v < j.lower - 1e-9 {
+                    let w = v + tau * ((j.lower - 1e-9 - v) / tau).ceil();
+                    if w <= j.upper + 1e-9 {
+                        v = w;
+                    }
                 }
                 if v < j.lower - 1e-9 || v > j.upper + 1e-9 {
                     limit_hit.get_or_insert((i, v));

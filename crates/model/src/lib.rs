@@ -9,6 +9,7 @@
 //!   and damped-least-squares IK for any chain.
 //! - [`builtin`]: `irb120`, `kr6r900`, `lrmate200id`, `ur5`, `turntable`, `track`.
 //! - [`mesh`]: STL (binary, ASCII) and OBJ vertices.
+//! - [`files`]: where URDFs and meshes are read from (the disk, or memory).
 //! - [`math`]: the small rigid-transform algebra all of it uses.
 //!
 //! Joint values are radians for revolute axes and metres for prismatic ones. A joint
@@ -17,6 +18,7 @@
 
 pub mod builtin;
 pub mod error;
+pub mod files;
 pub mod ik;
 pub mod math;
 pub mod mesh;

@@ -97,8 +97,12 @@ pub struct Joint {
     pub upper: f64,
     /// Maximum speed (rad/s or m/s).
     pub max_velocity: f64,
-    /// Maximum acceleration (rad/s² or m/s²).
+    /// Maximum acceleration (rad/s² or m/s²): the URDF's `acceleration`, or its
+    /// `deceleration` when that is smaller (motion profiles are symmetric).
     pub max_accel: f64,
+    /// Maximum jerk (rad/s³ or m/s³), if the URDF gives one (read whatever the URDF's
+    /// version; the trapezoidal profiles do not use it yet).
+    pub max_jerk: Option<f64>,
     /// Index in the robot's joint vector, for the axes on the root→tool chain.
     pub axis_index: Option<usize>,
 }

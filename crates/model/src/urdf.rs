@@ -13,6 +13,7 @@ use parry3d::math::Vector;
 use parry3d::shape::SharedShape;
 
 use crate::error::ModelError;
+use crate::files::{Disk, Files};
 use crate::math::{Iso, V3, norm};
 use crate::mesh;
 use crate::model::{
@@ -22,7 +23,8 @@ use crate::model::{
 /// How to load a URDF.
 #[derive(Clone, Debug, Default)]
 pub struct LoadOptions {
-    /// The tool (flange) link; required when the tree branches, else the chain's end.
+    /// The tool (flange) link. Without one: the chain's end, or `tool0` (the ROS-Industrial
+    /// convention) when the tree branches; a branching tree without `tool0` is an error.
     pub tool_link: Option<String>,
     /// Folders searched for `package://` meshes (besides the URDF's own folder).
     pub package_paths: Vec<PathBuf>,
@@ -30,12 +32,23 @@ pub struct LoadOptions {
 
 /// Loads a URDF file.
 pub fn load_file(path: &Path, opts: &LoadOptions) -> Result<RobotModel, ModelError> {
+    load_file_with(path, opts, &Disk)
+}
+
+/// Loads a URDF file, reading it and its meshes from `files`.
+pub fn load_file_with(
+    path: &Path,
+    opts: &LoadOptions,
+    files: &dyn Files,
+) -> Result<RobotModel, ModelError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| ModelError::Read {
+    let read = |reason: String| ModelError::Read {
         file: file.clone(),
-        reason: e.to_string(),
-    })?;
-    load_str(&text, &file, path.parent(), opts)
+        reason,
+    };
+    let bytes = files.read(path).map_err(|e| read(e.to_string()))?;
+    let text = String::from_utf8(bytes).map_err(|e| read(format!("not UTF-8 text: {e}")))?;
+    load_str_with(&text, &file, path.parent(), opts, files)
 }
 
 /// Loads URDF text; `file` names it in errors, `dir` is where relative meshes are.
@@ -45,6 +58,17 @@ pub fn load_str(
     dir: Option<&Path>,
     opts: &LoadOptions,
 ) -> Result<RobotModel, ModelError> {
+    load_str_with(text, file, dir, opts, &Disk)
+}
+
+/// [`load_str`], reading meshes from `files`.
+pub fn load_str_with(
+    text: &str,
+    file: &str,
+    dir: Option<&Path>,
+    opts: &LoadOptions,
+    files: &dyn Files,
+) -> Result<RobotModel, ModelError> {
     let invalid = |element: String, message: String, help: &str| ModelError::Invalid {
         file: file.to_string(),
         element,
@@ -52,6 +76,9 @@ pub fn load_str(
         help: help.to_string(),
     };
     check_joint_types(text, file)?;
+    // urdf-rs reads `acceleration`, `deceleration` and `jerk` only from URDF 1.2 files;
+    // vworks reads them whatever the version (docs/models.md).
+    let dynamics = limit_attributes(text);
     let robot = urdf_rs::read_from_string(text).map_err(|e| ModelError::Parse {
         file: file.to_string(),
         reason: e.to_string(),
@@ -186,6 +213,8 @@ pub fn load_str(
                 match children[l].len() {
                     0 => break l,
                     1 => l = by_name[robot.joints[children[l][0]].child.link.as_str()],
+                    // ROS-Industrial's convention: every industrial URDF has a `tool0`.
+                    _ if by_name.contains_key("tool0") => break by_name["tool0"],
                     _ => {
                         let leaves: Vec<&str> = (0..robot.links.len())
                             .filter(|i| children[*i].is_empty())
@@ -195,7 +224,7 @@ pub fn load_str(
                             format!("link `{}`", robot.links[l].name),
                             "the tree branches here, so the tool link is ambiguous".into(),
                             &format!(
-                                "name the tool link in the workcell (one of: {})",
+                                "name the tool link in the workcell (`tool_link`, one of: {}), or call it `tool0`",
                                 leaves.join(", ")
                             ),
                         ));
@@ -259,10 +288,29 @@ pub fn load_str(
                     "a moving joint needs <limit velocity=\"…\"/> greater than 0",
                 ));
             }
-            let acc = if lim.acceleration.is_finite() && lim.acceleration > 0.0 {
-                lim.acceleration
-            } else {
-                lim.velocity / DEFAULT_ACCEL_TIME
+            let extra = dynamics.get(j.name.as_str());
+            let given = |name: &str, value: Option<f64>| -> Result<Option<f64>, ModelError> {
+                match value {
+                    Some(v) if !(v.is_finite() && v > 0.0) => Err(invalid(
+                        el(),
+                        format!("its {name} limit is {v}"),
+                        &format!("write <limit {name}=\"…\"/> greater than 0, or leave it out"),
+                    )),
+                    other => Ok(other),
+                }
+            };
+            let acc = given(
+                "acceleration",
+                extra
+                    .and_then(|d| d.acceleration)
+                    .or((lim.acceleration.is_finite() && lim.acceleration > 0.0)
+                        .then_some(lim.acceleration)),
+            )?;
+            let dec = given("deceleration", extra.and_then(|d| d.deceleration))?;
+            let acc = match (acc, dec) {
+                (Some(a), Some(d)) => a.min(d),
+                (Some(a), None) | (None, Some(a)) => a,
+                (None, None) => lim.velocity / DEFAULT_ACCEL_TIME,
             };
             (lim.velocity, acc)
         } else {
@@ -280,6 +328,7 @@ pub fn load_str(
             upper,
             max_velocity,
             max_accel,
+            max_jerk: dynamics.get(j.name.as_str()).and_then(|d| d.jerk),
             axis_index: None,
         });
     }
@@ -300,7 +349,7 @@ pub fn load_str(
                 ));
             }
             let origin = Iso::from_xyz_rpy(o.xyz.0, o.rpy.0);
-            let geometry = geometry(&c.geometry, file, dir, &el, opts)?;
+            let geometry = geometry(&c.geometry, file, dir, &el, opts, files)?;
             shapes.push(build_shape(geometry, origin, file, &el)?);
         }
         let index = links.len();
@@ -400,6 +449,78 @@ fn check_joint_types(text: &str, file: &str) -> Result<(), ModelError> {
     Ok(())
 }
 
+/// The dynamic limits of a joint's `<limit>` element, read from the text.
+#[derive(Clone, Copy, Debug, Default)]
+struct Dynamics {
+    acceleration: Option<f64>,
+    deceleration: Option<f64>,
+    jerk: Option<f64>,
+}
+
+/// Each joint's `acceleration`, `deceleration` and `jerk` limit attributes (a value that
+/// is not a number reads as NaN, which the caller rejects).
+fn limit_attributes(text: &str) -> BTreeMap<String, Dynamics> {
+    let stripped = strip_blocks(text);
+    let mut out = BTreeMap::new();
+    let mut rest = stripped.as_str();
+    while let Some(i) = rest.find("<joint") {
+        let after = &rest[i + 6..];
+        rest = after;
+        if !after.starts_with(|c: char| c.is_whitespace()) {
+            continue;
+        }
+        let tag_end = after.find('>').unwrap_or(after.len());
+        let Some(name) = attribute(&after[..tag_end], "name") else {
+            continue;
+        };
+        // The joint's body: up to its end tag (or the next joint).
+        let body_end = after
+            .find("</joint>")
+            .or_else(|| after.find("<joint"))
+            .unwrap_or(after.len());
+        let body = &after[..body_end.max(tag_end)];
+        let Some(l) = body.find("<limit") else {
+            continue;
+        };
+        let limit = &body[l..];
+        let limit = &limit[..limit.find('>').unwrap_or(limit.len())];
+        let num =
+            |key: &str| attribute(limit, key).map(|v| v.trim().parse::<f64>().unwrap_or(f64::NAN));
+        out.insert(
+            name.to_string(),
+            Dynamics {
+                acceleration: num("acceleration"),
+                deceleration: num("deceleration"),
+                jerk: num("jerk"),
+            },
+        );
+    }
+    out
+}
+
+/// The value of attribute `key` in the text of one tag (`key="v"` or `key='v'`, with the
+/// key standing alone: `acceleration` is not found inside `deceleration`).
+fn attribute<'t>(tag: &'t str, key: &str) -> Option<&'t str> {
+    let mut from = 0;
+    while let Some(k) = tag[from..].find(key) {
+        let start = from + k;
+        from = start + key.len();
+        let before_ok = tag[..start].ends_with(|c: char| c.is_whitespace());
+        let rest = tag[from..].trim_start();
+        if !before_ok || !rest.starts_with('=') {
+            continue;
+        }
+        let v = rest[1..].trim_start();
+        let q = v.chars().next()?;
+        if q != '"' && q != '\'' {
+            return None;
+        }
+        let v = &v[1..];
+        return Some(&v[..v.find(q)?]);
+    }
+    None
+}
+
 /// The text without comments and without `<transmission>`/`<gazebo>` blocks, whose
 /// `<joint name=…>` elements are references, not joints.
 fn strip_blocks(text: &str) -> String {
@@ -436,6 +557,7 @@ fn geometry(
     dir: Option<&Path>,
     el: &str,
     opts: &LoadOptions,
+    files: &dyn Files,
 ) -> Result<Geometry, ModelError> {
     let bad = |what: &str| ModelError::Invalid {
         file: file.into(),
@@ -488,16 +610,27 @@ fn geometry(
                 message,
             };
             let candidates = mesh_candidates(filename, dir, &opts.package_paths);
-            let Some(path) = candidates.iter().find(|p| p.is_file()) else {
+            let mut found = None;
+            for p in &candidates {
+                match files.read(p) {
+                    Ok(bytes) => {
+                        found = Some((p, bytes));
+                        break;
+                    }
+                    Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+                    // A folder of that name, say: not this candidate.
+                    Err(e) if e.kind() == std::io::ErrorKind::IsADirectory => {}
+                    Err(e) => return Err(mesh_err(format!("cannot read {}: {e}", p.display()))),
+                }
+            }
+            let Some((path, bytes)) = found else {
                 let looked: Vec<String> =
                     candidates.iter().map(|p| p.display().to_string()).collect();
                 return Err(mesh_err(format!(
-                    "not found (looked for {}); put the mesh there or add its package's parent folder to the search path",
+                    "not found (looked for {}); put the mesh there or add its package's parent folder to the search path (the workcell's `package_path`, or ROS_PACKAGE_PATH)",
                     looked.join(", ")
                 )));
             };
-            let bytes = std::fs::read(path)
-                .map_err(|e| mesh_err(format!("cannot read {}: {e}", path.display())))?;
             let points = mesh::read_vertices(&bytes, filename, scale)
                 .map_err(|m| mesh_err(format!("{} ({})", m, path.display())))?;
             Geometry::Hull {

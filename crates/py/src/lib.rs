@@ -581,6 +581,8 @@ struct PyIssue {
     line: u32,
     /// Column (0 if unknown).
     col: u32,
+    /// For a near miss, how close the bodies came (m).
+    distance_m: Option<f64>,
 }
 
 #[pymethods]
@@ -598,6 +600,7 @@ fn issue(i: &Issue) -> PyIssue {
         file: i.file.clone(),
         line: i.line,
         col: i.col,
+        distance_m: i.distance_m,
     }
 }
 

@@ -106,6 +106,8 @@ pub struct Issue {
     pub line: u32,
     /// Column (0 if unknown).
     pub col: u32,
+    /// For a near miss, how close the bodies came (m), exactly; the message rounds it.
+    pub distance_m: Option<f64>,
 }
 
 /// Time spent per robot.
@@ -404,6 +406,7 @@ impl Simulation {
                 file: Some(d.at.file.clone()),
                 line: d.at.line,
                 col: d.at.col,
+                distance_m: None,
             })
             .collect();
         Simulation {
@@ -711,6 +714,7 @@ impl Simulation {
                 .map(|r| self.files[r].to_string()),
             line: pos.map_or(0, |p| p.line),
             col: pos.map_or(0, |p| p.col),
+            distance_m: None,
         }
     }
 
@@ -877,12 +881,15 @@ impl Simulation {
                         None,
                     ),
                     crate::collide::CollisionEvent::NearMiss(a, bname, dist) => {
+                        // Hundredths of a millimetre in words; the exact distance in
+                        // `Issue::distance_m` (JSON, Python).
                         let m = format!(
-                            "near miss: {a} and {bname} come within {}",
-                            fmt_quantity(dist, vworks_vm::Dim::LENGTH)
+                            "near miss: {a} and {bname} come within {:.2} mm",
+                            dist * 1e3
                         );
                         self.record(b, None, "warning", Detail::Text(format!("\"{m}\"")), None);
-                        let issue = self.issue("near_miss", m, None, None);
+                        let mut issue = self.issue("near_miss", m, None, None);
+                        issue.distance_m = Some(dist);
                         self.warnings.push(issue);
                     }
                 }

@@ -10,9 +10,10 @@ use std::sync::Arc;
 
 use parry3d::shape::SharedShape;
 use serde::Deserialize;
+pub use vworks_model::files::{Disk, Files, MemoryFiles};
 use vworks_model::math::Iso;
 use vworks_model::model::Geometry;
-use vworks_model::urdf::{LoadOptions, load_file};
+use vworks_model::urdf::{LoadOptions, load_file_with};
 use vworks_model::{RobotModel, builtin};
 use vworks_vm::{Dim, Module};
 use vworks_wslc::link::{CellSpec, Linked, RobotSpec, link};
@@ -208,6 +209,7 @@ impl Cell {
 
 struct Ctx<'a> {
     file: &'a str,
+    files: &'a dyn Files,
 }
 
 impl Ctx<'_> {
@@ -228,6 +230,26 @@ impl Ctx<'_> {
             Dim::SPEED => "\"250mm/s\" or 0.25 (m/s)",
             _ => "a number",
         };
+        let x = self.quantity_unchecked(v, dim, key, &unit_hint)?;
+        if !x.is_finite() || (dim == Dim::LENGTH && x.abs() > MAX_LENGTH) {
+            return Err(self.bad(
+                key,
+                format!(
+                    "{x:.3e} m is out of range: lengths in a workcell are within ±10 km; write {}",
+                    unit_hint()
+                ),
+            ));
+        }
+        Ok(x)
+    }
+
+    fn quantity_unchecked(
+        &self,
+        v: &toml::Value,
+        dim: Dim,
+        key: &str,
+        unit_hint: &dyn Fn() -> &'static str,
+    ) -> Result<f64, CellError> {
         match v {
             toml::Value::Integer(i) => Ok(*i as f64),
             toml::Value::Float(x) if x.is_finite() => Ok(*x),
@@ -296,6 +318,7 @@ impl Ctx<'_> {
     }
 
     fn body(&self, b: &BodyFile, key: &str, dir: &Path) -> Result<Body, CellError> {
+        let files = self.files;
         let given = [
             b.box_.is_some(),
             b.cylinder.is_some(),
@@ -346,13 +369,19 @@ impl Ctx<'_> {
         } else {
             let mesh = b.mesh.as_deref().unwrap_or_default();
             let path = dir.join(mesh);
-            let bytes = std::fs::read(&path).map_err(|e| {
+            let bytes = files.read(&path).map_err(|e| {
                 self.bad(
                     &format!("{key}.mesh"),
                     format!("cannot read `{}`: {e}{}", path.display(), read_hint(&e)),
                 )
             })?;
             let s = b.scale.unwrap_or(1.0);
+            if !(s.is_finite() && s > 0.0 && s <= MAX_LENGTH) {
+                return Err(self.bad(
+                    &format!("{key}.scale"),
+                    format!("{s} is not a usable scale; give a number greater than 0 (1 keeps the mesh's size)"),
+                ));
+            }
             let points = vworks_model::mesh::read_vertices(&bytes, mesh, [s; 3]).map_err(|e| {
                 self.bad(&format!("{key}.mesh"), format!("`{}`: {e}", path.display()))
             })?;
@@ -390,6 +419,48 @@ pub fn same_link(a: &str, b: &str) -> bool {
     a == b || norm(a) == norm(b)
 }
 
+/// Where ROS keeps packages, searched for `package://` meshes after the workcell's
+/// `package_path`: each folder of `ROS_PACKAGE_PATH` (ROS 1), and `PREFIX/share` for each
+/// prefix of `AMENT_PREFIX_PATH` (ROS 2), in order.
+fn ros_package_paths() -> Vec<PathBuf> {
+    let split = |var: &str| -> Vec<PathBuf> {
+        std::env::var_os(var)
+            .map(|v| {
+                std::env::split_paths(&v)
+                    .filter(|p| !p.as_os_str().is_empty())
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    let mut paths = split("ROS_PACKAGE_PATH");
+    paths.extend(
+        split("AMENT_PREFIX_PATH")
+            .into_iter()
+            .map(|p| p.join("share")),
+    );
+    paths
+}
+
+/// serde's "unknown field `cylce`, expected one of `name`, `cycle`, …" with the nearest
+/// valid key named: "…; did you mean `cycle`?".
+fn with_suggestion(msg: &str) -> String {
+    let Some(rest) = msg.strip_prefix("unknown field `") else {
+        return msg.to_string();
+    };
+    let Some((field, expected)) = rest.split_once('`') else {
+        return msg.to_string();
+    };
+    let valid = expected.split('`').skip(1).step_by(2);
+    match vworks_wslc::nearest(field, valid) {
+        Some(near) => format!("{msg}; did you mean `{near}`?"),
+        None => msg.to_string(),
+    }
+}
+
+/// The largest length a workcell may give (10 km): a size or a position beyond it is a
+/// typo (a unit missing), and would break the collision geometry's arithmetic.
+const MAX_LENGTH: f64 = 1e4;
+
 /// What to do about a file that cannot be read.
 fn read_hint(e: &std::io::Error) -> &'static str {
     match e.kind() {
@@ -403,8 +474,14 @@ fn read_hint(e: &std::io::Error) -> &'static str {
 
 /// Loads a workcell file: models, programs (compiled and linked), shapes.
 pub fn load(path: &Path) -> Result<Cell, CellError> {
+    load_with(path, &Disk)
+}
+
+/// Loads a workcell, reading it and every file it names (programs, URDFs, meshes) from
+/// `files`: the disk, or memory ([`MemoryFiles`]).
+pub fn load_with(path: &Path, fs: &dyn Files) -> Result<Cell, CellError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| CellError::Read {
+    let bytes = fs.read(path).map_err(|e| CellError::Read {
         file: file.clone(),
         reason: match e.kind() {
             std::io::ErrorKind::NotFound => format!(
@@ -413,9 +490,16 @@ pub fn load(path: &Path) -> Result<Cell, CellError> {
             _ => format!("{e}{}", read_hint(&e)),
         },
     })?;
-    let cx = Ctx { file: &file };
+    let text = vworks_wslc::source_text(bytes).map_err(|e| CellError::Read {
+        file: file.clone(),
+        reason: e.to_string(),
+    })?;
+    let cx = Ctx {
+        file: &file,
+        files: fs,
+    };
     let cf: CellFile = toml::from_str(&text).map_err(|e| {
-        let msg = e.message().to_string();
+        let msg = with_suggestion(e.message());
         let place = e.span().map(|s| {
             let before = &text[..s.start.min(text.len())];
             let line = before.matches('\n').count() + 1;
@@ -492,14 +576,19 @@ pub fn load(path: &Path) -> Result<Cell, CellError> {
             }
             (None, Some(u)) => {
                 let upath = dir.join(u);
-                if let Ok(bytes) = std::fs::read(&upath) {
+                if let Ok(bytes) = fs.read(&upath) {
                     files.push((upath.display().to_string(), bytes));
                 }
                 let opts = LoadOptions {
                     tool_link: r.tool_link.clone(),
-                    package_paths: r.package_path.iter().map(|p| dir.join(p)).collect(),
+                    package_paths: r
+                        .package_path
+                        .iter()
+                        .map(|p| dir.join(p))
+                        .chain(ros_package_paths())
+                        .collect(),
                 };
-                load_file(&dir.join(u), &opts).map_err(|e| CellError::Model {
+                load_file_with(&dir.join(u), &opts, fs).map_err(|e| CellError::Model {
                     file: file.clone(),
                     robot: r.name.clone(),
                     source: Box::new(e),
@@ -522,12 +611,14 @@ pub fn load(path: &Path) -> Result<Cell, CellError> {
         let module = match modules.iter().find(|(p, _)| *p == pname) {
             Some((_, m)) => Arc::clone(m),
             None => {
-                let src = std::fs::read_to_string(&ppath).map_err(|e| {
+                let bytes = fs.read(&ppath).map_err(|e| {
                     cx.bad(
                         &format!("{key}.program"),
                         format!("cannot read `{pname}`: {e}{}", read_hint(&e)),
                     )
                 })?;
+                let src = vworks_wslc::source_text(bytes)
+                    .map_err(|e| cx.bad(&format!("{key}.program"), format!("{pname}: {e}")))?;
                 render_sources.add(&pname, &src);
                 sources.push((pname.clone(), src.clone()));
                 match vworks_wslc::compile(&pname, &src) {
@@ -564,7 +655,27 @@ pub fn load(path: &Path) -> Result<Cell, CellError> {
                     } else {
                         Dim::ANGLE
                     };
-                    h.push(cx.quantity(x, dim, &format!("{key}.home[{k}]"))?);
+                    let v = cx.quantity(x, dim, &format!("{key}.home[{k}]"))?;
+                    let j = model.axis(k);
+                    if v < j.lower - 1e-9 || v > j.upper + 1e-9 {
+                        let (scale, unit) = if dim == Dim::LENGTH {
+                            (1e3, "mm")
+                        } else {
+                            (180.0 / std::f64::consts::PI, "deg")
+                        };
+                        return Err(cx.bad(
+                            &format!("{key}.home[{k}]"),
+                            format!(
+                                "{:.1}{unit} is outside axis {} `{}`'s range {:.1}{unit} to {:.1}{unit}; choose a home within the limits",
+                                v * scale,
+                                k + 1,
+                                j.name,
+                                j.lower * scale,
+                                j.upper * scale
+                            ),
+                        ));
+                    }
+                    h.push(v);
                 }
                 h
             }
@@ -573,6 +684,12 @@ pub fn load(path: &Path) -> Result<Cell, CellError> {
             Some(v) => cx.quantity(v, Dim::SPEED, &format!("{key}.default_speed"))?,
             None => 0.25,
         };
+        if default_speed <= 0.0 {
+            return Err(cx.bad(
+                &format!("{key}.default_speed"),
+                "must be greater than zero: it is the speed of every move_l and move_c without `speed`; write e.g. \"250mm/s\"",
+            ));
+        }
         let entry_name = r.entry.clone().unwrap_or_else(|| "main".into());
         let entry = if serve_only {
             None
@@ -672,7 +789,7 @@ pub fn load(path: &Path) -> Result<Cell, CellError> {
     for g in hulls {
         if let Geometry::Hull { source, .. } = g
             && !files.iter().any(|(f, _)| f == source)
-            && let Ok(bytes) = std::fs::read(source)
+            && let Ok(bytes) = fs.read(Path::new(source))
         {
             files.push((source.clone(), bytes));
         }

@@ -71,6 +71,7 @@ codes! {
     E0060 = "`remote` outside `parallel`",
     E0061 = "more than one local branch in `parallel`",
     E0062 = "statement not allowed directly in `parallel`",
+    E0063 = "`return`, `break` or `continue` leaves a `parallel` block",
     E0070 = "not allowed in a function",
     E0080 = "initializer is not constant",
     E0081 = "global of a non-scalar type",

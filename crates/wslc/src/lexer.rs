@@ -231,7 +231,8 @@ pub fn lex(src: &str, diags: &mut Vec<Diagnostic>) -> Vec<Token> {
     let mut lx = Lexer {
         src,
         b: src.as_bytes(),
-        i: 0,
+        // A UTF-8 byte-order mark (as some Windows editors write) is not code.
+        i: if src.starts_with('\u{feff}') { 3 } else { 0 },
         toks: Vec::with_capacity(src.len() / 3 + 1),
         diags,
     };

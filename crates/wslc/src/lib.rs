@@ -55,6 +55,53 @@ fn summary(d: &[Diagnostic]) -> String {
     errors.join("\n")
 }
 
+/// The candidate nearest to `name` by edit distance, if one is near enough to be a
+/// likely misspelling (at most a third of its length away): for "did you mean" hints in
+/// programs and in workcell files alike.
+pub fn nearest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+    candidates
+        .into_iter()
+        .map(|c| (lower::edit_distance(name, c), c))
+        .filter(|(d, c)| *d > 0 && *d <= c.chars().count().div_ceil(3))
+        .min_by_key(|(d, c)| (*d, *c))
+        .map(|(_, c)| c)
+}
+
+/// A program file's bytes that are not UTF-8 text: where the first bad byte is.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("line {line}, column {col}: byte 0x{byte:02X} is not UTF-8 text; save the file as UTF-8")]
+pub struct NotUtf8 {
+    /// 1-based line of the byte.
+    pub line: u32,
+    /// 1-based column (in characters) of the byte.
+    pub col: u32,
+    /// The byte.
+    pub byte: u8,
+}
+
+/// A program file's text from its bytes: UTF-8, without a leading byte-order mark.
+pub fn source_text(bytes: Vec<u8>) -> Result<String, NotUtf8> {
+    let text = match String::from_utf8(bytes) {
+        Ok(t) => t,
+        Err(e) => {
+            let bytes = e.as_bytes();
+            let at = e.utf8_error().valid_up_to();
+            // The part before the bad byte is valid: count its lines and characters.
+            let before = std::str::from_utf8(&bytes[..at]).unwrap_or_default();
+            let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+            return Err(NotUtf8 {
+                line: before.matches('\n').count() as u32 + 1,
+                col: before[line_start..].chars().count() as u32 + 1,
+                byte: bytes[at],
+            });
+        }
+    };
+    Ok(match text.strip_prefix('\u{feff}') {
+        Some(rest) => rest.to_string(),
+        None => text,
+    })
+}
+
 /// Compiles one module. `path` names the file in diagnostics and in the module.
 pub fn compile(path: &str, source: &str) -> Result<Compiled, CompileError> {
     let mut diags = Vec::new();

@@ -180,7 +180,10 @@ struct FnCtx {
     loops: Vec<Loop>,
     /// Captured locals of the enclosing procedure: name, its slot there, width, type.
     captures: Vec<(String, u32, u8, Ty)>,
-    in_parallel: bool,
+    /// Inside a `parallel` block's local branch: `Some(loops)`, the loops open around
+    /// the block (a `break` or `continue` to one of them, or a `return`, would leave the
+    /// block before its join: E0063).
+    in_parallel: Option<usize>,
 }
 
 impl FnCtx {
@@ -195,7 +198,7 @@ impl FnCtx {
             next_slot: 0,
             loops: Vec::new(),
             captures: Vec::new(),
-            in_parallel: false,
+            in_parallel: None,
         }
     }
 }
@@ -285,7 +288,7 @@ const BUILTINS: &[&str] = &[
 const TYPE_NAMES: &str =
     "bool, int, num, length, angle, time, speed, angspeed, accel, angaccel, joints, pose";
 
-fn edit_distance(a: &str, b: &str) -> usize {
+pub(crate) fn edit_distance(a: &str, b: &str) -> usize {
     let b: Vec<char> = b.chars().collect();
     let mut prev: Vec<usize> = (0..=b.len()).collect();
     for (i, ca) in a.chars().enumerate() {
@@ -853,7 +856,7 @@ impl Compiler<'_> {
                     self.emit(Instr::Pop(w), sp);
                 }
             }
-            StmtKind::If { cond, then, els } => return self.if_stmt(cond, then, els.as_deref()),
+            StmtKind::If { branches, els } => return self.if_stmt(branches, els.as_ref()),
             StmtKind::While { cond, body } => {
                 let top = self.here();
                 let c = self.expr(cond);
@@ -888,6 +891,14 @@ impl Compiler<'_> {
                     );
                     return false;
                 }
+                if self
+                    .f()
+                    .in_parallel
+                    .is_some_and(|open| self.f().loops.len() <= open)
+                {
+                    let w = if is_break { "break" } else { "continue" };
+                    self.leaves_parallel(&format!("`{w}`"), sp);
+                }
                 let j = self.emit(Instr::Jump(0), sp);
                 if let Some(l) = self.f().loops.last_mut() {
                     if is_break {
@@ -898,7 +909,12 @@ impl Compiler<'_> {
                 }
                 return true;
             }
-            StmtKind::Return(value) => return self.return_stmt(value.as_ref(), sp),
+            StmtKind::Return(value) => {
+                if self.f().in_parallel.is_some() {
+                    self.leaves_parallel("`return`", sp);
+                }
+                return self.return_stmt(value.as_ref(), sp);
+            }
             StmtKind::Move {
                 kind,
                 via,
@@ -1389,33 +1405,32 @@ impl Compiler<'_> {
         );
     }
 
-    fn if_stmt(&mut self, cond: &Expr, then: &Block, els: Option<&Stmt>) -> bool {
-        let c = self.expr(cond);
-        self.expect_bool(&c, cond.span, "an `if` condition");
-        let jf = self.emit(Instr::JumpIfFalse(0), cond.span);
-        let then_div = self.block(then);
-        match els {
-            None => {
-                let end = self.here();
-                self.patch(jf, end);
-                false
+    /// An `if` chain; true if every path through it diverges.
+    fn if_stmt(&mut self, branches: &[(Expr, Block)], els: Option<&Block>) -> bool {
+        let mut to_end = Vec::new();
+        let mut all_div = true;
+        for (k, (cond, then)) in branches.iter().enumerate() {
+            let c = self.expr(cond);
+            self.expect_bool(&c, cond.span, "an `if` condition");
+            let jf = self.emit(Instr::JumpIfFalse(0), cond.span);
+            let then_div = self.block(then);
+            all_div &= then_div;
+            let last = k + 1 == branches.len() && els.is_none();
+            if !then_div && !last {
+                to_end.push(self.emit(Instr::Jump(0), then.span));
             }
-            Some(e) => {
-                let jend = if then_div {
-                    None
-                } else {
-                    Some(self.emit(Instr::Jump(0), then.span))
-                };
-                let else_start = self.here();
-                self.patch(jf, else_start);
-                let else_div = self.stmt(e);
-                let end = self.here();
-                if let Some(j) = jend {
-                    self.patch(j, end);
-                }
-                then_div && else_div
-            }
+            let next = self.here();
+            self.patch(jf, next);
         }
+        match els {
+            Some(b) => all_div &= self.block(b),
+            None => all_div = false,
+        }
+        let end = self.here();
+        for j in to_end {
+            self.patch(j, end);
+        }
+        all_div
     }
 
     fn for_stmt(&mut self, var: &Ident, start: &Expr, end: &Expr, body: &Block, sp: Span) {
@@ -1608,6 +1623,18 @@ impl Compiler<'_> {
         out
     }
 
+    /// E0063: `what` would leave a `parallel` block's local branch before its join.
+    fn leaves_parallel(&mut self, what: &str, sp: Span) {
+        self.err(
+            Diagnostic::error(
+                Code::E0063,
+                format!("{what} cannot leave a `parallel` block: its remote work would never be joined"),
+                sp,
+            )
+            .with_help("end the local branch normally, and decide after the block (set a variable here, test it after `}`)"),
+        );
+    }
+
     fn parallel(&mut self, branches: &[Stmt], sp: Span) {
         self.takes_time("run `parallel` work", sp);
         let mut local: Option<&Block> = None;
@@ -1669,7 +1696,8 @@ impl Compiler<'_> {
             self.emit(Instr::Remote(i), bsp);
         }
         if let Some(b) = local {
-            let was = std::mem::replace(&mut self.f().in_parallel, true);
+            let open = self.f().loops.len();
+            let was = self.f().in_parallel.replace(open);
             self.block(b);
             self.f().in_parallel = was;
         }

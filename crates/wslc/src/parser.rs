@@ -187,17 +187,19 @@ impl Parser<'_, '_> {
         Err(self.unexpected(what))
     }
 
+    /// One level deeper; an error (and no level) past [`MAX_DEPTH`].
     fn enter(&mut self) -> PResult<()> {
-        self.depth += 1;
-        if self.depth > MAX_DEPTH {
+        if self.depth >= MAX_DEPTH {
             let d = Diagnostic::error(
                 Code::E0006,
                 format!("nested more than {MAX_DEPTH} levels deep"),
                 self.span(),
             )
-            .with_help("split the expression or the blocks into procedures or variables");
+            .with_note("each operator of a chain like `a + b + c` counts as one level")
+            .with_help("split the expression or the blocks into procedures or variables: `var part = a + b; …`");
             return Err(self.report(d));
         }
+        self.depth += 1;
         Ok(())
     }
 
@@ -597,33 +599,25 @@ impl Parser<'_, '_> {
         }
     }
 
+    /// `if`, every `else if` of its chain (a loop: a chain is not nesting), `else`.
     fn if_stmt(&mut self) -> PResult<StmtKind> {
         self.bump();
+        let mut branches = Vec::new();
         let cond = self.expr()?;
         let then = self.block()?;
-        let els = if self.eat_kw(Kw::Else) {
-            let start = self.span();
-            if self.at_kw(Kw::If) {
-                self.enter()?;
-                let k = self.if_stmt();
-                self.leave();
-                let k = k?;
-                Some(Box::new(Stmt {
-                    kind: k,
-                    span: start.to(self.prev_span()),
-                }))
+        branches.push((cond, then));
+        let mut els = None;
+        while self.eat_kw(Kw::Else) {
+            if self.eat_kw(Kw::If) {
+                let cond = self.expr()?;
+                let then = self.block()?;
+                branches.push((cond, then));
             } else {
-                let b = self.block()?;
-                let span = b.span;
-                Some(Box::new(Stmt {
-                    kind: StmtKind::Block(b),
-                    span,
-                }))
+                els = Some(self.block()?);
+                break;
             }
-        } else {
-            None
-        };
-        Ok(StmtKind::If { cond, then, els })
+        }
+        Ok(StmtKind::If { branches, els })
     }
 
     fn move_stmt(&mut self, kw: Kw) -> PResult<StmtKind> {
@@ -786,21 +780,31 @@ impl Parser<'_, '_> {
         ops: &[(TokKind, BinOp)],
     ) -> PResult<Expr> {
         let mut l = next(self)?;
-        loop {
+        // `a + b + c …` is a left-deep tree, one level per operator: the chain counts
+        // towards the nesting limit, so that what the compiler walks recursively later
+        // (and drops) stays shallow.
+        let mut chain = 0;
+        let out = loop {
             let Some(op) = ops.iter().find(|(t, _)| t == self.kind()).map(|(_, o)| *o) else {
-                return Ok(l);
+                break Ok(l);
             };
             self.bump();
-            self.enter()?;
-            let r = next(self);
-            self.leave();
-            let r = r?;
+            if let Err(e) = self.enter() {
+                break Err(e);
+            }
+            chain += 1;
+            let r = match next(self) {
+                Ok(r) => r,
+                Err(e) => break Err(e),
+            };
             let span = l.span.to(r.span);
             l = Expr {
                 kind: ExprKind::Binary(op, Box::new(l), Box::new(r)),
                 span,
             };
-        }
+        };
+        self.depth -= chain;
+        out
     }
 
     fn or_expr(&mut self) -> PResult<Expr> {

@@ -179,13 +179,13 @@ pub enum StmtKind {
         args: Vec<Expr>,
     },
     /// `if c { } else …`
+    /// `if c { } else if d { } … else { }`: the chain is flat (a dispatch on a program
+    /// number may have hundreds of branches; it is not nesting).
     If {
-        /// Condition.
-        cond: Expr,
-        /// Then-branch.
-        then: Block,
-        /// `else if` (an `If` statement) or `else { }` (a `Block` statement).
-        els: Option<Box<Stmt>>,
+        /// Each condition and its block, in order: the `if`, then every `else if`.
+        branches: Vec<(Expr, Block)>,
+        /// The final `else { }`.
+        els: Option<Block>,
     },
     /// `while c { }`
     While {
