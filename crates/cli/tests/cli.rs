@@ -356,3 +356,61 @@ fn a_log_that_cannot_be_written_fails_the_run_and_says_why() {
         text(&out.stderr)
     );
 }
+
+/// A byte that is not UTF-8 gave an error with no line: now the file, line and column.
+#[test]
+fn a_program_that_is_not_utf8_is_an_error_at_its_line() {
+    let d = temp_dir("not-utf8");
+    let p = d.join("latin1.wsl");
+    // "café" in Latin-1 on line 2, column 11.
+    std::fs::write(&p, b"proc main() {\n    log \"caf\xe9\";\n}\n").unwrap();
+    let out = vworks(&["check", p.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = text(&out.stderr);
+    assert!(
+        err.contains("latin1.wsl: line 2, column 13: byte 0xE9 is not UTF-8 text; save the file as UTF-8"),
+        "{err}"
+    );
+    // The same through a workcell.
+    std::fs::write(d.join("cell.toml"), "[[robot]]\nname = \"r1\"\nmodel = \"turntable\"\nprogram = \"latin1.wsl\"\n").unwrap();
+    let out = vworks(&["run", d.join("cell.toml").to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = text(&out.stderr);
+    assert!(err.contains("line 2, column 13: byte 0xE9"), "{err}");
+}
+
+/// `package://` meshes are found through ROS_PACKAGE_PATH (after the workcell's
+/// `package_path`), as a ROS-Industrial user expects.
+#[test]
+fn package_meshes_are_found_through_ros_package_path() {
+    let d = temp_dir("ros-package-path");
+    let share = d.join("ros/share");
+    std::fs::create_dir_all(share.join("my_robot/meshes")).unwrap();
+    let stl = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 0.1 0 0\nvertex 0 0.1 0\nendloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 0 0.1 0\nvertex 0 0 0.1\nendloop\nendfacet\nendsolid t\n";
+    std::fs::write(share.join("my_robot/meshes/base.stl"), stl).unwrap();
+    let cell = d.join("cell");
+    std::fs::create_dir_all(&cell).unwrap();
+    std::fs::write(
+        cell.join("arm.urdf"),
+        r#"<?xml version="1.0"?><robot name="arm"><link name="base"><collision><geometry><mesh filename="package://my_robot/meshes/base.stl"/></geometry></collision></link><link name="l1"/><joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" velocity="1" effort="0"/></joint></robot>"#,
+    )
+    .unwrap();
+    std::fs::write(cell.join("cell.toml"), "[[robot]]\nname = \"r1\"\nurdf = \"arm.urdf\"\nprogram = \"r1.wsl\"\n").unwrap();
+    std::fs::write(cell.join("r1.wsl"), "proc main() {}\n").unwrap();
+    let run = |ros: Option<&std::path::Path>| {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_vworks"));
+        c.args(["run", cell.join("cell.toml").to_str().unwrap()])
+            .env("NO_COLOR", "1")
+            .env_remove("ROS_PACKAGE_PATH")
+            .env_remove("AMENT_PREFIX_PATH");
+        if let Some(p) = ros {
+            c.env("ROS_PACKAGE_PATH", p);
+        }
+        c.output().unwrap()
+    };
+    let without = run(None);
+    assert_eq!(without.status.code(), Some(1), "{}", text(&without.stdout));
+    assert!(text(&without.stderr).contains("ROS_PACKAGE_PATH"));
+    let with = run(Some(&share));
+    assert_eq!(with.status.code(), Some(0), "{}", text(&with.stderr));
+}

@@ -409,13 +409,8 @@ fn check_joint_types(text: &str, file: &str) -> Result<(), ModelError> {
             continue;
         }
         let tag = &after[..after.find('>').unwrap_or(after.len())];
-        let attr = |key: &str| -> Option<&str> {
-            let k = tag.find(&format!("{key}="))?;
-            let v = &tag[k + key.len() + 1..];
-            let q = v.chars().next()?;
-            let v = &v[1..];
-            Some(&v[..v.find(q)?])
-        };
+        // (A quote that is not ASCII once sliced inside a character: found by fuzzing.)
+        let attr = |key: &str| attribute(tag, key);
         let name = attr("name").unwrap_or("?");
         match attr("type") {
             Some("revolute" | "continuous" | "prismatic" | "fixed") => {}

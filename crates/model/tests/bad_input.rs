@@ -271,3 +271,83 @@ fn branching_tree_loads_with_a_named_tool() {
     assert_eq!(m.axis(0).name, "ac");
     assert_eq!(m.linear_axes(), 1);
 }
+
+/// Found by the `urdf` fuzz target: a joint type opened by a non-ASCII "quote" was sliced
+/// inside a character (a panic). Now the joint has no type.
+#[test]
+fn a_type_after_a_non_ascii_character_is_an_error_not_a_panic() {
+    let text = robot(&format!(
+        "{}{}<joint name=\"j\" type=\u{68d}evolute\"><parent link=\"a\"/><child link=\"b\"/></joint>",
+        link("a"),
+        link("b")
+    ));
+    expect_error(
+        "non-ascii quote",
+        load("quote.urdf", &text),
+        "quote.urdf",
+        &["joint `j`"],
+    );
+}
+
+/// A branching tree with a link named `tool0` (the ROS-Industrial convention) needs no
+/// `tool_link`; without one it is still an error that says what to do.
+#[test]
+fn tool0_is_the_tool_when_the_tree_branches() {
+    let body = [
+        link("base"),
+        link("l1"),
+        link("tool0"),
+        link("finger"),
+        joint("j1", "revolute", "base", "l1", ""),
+        joint("j2", "revolute", "l1", "tool0", ""),
+        joint("jf", "revolute", "l1", "finger", ""),
+    ]
+    .concat();
+    let m = load("tool0.urdf", &robot(&body)).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(m.links[m.tool_link].name, "tool0");
+    assert_eq!(m.dof(), 2);
+    let body = body.replace("tool0", "flange");
+    expect_error(
+        "branching without tool0",
+        load("notool0.urdf", &robot(&body)),
+        "notool0.urdf",
+        &["the tree branches", "tool_link", "tool0"],
+    );
+}
+
+/// `acceleration`, `deceleration` and `jerk` are read from a URDF 1.0 file (urdf-rs reads
+/// them only from 1.2); a deceleration below the acceleration limits both (symmetric
+/// profiles); a value that is not a positive number is an error naming the joint.
+#[test]
+fn dynamic_limits_are_read_whatever_the_version() {
+    let limits = |attrs: &str| {
+        robot(&[
+            link("a"),
+            link("b"),
+            format!(
+                r#"<joint name="j" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" velocity="2" effort="0" {attrs}/></joint>"#
+            ),
+        ]
+        .concat())
+    };
+    let m = load("acc.urdf", &limits(r#"acceleration="3.5" jerk="40""#)).unwrap();
+    assert_eq!(m.axis(0).max_accel, 3.5);
+    assert_eq!(m.axis(0).max_jerk, Some(40.0));
+    let m = load("dec.urdf", &limits(r#"acceleration="3.5" deceleration="1.25""#)).unwrap();
+    assert_eq!(m.axis(0).max_accel, 1.25);
+    let m = load("none.urdf", &limits("")).unwrap();
+    assert!((m.axis(0).max_accel - 2.0 / 0.3).abs() < 1e-12);
+    assert_eq!(m.axis(0).max_jerk, None);
+    expect_error(
+        "zero acceleration",
+        load("zero.urdf", &limits(r#"acceleration="0""#)),
+        "zero.urdf",
+        &["joint `j`", "acceleration limit is 0"],
+    );
+    expect_error(
+        "not a number",
+        load("nan.urdf", &limits(r#"deceleration="fast""#)),
+        "nan.urdf",
+        &["joint `j`", "deceleration limit is NaN"],
+    );
+}
