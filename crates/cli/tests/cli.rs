@@ -368,11 +368,17 @@ fn a_program_that_is_not_utf8_is_an_error_at_its_line() {
     assert_eq!(out.status.code(), Some(1));
     let err = text(&out.stderr);
     assert!(
-        err.contains("latin1.wsl: line 2, column 13: byte 0xE9 is not UTF-8 text; save the file as UTF-8"),
+        err.contains(
+            "latin1.wsl: line 2, column 13: byte 0xE9 is not UTF-8 text; save the file as UTF-8"
+        ),
         "{err}"
     );
     // The same through a workcell.
-    std::fs::write(d.join("cell.toml"), "[[robot]]\nname = \"r1\"\nmodel = \"turntable\"\nprogram = \"latin1.wsl\"\n").unwrap();
+    std::fs::write(
+        d.join("cell.toml"),
+        "[[robot]]\nname = \"r1\"\nmodel = \"turntable\"\nprogram = \"latin1.wsl\"\n",
+    )
+    .unwrap();
     let out = vworks(&["run", d.join("cell.toml").to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(1));
     let err = text(&out.stderr);
@@ -395,7 +401,11 @@ fn package_meshes_are_found_through_ros_package_path() {
         r#"<?xml version="1.0"?><robot name="arm"><link name="base"><collision><geometry><mesh filename="package://my_robot/meshes/base.stl"/></geometry></collision></link><link name="l1"/><joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" velocity="1" effort="0"/></joint></robot>"#,
     )
     .unwrap();
-    std::fs::write(cell.join("cell.toml"), "[[robot]]\nname = \"r1\"\nurdf = \"arm.urdf\"\nprogram = \"r1.wsl\"\n").unwrap();
+    std::fs::write(
+        cell.join("cell.toml"),
+        "[[robot]]\nname = \"r1\"\nurdf = \"arm.urdf\"\nprogram = \"r1.wsl\"\n",
+    )
+    .unwrap();
     std::fs::write(cell.join("r1.wsl"), "proc main() {}\n").unwrap();
     let run = |ros: Option<&std::path::Path>| {
         let mut c = Command::new(env!("CARGO_BIN_EXE_vworks"));

@@ -84,6 +84,21 @@ pub enum IkError {
     },
 }
 
+impl IkError {
+    /// The same error reporting the position `p` (m) instead of the flange's: IK solves
+    /// for the flange, but the user wrote the TCP, which a tool offset moves.
+    pub fn at_position(mut self, p: [f64; 3]) -> IkError {
+        match &mut self {
+            IkError::OutOfReach { x, y, z, .. }
+            | IkError::JointLimits { x, y, z, .. }
+            | IkError::NoConvergence { x, y, z, .. } => {
+                (*x, *y, *z) = (p[0], p[1], p[2]);
+            }
+        }
+        self
+    }
+}
+
 /// The geometry of a spherical-wrist arm, read from its model.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SphericalWrist {

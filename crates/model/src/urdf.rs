@@ -383,6 +383,22 @@ pub fn load_str_with(
     for (i, j) in axes.iter().enumerate() {
         joints[*j].axis_index = Some(i);
     }
+    // A <mimic> joint on the way to the tool would silently become an axis of its own
+    // (vworks does not couple joints); off that path it stays at 0 like any other joint.
+    for &j in &axes {
+        let name = &joints[j].name;
+        if robot
+            .joints
+            .iter()
+            .any(|rj| rj.name == *name && rj.mimic.is_some())
+        {
+            return Err(invalid(
+                format!("joint `{name}`"),
+                "mimics another joint, and is on the chain to the tool: vworks would move it as an axis of its own".into(),
+                "give it its own axis (remove <mimic>), or choose a tool link whose chain does not pass through it",
+            ));
+        }
+    }
     let mut model = RobotModel {
         name: robot.name.clone(),
         source: file.to_string(),

@@ -333,7 +333,11 @@ fn dynamic_limits_are_read_whatever_the_version() {
     let m = load("acc.urdf", &limits(r#"acceleration="3.5" jerk="40""#)).unwrap();
     assert_eq!(m.axis(0).max_accel, 3.5);
     assert_eq!(m.axis(0).max_jerk, Some(40.0));
-    let m = load("dec.urdf", &limits(r#"acceleration="3.5" deceleration="1.25""#)).unwrap();
+    let m = load(
+        "dec.urdf",
+        &limits(r#"acceleration="3.5" deceleration="1.25""#),
+    )
+    .unwrap();
     assert_eq!(m.axis(0).max_accel, 1.25);
     let m = load("none.urdf", &limits("")).unwrap();
     assert!((m.axis(0).max_accel - 2.0 / 0.3).abs() < 1e-12);
@@ -350,4 +354,36 @@ fn dynamic_limits_are_read_whatever_the_version() {
         "nan.urdf",
         &["joint `j`", "deceleration limit is NaN"],
     );
+}
+
+/// A `<mimic>` joint on the chain to the tool would silently have become an independent
+/// axis: an error naming it. Off the chain (a gripper finger) it is accepted.
+#[test]
+fn a_mimic_joint_on_the_tool_chain_is_an_error() {
+    let mimic = r#"<mimic joint="j1" multiplier="1"/>"#;
+    let body = [
+        link("base"),
+        link("l1"),
+        link("l2"),
+        joint("j1", "revolute", "base", "l1", ""),
+        joint("j2", "revolute", "l1", "l2", mimic),
+    ]
+    .concat();
+    expect_error(
+        "mimic on the chain",
+        load("mimic.urdf", &robot(&body)),
+        "mimic.urdf",
+        &["joint `j2`", "mimics another joint"],
+    );
+    let body = [
+        link("base"),
+        link("l1"),
+        link("tool0"),
+        link("finger"),
+        joint("j1", "revolute", "base", "l1", ""),
+        joint("j2", "revolute", "l1", "tool0", ""),
+        joint("jf", "revolute", "l1", "finger", mimic),
+    ]
+    .concat();
+    load("finger.urdf", &robot(&body)).unwrap_or_else(|e| panic!("{e}"));
 }

@@ -1165,7 +1165,8 @@ impl Vm {
         let flange = tcp.mul(&self.cfg.tool.inverse());
         self.model
             .ik(&flange, &near[..n], &mut q[..n])
-            .map_err(|e: IkError| format!("unreachable pose: {e}"))?;
+            // In the TCP's terms, as the program wrote the target.
+            .map_err(|e: IkError| format!("unreachable pose: {}", e.at_position(tcp.t)))?;
         Ok(q)
     }
 
