@@ -362,6 +362,19 @@ def test_warnings_are_issues():
     assert w.kind == "near_miss" and "left.link_6 and right.link_6" in w.message
     assert (w.robot, w.file, w.line, w.col) == (None, None, 0, 0)
     assert "near_miss" in repr(w)
+    # The message rounds to hundredths of a millimetre; the distance is exact.
+    assert "come within 2.45 mm" in w.message
+    assert w.distance_m is not None and abs(w.distance_m - 0.002452613618) < 1e-11
+
+
+def test_compile_and_link_warnings_are_in_the_result(tmp_path):
+    (tmp_path / "r1.wsl").write_text("global g = 0;\nproc main() {\n    var g = 1;\n    log g;\n}\n")
+    (tmp_path / "cell.toml").write_text('[[robot]]\nname = "r1"\nmodel = "turntable"\nprogram = "r1.wsl"\n')
+    r = vworks.load_cell(tmp_path / "cell.toml").run()
+    (w,) = r.warnings
+    assert (w.kind, w.line, w.col) == ("W0001", 3, 9)
+    assert w.file is not None and w.file.endswith("r1.wsl")
+    assert w.distance_m is None
 
 
 def test_to_pandas_without_pandas_says_what_to_install(monkeypatch):

@@ -494,6 +494,15 @@ impl Simulation {
         self
     }
 
+    /// How many events each robot may perform at one simulated instant (default
+    /// [`VmConfig::instant_events`], 100,000): lower for a fuzzer or a quick check.
+    pub fn with_robot_instant_limit(mut self, limit: u64) -> Simulation {
+        for vm in &mut self.vms {
+            vm.set_instant_events(limit.max(1));
+        }
+        self
+    }
+
     /// Stops the run (outcome `interrupted`, log finished) when `flag` becomes true.
     pub fn with_stop(mut self, flag: Arc<AtomicBool>) -> Simulation {
         self.stop = Some(flag);

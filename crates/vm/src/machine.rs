@@ -609,6 +609,12 @@ impl Vm {
         out.append(self.reads.get_mut());
     }
 
+    /// Sets how many events the robot may perform at one instant
+    /// ([`VmConfig::instant_events`]).
+    pub fn set_instant_events(&mut self, limit: u64) {
+        self.cfg.instant_events = limit;
+    }
+
     /// Stops the VM for good: the SE found a runtime error in the event it just performed
     /// (a part gripped twice). Its next event is [`Next::Done`].
     pub fn halt(&mut self) {
