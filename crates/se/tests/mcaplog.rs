@@ -4,7 +4,7 @@
 #![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)] // tests fail by panicking
 
 use std::collections::BTreeMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use foxglove::messages::FrameTransforms;
@@ -109,10 +109,7 @@ fn read_back(bytes: &[u8]) -> (BTreeMap<String, u64>, Vec<String>) {
             let pos = match v["file"].as_str() {
                 Some(f) => format!(
                     "{}:{}:{}",
-                    std::path::Path::new(f)
-                        .file_name()
-                        .unwrap()
-                        .to_string_lossy(),
+                    Path::new(f).file_name().unwrap().to_string_lossy(),
                     v["line"],
                     v["col"]
                 ),
@@ -213,7 +210,7 @@ fn the_cell_and_its_programs_are_attached() {
         .attachment_indexes
         .iter()
         .map(|a| {
-            std::path::Path::new(&a.name)
+            Path::new(&a.name)
                 .file_name()
                 .unwrap()
                 .to_string_lossy()
@@ -263,7 +260,7 @@ fn urdfs_and_meshes_are_attached_and_meshes_drawn_as_triangles() {
     let mut attached = BTreeMap::new();
     for index in &summary.attachment_indexes {
         let a = mcap::read::attachment(&bytes, index).unwrap();
-        let name = std::path::Path::new(&a.name)
+        let name = Path::new(&a.name)
             .file_name()
             .unwrap()
             .to_string_lossy()
@@ -536,7 +533,7 @@ fn a_log_that_cannot_be_written_is_reported_and_the_run_goes_on() {
     // stops, the run finishes as it would without a log and says why the log is missing.
     let cell = Arc::new(load(&root().join("workcells/handoff/cell.toml")).unwrap());
     let plain = Simulation::new(Arc::clone(&cell)).run(None);
-    let log = McapLog::create(std::path::Path::new("/dev/full"), &cell, 1).unwrap();
+    let log = McapLog::create(Path::new("/dev/full"), &cell, 1).unwrap();
     let r = Simulation::new(Arc::clone(&cell)).with_log(log).run(None);
     let err = r.log_error.clone().expect("the log error is reported");
     assert!(
@@ -673,4 +670,21 @@ fn the_same_run_writes_the_same_bytes() {
     let (_, second) = run_logged(&cell, 1, None, "same-2");
     assert!(first.len() > 1_000_000);
     assert!(first == second, "two runs of one cell wrote different logs");
+}
+
+/// Found by the `log` fuzz target: a damaged chunk header claiming 2^56 bytes
+/// uncompressed made the mcap crate allocate them (an abort). The reader stops before
+/// that chunk and says the file is damaged there.
+#[test]
+fn a_chunk_claiming_an_absurd_size_is_damage_not_an_abort() {
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/log-chunk-claims-2-56-bytes.mcap");
+    let bytes = std::fs::read(&path).unwrap();
+    match vworks_se::mcaplog::read_log_bytes("damaged.mcap", &bytes) {
+        Ok(contents) => {
+            let (_, why) = contents.damage.expect("reported as damaged");
+            assert!(why.contains("claims") || !why.is_empty(), "{why}");
+        }
+        Err(e) => assert!(e.to_string().contains("damaged.mcap"), "{e}"),
+    }
 }

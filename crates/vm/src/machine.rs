@@ -421,8 +421,8 @@ pub struct Vm {
     /// Per module global: the instant the main program or a handler last read it, and
     /// where (for race warnings); `reads` lists the globals first read at this instant
     /// since the SE last took them.
-    read_at: Vec<std::cell::Cell<i64>>,
-    reads: std::cell::RefCell<Vec<(u32, SrcPos)>>,
+    read_at: Vec<std::sync::atomic::AtomicI64>,
+    reads: std::sync::Mutex<Vec<(u32, SrcPos)>>,
 }
 
 struct View<'a> {
@@ -437,10 +437,13 @@ impl Reader for View<'_> {
     fn global(&self, g: u32, pc: u32) -> u64 {
         if self.record_reads
             && let Some(at) = self.vm.read_at.get(g as usize)
-            && at.get() != self.t
+            && at.load(std::sync::atomic::Ordering::Relaxed) != self.t
         {
-            at.set(self.t);
-            self.vm.reads.borrow_mut().push((g, self.vm.m.pos_of(pc)));
+            // Once per global and instant: the lock is rare.
+            at.store(self.t, std::sync::atomic::Ordering::Relaxed);
+            if let Ok(mut reads) = self.vm.reads.lock() {
+                reads.push((g, self.vm.m.pos_of(pc)));
+            }
         }
         self.vm.globals.get(g as usize).copied().unwrap_or(0)
     }
@@ -543,9 +546,9 @@ impl Vm {
             source: Source::None,
             signals: Vec::new(),
             read_at: (0..globals.len())
-                .map(|_| std::cell::Cell::new(-1))
+                .map(|_| std::sync::atomic::AtomicI64::new(-1))
                 .collect(),
-            reads: std::cell::RefCell::new(Vec::with_capacity(4)),
+            reads: std::sync::Mutex::new(Vec::with_capacity(4)),
             globals,
             warnings: Vec::new(),
             activation: 0,
@@ -606,7 +609,9 @@ impl Vm {
     /// reading statement's position: the SE warns of a race when another robot sets one
     /// at the same instant.
     pub fn take_reads(&mut self, out: &mut Vec<(u32, SrcPos)>) {
-        out.append(self.reads.get_mut());
+        if let Ok(reads) = self.reads.get_mut() {
+            out.append(reads);
+        }
     }
 
     /// Sets how many events the robot may perform at one instant

@@ -95,6 +95,12 @@ pub fn read_log_bytes(file: &str, bytes: &[u8]) -> Result<LogContents, LogError>
         file: file.into(),
         reason,
     };
+    // A damaged chunk header or record can claim any size, which the mcap crate's message
+    // stream would allocate at once (2^56 bytes: found by fuzzing). A first pass with a
+    // record size limit counts the messages before such a record; the stream stops there.
+    let (bytes, bad_chunk) = sane_prefix(bytes);
+    let (safe_messages, oversized) = messages_before_oversized(bytes);
+    let bad_chunk = bad_chunk.or(oversized);
     let stream = mcap::MessageStream::new(bytes).map_err(|e| invalid(e.to_string()))?;
     let mut out = LogContents::default();
     // The metadata record sits before the first chunk; a damaged tail does not hide it.
@@ -110,7 +116,13 @@ pub fn read_log_bytes(file: &str, bytes: &[u8]) -> Result<LogContents, LogError>
             }
         }
     }
-    for (read, m) in (0u64..).zip(stream) {
+    let mut stream = stream;
+    for read in 0u64.. {
+        // Checked before the stream is asked for the next message, not after.
+        if safe_messages.is_some_and(|n| read >= n) {
+            break;
+        }
+        let Some(m) = stream.next() else { break };
         let m = match m {
             Ok(m) => m,
             Err(e) => {
@@ -137,5 +149,85 @@ pub fn read_log_bytes(file: &str, bytes: &[u8]) -> Result<LogContents, LogError>
             });
         }
     }
+    if let (Some(why), None) = (bad_chunk, &out.damage) {
+        let read = out.counts.values().sum();
+        out.damage = Some((read, why));
+    }
     Ok(out)
+}
+
+/// How many messages the log holds before a record larger than [`MAX_CHUNK`] (inside a
+/// chunk or not) or other damage, and what is wrong there; `None` if there is none. Reads with
+/// the mcap crate's sans-io reader, whose record size limit the message stream lacks.
+fn messages_before_oversized(bytes: &[u8]) -> (Option<u64>, Option<String>) {
+    use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
+    let mut reader = LinearReader::new_with_options(
+        LinearReaderOptions::default().with_record_length_limit(MAX_CHUNK as usize),
+    );
+    let mut rest = bytes;
+    let mut messages = 0u64;
+    while let Some(event) = reader.next_event() {
+        match event {
+            Ok(LinearReadEvent::ReadRequest(need)) => {
+                let len = need.min(rest.len());
+                reader.insert(len).copy_from_slice(&rest[..len]);
+                reader.notify_read(len);
+                rest = &rest[len..];
+            }
+            Ok(LinearReadEvent::Record { opcode, .. }) => {
+                if opcode == mcap::records::op::MESSAGE {
+                    messages += 1;
+                }
+            }
+            Err(mcap::McapError::RecordTooLarge { opcode, len }) => {
+                return (
+                    Some(messages),
+                    Some(format!(
+                        "after {messages} messages a record (opcode {opcode:#04x}) claims {len} bytes: the file is damaged there"
+                    )),
+                );
+            }
+            // Any other damage: the message stream stops there too (it may abort on a
+            // size it would allocate before it sees the damage).
+            Err(e) => return (Some(messages), Some(e.to_string())),
+        }
+    }
+    (None, None)
+}
+
+/// The largest uncompressed chunk a log may claim (vworks writes chunks of about 10 kB).
+const MAX_CHUNK: u64 = 256 << 20;
+
+/// The bytes up to the first chunk record that claims more than [`MAX_CHUNK`] bytes
+/// uncompressed, and why they stop there; all of them if there is none. Walks the
+/// top-level records (opcode, length, content) after the magic.
+fn sane_prefix(bytes: &[u8]) -> (&[u8], Option<String>) {
+    const CHUNK: u8 = 0x06;
+    let u64_at = |at: usize| -> Option<u64> {
+        let b = bytes.get(at..at.checked_add(8)?)?;
+        Some(u64::from_le_bytes(b.try_into().ok()?))
+    };
+    let mut pos = mcap::MAGIC.len();
+    while let (Some(&op), Some(len)) = (bytes.get(pos), u64_at(pos + 1)) {
+        // A chunk: start time, end time, then the uncompressed size.
+        if op == CHUNK
+            && let Some(size) = u64_at(pos + 9 + 16)
+            && size > MAX_CHUNK
+        {
+            return (
+                &bytes[..pos],
+                Some(format!(
+                    "the chunk at byte {pos} claims {size} bytes uncompressed (at most {MAX_CHUNK}): the file is damaged there"
+                )),
+            );
+        }
+        match usize::try_from(len)
+            .ok()
+            .and_then(|l| (pos + 9).checked_add(l))
+        {
+            Some(next) if next <= bytes.len() => pos = next,
+            _ => break,
+        }
+    }
+    (bytes, None)
 }
