@@ -688,3 +688,16 @@ fn a_chunk_claiming_an_absurd_size_is_damage_not_an_abort() {
         Err(e) => assert!(e.to_string().contains("damaged.mcap"), "{e}"),
     }
 }
+
+/// Found by the `log` fuzz target: a damaged metadata record whose map claims 3.5 GB made
+/// the mcap crate reserve them. Fields longer than their record are damage.
+#[test]
+fn a_field_longer_than_its_record_is_damage_not_a_huge_allocation() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/log-metadata-map-claims-3-5-gb.mcap");
+    let bytes = std::fs::read(&path).unwrap();
+    match vworks_se::mcaplog::read_log_bytes("damaged.mcap", &bytes) {
+        Ok(contents) => assert!(contents.damage.is_some()),
+        Err(e) => assert!(e.to_string().contains("damaged.mcap"), "{e}"),
+    }
+}

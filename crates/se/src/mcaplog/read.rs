@@ -99,23 +99,12 @@ pub fn read_log_bytes(file: &str, bytes: &[u8]) -> Result<LogContents, LogError>
     // stream would allocate at once (2^56 bytes: found by fuzzing). A first pass with a
     // record size limit counts the messages before such a record; the stream stops there.
     let (bytes, bad_chunk) = sane_prefix(bytes);
-    let (safe_messages, oversized) = messages_before_oversized(bytes);
+    let (safe_messages, oversized, metadata) = messages_before_oversized(bytes);
     let bad_chunk = bad_chunk.or(oversized);
     let stream = mcap::MessageStream::new(bytes).map_err(|e| invalid(e.to_string()))?;
     let mut out = LogContents::default();
     // The metadata record sits before the first chunk; a damaged tail does not hide it.
-    if let Ok(records) = mcap::read::LinearReader::new(bytes) {
-        for record in records {
-            match record {
-                Ok(mcap::records::Record::Metadata(m)) if m.name == "vworks" => {
-                    out.metadata = m.metadata;
-                    break;
-                }
-                Ok(_) => {}
-                Err(_) => break,
-            }
-        }
-    }
+    out.metadata = metadata;
     let mut stream = stream;
     for read in 0u64.. {
         // Checked before the stream is asked for the next message, not after.
@@ -159,13 +148,16 @@ pub fn read_log_bytes(file: &str, bytes: &[u8]) -> Result<LogContents, LogError>
 /// How many messages the log holds before a record larger than [`MAX_CHUNK`] (inside a
 /// chunk or not) or other damage, and what is wrong there; `None` if there is none. Reads with
 /// the mcap crate's sans-io reader, whose record size limit the message stream lacks.
-fn messages_before_oversized(bytes: &[u8]) -> (Option<u64>, Option<String>) {
+fn messages_before_oversized(
+    bytes: &[u8],
+) -> (Option<u64>, Option<String>, BTreeMap<String, String>) {
     use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
     let mut reader = LinearReader::new_with_options(
         LinearReaderOptions::default().with_record_length_limit(MAX_CHUNK as usize),
     );
     let mut rest = bytes;
     let mut messages = 0u64;
+    let mut metadata = BTreeMap::new();
     while let Some(event) = reader.next_event() {
         match event {
             Ok(LinearReadEvent::ReadRequest(need)) => {
@@ -174,9 +166,25 @@ fn messages_before_oversized(bytes: &[u8]) -> (Option<u64>, Option<String>) {
                 reader.notify_read(len);
                 rest = &rest[len..];
             }
-            Ok(LinearReadEvent::Record { opcode, .. }) => {
+            Ok(LinearReadEvent::Record { opcode, data }) => {
                 if opcode == mcap::records::op::MESSAGE {
                     messages += 1;
+                }
+                if !lengths_fit(opcode, data) {
+                    return (
+                        Some(messages),
+                        Some(format!(
+                            "after {messages} messages a record (opcode {opcode:#04x}) has a field longer than the record: the file is damaged there"
+                        )),
+                        metadata,
+                    );
+                }
+                // The run's metadata (its lengths fit: safe to parse).
+                if opcode == mcap::records::op::METADATA
+                    && let Ok(mcap::records::Record::Metadata(m)) = mcap::parse_record(opcode, data)
+                    && m.name == "vworks"
+                {
+                    metadata = m.metadata;
                 }
             }
             Err(mcap::McapError::RecordTooLarge { opcode, len }) => {
@@ -185,14 +193,55 @@ fn messages_before_oversized(bytes: &[u8]) -> (Option<u64>, Option<String>) {
                     Some(format!(
                         "after {messages} messages a record (opcode {opcode:#04x}) claims {len} bytes: the file is damaged there"
                     )),
+                    metadata,
                 );
             }
             // Any other damage: the message stream stops there too (it may abort on a
             // size it would allocate before it sees the damage).
-            Err(e) => return (Some(messages), Some(e.to_string())),
+            Err(e) => return (Some(messages), Some(e.to_string()), metadata),
         }
     }
-    (None, None)
+    (None, None, metadata)
+}
+
+/// Whether every length-prefixed field of a record fits in the record: the mcap crate
+/// reserves a string or map's declared length before reading it (3.5 GB for a damaged
+/// metadata map: found by fuzzing). Checks the records with such fields that a data
+/// section holds: header, schema, channel, metadata, attachment.
+fn lengths_fit(opcode: u8, data: &[u8]) -> bool {
+    use mcap::records::op;
+    // Skips `fixed` bytes, then a field with a u32 (or u64) length prefix.
+    struct Fields<'a>(&'a [u8]);
+    impl Fields<'_> {
+        fn skip(&mut self, n: usize) -> bool {
+            match self.0.get(n..) {
+                Some(rest) => {
+                    self.0 = rest;
+                    true
+                }
+                None => false,
+            }
+        }
+        fn prefixed(&mut self, wide: bool) -> bool {
+            let w = if wide { 8 } else { 4 };
+            let Some(b) = self.0.get(..w) else {
+                return false;
+            };
+            let mut len = [0u8; 8];
+            len[..w].copy_from_slice(b);
+            let len = u64::from_le_bytes(len);
+            self.skip(w) && usize::try_from(len).is_ok_and(|l| self.skip(l))
+        }
+    }
+    let mut f = Fields(data);
+    match opcode {
+        op::HEADER => f.prefixed(false) && f.prefixed(false),
+        op::SCHEMA => f.skip(2) && f.prefixed(false) && f.prefixed(false) && f.prefixed(false),
+        op::CHANNEL => f.skip(4) && f.prefixed(false) && f.prefixed(false) && f.prefixed(false),
+        op::METADATA => f.prefixed(false) && f.prefixed(false),
+        op::ATTACHMENT => f.skip(16) && f.prefixed(false) && f.prefixed(false) && f.prefixed(true),
+        _ => true,
+    }
 }
 
 /// The largest uncompressed chunk a log may claim (vworks writes chunks of about 10 kB).
