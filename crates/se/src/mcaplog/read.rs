@@ -102,9 +102,11 @@ pub fn read_log_bytes(file: &str, bytes: &[u8]) -> Result<LogContents, LogError>
     let (safe_messages, oversized, metadata) = messages_before_oversized(bytes);
     let bad_chunk = bad_chunk.or(oversized);
     let stream = mcap::MessageStream::new(bytes).map_err(|e| invalid(e.to_string()))?;
-    let mut out = LogContents::default();
     // The metadata record sits before the first chunk; a damaged tail does not hide it.
-    out.metadata = metadata;
+    let mut out = LogContents {
+        metadata,
+        ..LogContents::default()
+    };
     let mut stream = stream;
     for read in 0u64.. {
         // Checked before the stream is asked for the next message, not after.
