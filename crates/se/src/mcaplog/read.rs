@@ -234,13 +234,30 @@ fn lengths_fit(opcode: u8, data: &[u8]) -> bool {
             let len = u64::from_le_bytes(len);
             self.skip(w) && usize::try_from(len).is_ok_and(|l| self.skip(l))
         }
+        /// A string map: a u32 byte length, then (key, value) strings filling it exactly.
+        fn map(&mut self) -> bool {
+            let Some(b) = self.0.get(..4) else {
+                return false;
+            };
+            let len = u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize;
+            let Some(entries) = self.0.get(4..).and_then(|r| r.get(..len)) else {
+                return false;
+            };
+            let mut inner = Fields(entries);
+            while !inner.0.is_empty() {
+                if !(inner.prefixed(false) && inner.prefixed(false)) {
+                    return false;
+                }
+            }
+            self.skip(4 + len)
+        }
     }
     let mut f = Fields(data);
     match opcode {
         op::HEADER => f.prefixed(false) && f.prefixed(false),
         op::SCHEMA => f.skip(2) && f.prefixed(false) && f.prefixed(false) && f.prefixed(false),
-        op::CHANNEL => f.skip(4) && f.prefixed(false) && f.prefixed(false) && f.prefixed(false),
-        op::METADATA => f.prefixed(false) && f.prefixed(false),
+        op::CHANNEL => f.skip(4) && f.prefixed(false) && f.prefixed(false) && f.map(),
+        op::METADATA => f.prefixed(false) && f.map(),
         op::ATTACHMENT => f.skip(16) && f.prefixed(false) && f.prefixed(false) && f.prefixed(true),
         _ => true,
     }
