@@ -96,114 +96,118 @@ pub fn read_log_bytes(file: &str, bytes: &[u8]) -> Result<LogContents, LogError>
         reason,
     };
     // A damaged chunk header or record can claim any size, which the mcap crate's message
-    // stream would allocate at once (2^56 bytes: found by fuzzing). A first pass with a
-    // record size limit counts the messages before such a record; the stream stops there.
+    // stream would allocate at once (2^56 bytes; a 4 GB string: found by fuzzing). So the
+    // log is read with its sans-io reader and a record size limit, every length checked
+    // before a record is parsed, and messages taken from their records here.
     let (bytes, bad_chunk) = sane_prefix(bytes);
-    let (safe_messages, oversized, metadata) = messages_before_oversized(bytes);
-    let bad_chunk = bad_chunk.or(oversized);
-    let stream = mcap::MessageStream::new(bytes).map_err(|e| invalid(e.to_string()))?;
-    // The metadata record sits before the first chunk; a damaged tail does not hide it.
-    let mut out = LogContents {
-        metadata,
-        ..LogContents::default()
-    };
-    let mut stream = stream;
-    for read in 0u64.. {
-        // Checked before the stream is asked for the next message, not after.
-        if safe_messages.is_some_and(|n| read >= n) {
-            break;
-        }
-        let Some(m) = stream.next() else { break };
-        let m = match m {
-            Ok(m) => m,
-            Err(e) => {
-                out.damage = Some((read, e.to_string()));
-                break;
-            }
-        };
-        *out.counts.entry(m.channel.topic.clone()).or_default() += 1;
-        let (first, last) = out.span.unwrap_or((m.log_time, m.log_time));
-        out.span = Some((first.min(m.log_time), last.max(m.log_time)));
-        if m.channel.topic == "/events" {
-            let v: serde_json::Value = serde_json::from_slice(&m.data)
-                .map_err(|e| invalid(format!("an event is not JSON: {e}")))?;
-            let text = |k: &str| v[k].as_str().map(str::to_string);
-            let int = |k: &str| u32::try_from(v[k].as_u64().unwrap_or(0)).unwrap_or(u32::MAX);
-            out.events.push(LoggedEvent {
-                time_ns: v["time_ns"].as_i64().unwrap_or(0),
-                robot: text("robot"),
-                kind: text("kind").unwrap_or_else(|| "?".into()),
-                details: text("details").unwrap_or_default(),
-                file: text("file"),
-                line: int("line"),
-                col: int("col"),
-            });
-        }
-    }
-    if let (Some(why), None) = (bad_chunk, &out.damage) {
+    let mut out = LogContents::default();
+    let damage = scan(bytes, &mut out, &invalid)?;
+    if let Some(why) = bad_chunk.or(damage) {
         let read = out.counts.values().sum();
         out.damage = Some((read, why));
     }
     Ok(out)
 }
 
-/// How many messages the log holds before a record larger than [`MAX_CHUNK`] (inside a
-/// chunk or not) or other damage, and what is wrong there; `None` if there is none. Reads with
-/// the mcap crate's sans-io reader, whose record size limit the message stream lacks.
-fn messages_before_oversized(
+/// Reads every record of `bytes` into `out` (counts per topic, time span, events,
+/// metadata); returns what is damaged, if something is, where the reading stopped.
+fn scan(
     bytes: &[u8],
-) -> (Option<u64>, Option<String>, BTreeMap<String, String>) {
+    out: &mut LogContents,
+    invalid: &dyn Fn(String) -> LogError,
+) -> Result<Option<String>, LogError> {
+    use mcap::records::op;
     use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
     let mut reader = LinearReader::new_with_options(
         LinearReaderOptions::default().with_record_length_limit(MAX_CHUNK as usize),
     );
     let mut rest = bytes;
     let mut messages = 0u64;
-    let mut metadata = BTreeMap::new();
+    // Channel id → topic.
+    let mut topics: BTreeMap<u16, String> = BTreeMap::new();
+    let u16_at = |d: &[u8], at: usize| d.get(at..at + 2).map(|b| u16::from_le_bytes([b[0], b[1]]));
+    let u64_at = |d: &[u8], at: usize| {
+        d.get(at..at + 8)
+            .and_then(|b| b.try_into().ok())
+            .map(u64::from_le_bytes)
+    };
     while let Some(event) = reader.next_event() {
-        match event {
+        let (opcode, data) = match event {
             Ok(LinearReadEvent::ReadRequest(need)) => {
                 let len = need.min(rest.len());
                 reader.insert(len).copy_from_slice(&rest[..len]);
                 reader.notify_read(len);
                 rest = &rest[len..];
+                continue;
             }
-            Ok(LinearReadEvent::Record { opcode, data }) => {
-                if opcode == mcap::records::op::MESSAGE {
-                    messages += 1;
+            Ok(LinearReadEvent::Record { opcode, data }) => (opcode, data),
+            Err(mcap::McapError::RecordTooLarge { opcode, len }) => {
+                return Ok(Some(format!(
+                    "after {messages} messages a record (opcode {opcode:#04x}) claims {len} bytes: the file is damaged there"
+                )));
+            }
+            Err(e) => return Ok(Some(e.to_string())),
+        };
+        if !lengths_fit(opcode, data) {
+            return Ok(Some(format!(
+                "after {messages} messages a record (opcode {opcode:#04x}) has a field longer than the record: the file is damaged there"
+            )));
+        }
+        match opcode {
+            // Channel: id u16, schema id u16, topic (u32 length, bytes), …
+            op::CHANNEL => {
+                let (Some(id), Some(len)) = (u16_at(data, 0), data.get(4..8)) else {
+                    continue;
+                };
+                let len = u32::from_le_bytes([len[0], len[1], len[2], len[3]]) as usize;
+                if let Some(topic) = data.get(8..8 + len) {
+                    topics.insert(id, String::from_utf8_lossy(topic).into_owned());
                 }
-                if !lengths_fit(opcode, data) {
-                    return (
-                        Some(messages),
-                        Some(format!(
-                            "after {messages} messages a record (opcode {opcode:#04x}) has a field longer than the record: the file is damaged there"
-                        )),
-                        metadata,
-                    );
-                }
-                // The run's metadata (its lengths fit: safe to parse).
-                if opcode == mcap::records::op::METADATA
-                    && let Ok(mcap::records::Record::Metadata(m)) = mcap::parse_record(opcode, data)
+            }
+            // The run's metadata (its lengths fit: safe to parse).
+            op::METADATA => {
+                if let Ok(mcap::records::Record::Metadata(m)) = mcap::parse_record(opcode, data)
                     && m.name == "vworks"
                 {
-                    metadata = m.metadata;
+                    out.metadata = m.metadata;
                 }
             }
-            Err(mcap::McapError::RecordTooLarge { opcode, len }) => {
-                return (
-                    Some(messages),
-                    Some(format!(
-                        "after {messages} messages a record (opcode {opcode:#04x}) claims {len} bytes: the file is damaged there"
-                    )),
-                    metadata,
-                );
+            // Message: channel id u16, sequence u32, log time u64, publish time u64, data.
+            op::MESSAGE => {
+                let (Some(channel), Some(log_time)) = (u16_at(data, 0), u64_at(data, 6)) else {
+                    return Ok(Some(format!("message {messages} is cut short")));
+                };
+                let Some(topic) = topics.get(&channel) else {
+                    return Ok(Some(format!(
+                        "message {messages} is on channel {channel}, which the log never declared"
+                    )));
+                };
+                messages += 1;
+                *out.counts.entry(topic.clone()).or_default() += 1;
+                let (first, last) = out.span.unwrap_or((log_time, log_time));
+                out.span = Some((first.min(log_time), last.max(log_time)));
+                if topic == "/events" {
+                    let payload = data.get(22..).unwrap_or_default();
+                    let v: serde_json::Value = serde_json::from_slice(payload)
+                        .map_err(|e| invalid(format!("an event is not JSON: {e}")))?;
+                    let text = |k: &str| v[k].as_str().map(str::to_string);
+                    let int =
+                        |k: &str| u32::try_from(v[k].as_u64().unwrap_or(0)).unwrap_or(u32::MAX);
+                    out.events.push(LoggedEvent {
+                        time_ns: v["time_ns"].as_i64().unwrap_or(0),
+                        robot: text("robot"),
+                        kind: text("kind").unwrap_or_else(|| "?".into()),
+                        details: text("details").unwrap_or_default(),
+                        file: text("file"),
+                        line: int("line"),
+                        col: int("col"),
+                    });
+                }
             }
-            // Any other damage: the message stream stops there too (it may abort on a
-            // size it would allocate before it sees the damage).
-            Err(e) => return (Some(messages), Some(e.to_string()), metadata),
+            _ => {}
         }
     }
-    (None, None, metadata)
+    Ok(None)
 }
 
 /// Whether every length-prefixed field of a record fits in the record: the mcap crate
