@@ -428,6 +428,18 @@ fn simulate(
     sim.into_result()
 }
 
+/// A warning or error as `run --json` lists them.
+fn json_issue(
+    kind: &str,
+    message: &str,
+    robot: Option<&str>,
+    file: Option<&str>,
+    line: u32,
+    col: u32,
+) -> serde_json::Value {
+    serde_json::json!({"kind": kind, "message": message, "robot": robot, "file": file, "line": line, "col": col})
+}
+
 /// How `vworks run` was asked to run a cell.
 struct RunOptions<'a> {
     until: Option<&'a str>,
@@ -450,20 +462,18 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
         progress,
         color,
     } = opts;
-    // With --json, a run that cannot start is still one JSON object on stdout.
-    let json_error = |errors: Vec<serde_json::Value>| {
+    // With --json, a run that cannot start is still one JSON object on stdout; the
+    // message goes to stderr as without it.
+    let cannot_start = |errors: Vec<serde_json::Value>, message: String| {
         if json {
             let v = serde_json::json!({"outcome": "error", "errors": errors});
             out!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
         }
+        Err(message)
     };
-    let plain_error = |kind: &str, message: &str, file: Option<String>| serde_json::json!({"kind": kind, "message": message, "robot": null, "file": file, "line": 0, "col": 0});
     let until = match until.map(parse_time).transpose() {
         Ok(u) => u,
-        Err(e) => {
-            json_error(vec![plain_error("usage", &e, None)]);
-            return Err(e);
-        }
+        Err(e) => return cannot_start(vec![json_issue("usage", &e, None, None, 0, 0)], e),
     };
     let cell = match vworks_se::workcell::load(path) {
         Ok(c) => std::sync::Arc::new(c),
@@ -472,22 +482,28 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
             diagnostics,
         }) => {
             eprint!("{rendered}");
-            json_error(
-                diagnostics
-                    .iter()
-                    .filter(|d| d.is_error())
-                    .map(|d| serde_json::json!({"kind": d.code.as_str(), "message": d.message, "robot": null, "file": d.at.file, "line": d.at.line, "col": d.at.col}))
-                    .collect(),
-            );
-            return Err(format!("{}: the programs have errors", path.display()));
+            let errors = diagnostics
+                .iter()
+                .filter(|d| d.is_error())
+                .map(|d| {
+                    let at = &d.at;
+                    json_issue(
+                        d.code.as_str(),
+                        &d.message,
+                        None,
+                        Some(&at.file),
+                        at.line,
+                        at.col,
+                    )
+                })
+                .collect();
+            let m = format!("{}: the programs have errors", path.display());
+            return cannot_start(errors, m);
         }
         Err(e) => {
-            json_error(vec![plain_error(
-                "workcell",
-                &e.to_string(),
-                Some(display(path)),
-            )]);
-            return Err(e.to_string());
+            let m = e.to_string();
+            let file = display(path);
+            return cannot_start(vec![json_issue("workcell", &m, None, Some(&file), 0, 0)], m);
         }
     };
     // Compile and link warnings, as `vworks check` prints them.
@@ -502,12 +518,8 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
         match vworks_se::mcaplog::McapLog::create(path, &cell, log_every) {
             Ok(l) => sim = sim.with_log(l),
             Err(e) => {
-                json_error(vec![plain_error(
-                    "log",
-                    &e.to_string(),
-                    Some(display(path)),
-                )]);
-                return Err(e.to_string());
+                let (m, file) = (e.to_string(), display(path));
+                return cannot_start(vec![json_issue("log", &m, None, Some(&file), 0, 0)], m);
             }
         }
     }
@@ -522,7 +534,14 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
         }
     }
     let issue = |i: &vworks_se::engine::Issue| {
-        let mut v = serde_json::json!({"kind": i.kind, "message": i.message, "robot": i.robot, "file": i.file, "line": i.line, "col": i.col});
+        let mut v = json_issue(
+            &i.kind,
+            &i.message,
+            i.robot.as_deref(),
+            i.file.as_deref(),
+            i.line,
+            i.col,
+        );
         if let Some(d) = i.distance_m {
             v["distance_m"] = d.into();
         }
@@ -595,8 +614,9 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
                 c.depth * 1e3
             );
         }
-        // (Compile and link warnings, W…, were printed with their source lines.)
-        for w in r.warnings.iter().filter(|w| !w.kind.starts_with('W')) {
+        // (The compile and link warnings, which open the list, were printed with their
+        // source lines.)
+        for w in r.warnings.iter().skip(cell.warnings.len()) {
             out!("warning[{}]: {}", w.kind, w.message);
         }
         for e in &r.errors {

@@ -9,22 +9,12 @@
 #![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)] // tests fail by panicking
 
 mod common;
-use common::{parse, root, run};
+use common::{case_names, parse, root, run};
 
 #[test]
 fn every_bad_input_gets_an_answer_a_person_can_act_on() {
     let dir = root().join("tests/errors");
-    let mut names: Vec<String> = std::fs::read_dir(&dir)
-        .unwrap()
-        .filter_map(|e| {
-            let p = e.unwrap().path();
-            if p.extension()? != "case" {
-                return None;
-            }
-            Some(p.file_stem()?.to_string_lossy().into_owned())
-        })
-        .collect();
-    names.sort();
+    let names = case_names(&dir);
     assert!(names.len() >= 30, "{} cases", names.len());
     for name in &names {
         let case = parse(&std::fs::read_to_string(dir.join(format!("{name}.case"))).unwrap());

@@ -13,7 +13,7 @@
 #![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)] // tests fail by panicking
 
 mod common;
-use common::{parse, root, run};
+use common::{case_names, parse, root, run};
 
 /// `1234x real time` → `Nx real time`: the only thing in an output that depends on the
 /// machine.
@@ -36,17 +36,7 @@ fn mask_speed(text: &str) -> String {
 #[test]
 fn runs_give_the_times_and_outcomes_the_language_reference_promises() {
     let dir = root().join("tests/runs");
-    let mut names: Vec<String> = std::fs::read_dir(&dir)
-        .unwrap()
-        .filter_map(|e| {
-            let p = e.unwrap().path();
-            if p.extension()? != "case" {
-                return None;
-            }
-            Some(p.file_stem()?.to_string_lossy().into_owned())
-        })
-        .collect();
-    names.sort();
+    let names = case_names(&dir);
     assert!(names.len() >= 10, "{} cases", names.len());
     for name in &names {
         let text = std::fs::read_to_string(dir.join(format!("{name}.case"))).unwrap();

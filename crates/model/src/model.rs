@@ -107,6 +107,18 @@ pub struct Joint {
     pub axis_index: Option<usize>,
 }
 
+impl Joint {
+    /// A position of this joint in the units a programmer writes, to a tenth: degrees, or
+    /// millimetres for a prismatic joint (`-165.0deg`, `250.0mm`).
+    pub fn display(&self, v: f64) -> String {
+        if self.kind == JointKind::Prismatic {
+            format!("{:.1}mm", v * 1e3)
+        } else {
+            format!("{:.1}deg", v.to_degrees())
+        }
+    }
+}
+
 /// The geometry of a collision body, in the link frame (before `origin`).
 #[derive(Clone, Debug, PartialEq)]
 pub enum Geometry {

@@ -75,10 +75,13 @@ pub fn load_str_with(
         message,
         help: help.to_string(),
     };
-    check_joint_types(text, file)?;
+    // Joint elements read from the text itself (comments and references left out).
+    let stripped = strip_blocks(text);
+    let elements = joint_elements(&stripped);
+    check_joint_types(&elements, file)?;
     // urdf-rs reads `acceleration`, `deceleration` and `jerk` only from URDF 1.2 files;
     // vworks reads them whatever the version (docs/models.md).
-    let dynamics = limit_attributes(text);
+    let dynamics = limit_attributes(&elements);
     let robot = urdf_rs::read_from_string(text).map_err(|e| ModelError::Parse {
         file: file.to_string(),
         reason: e.to_string(),
@@ -299,13 +302,7 @@ pub fn load_str_with(
                     other => Ok(other),
                 }
             };
-            let acc = given(
-                "acceleration",
-                extra
-                    .and_then(|d| d.acceleration)
-                    .or((lim.acceleration.is_finite() && lim.acceleration > 0.0)
-                        .then_some(lim.acceleration)),
-            )?;
+            let acc = given("acceleration", extra.and_then(|d| d.acceleration))?;
             let dec = given("deceleration", extra.and_then(|d| d.deceleration))?;
             let acc = match (acc, dec) {
                 (Some(a), Some(d)) => a.min(d),
@@ -414,19 +411,41 @@ pub fn load_str_with(
     Ok(model)
 }
 
-/// Rejects joint types before urdf-rs does, so the error names the joint.
-fn check_joint_types(text: &str, file: &str) -> Result<(), ModelError> {
-    let stripped = strip_blocks(text);
-    let mut rest = stripped.as_str();
+/// A `<joint …>` element of the text: its start tag's attributes, and its body up to its
+/// end tag (or the next joint).
+struct JointElement<'t> {
+    tag: &'t str,
+    body: &'t str,
+}
+
+/// Every `<joint …>` element of `text` (stripped of comments and references).
+fn joint_elements(text: &str) -> Vec<JointElement<'_>> {
+    let mut out = Vec::new();
+    let mut rest = text;
     while let Some(i) = rest.find("<joint") {
         let after = &rest[i + 6..];
         rest = after;
         if !after.starts_with(|c: char| c.is_whitespace()) {
             continue;
         }
-        let tag = &after[..after.find('>').unwrap_or(after.len())];
+        let tag_end = after.find('>').unwrap_or(after.len());
+        let body_end = after
+            .find("</joint>")
+            .or_else(|| after.find("<joint"))
+            .unwrap_or(after.len());
+        out.push(JointElement {
+            tag: &after[..tag_end],
+            body: &after[..body_end.max(tag_end)],
+        });
+    }
+    out
+}
+
+/// Rejects joint types before urdf-rs does, so the error names the joint.
+fn check_joint_types(elements: &[JointElement<'_>], file: &str) -> Result<(), ModelError> {
+    for j in elements {
         // (A quote that is not ASCII once sliced inside a character: found by fuzzing.)
-        let attr = |key: &str| attribute(tag, key);
+        let attr = |key: &str| attribute(j.tag, key);
         let name = attr("name").unwrap_or("?");
         match attr("type") {
             Some("revolute" | "continuous" | "prismatic" | "fixed") => {}
@@ -470,30 +489,13 @@ struct Dynamics {
 
 /// Each joint's `acceleration`, `deceleration` and `jerk` limit attributes (a value that
 /// is not a number reads as NaN, which the caller rejects).
-fn limit_attributes(text: &str) -> BTreeMap<String, Dynamics> {
-    let stripped = strip_blocks(text);
+fn limit_attributes(elements: &[JointElement<'_>]) -> BTreeMap<String, Dynamics> {
     let mut out = BTreeMap::new();
-    let mut rest = stripped.as_str();
-    while let Some(i) = rest.find("<joint") {
-        let after = &rest[i + 6..];
-        rest = after;
-        if !after.starts_with(|c: char| c.is_whitespace()) {
-            continue;
-        }
-        let tag_end = after.find('>').unwrap_or(after.len());
-        let Some(name) = attribute(&after[..tag_end], "name") else {
+    for j in elements {
+        let (Some(name), Some(l)) = (attribute(j.tag, "name"), j.body.find("<limit")) else {
             continue;
         };
-        // The joint's body: up to its end tag (or the next joint).
-        let body_end = after
-            .find("</joint>")
-            .or_else(|| after.find("<joint"))
-            .unwrap_or(after.len());
-        let body = &after[..body_end.max(tag_end)];
-        let Some(l) = body.find("<limit") else {
-            continue;
-        };
-        let limit = &body[l..];
+        let limit = &j.body[l..];
         let limit = &limit[..limit.find('>').unwrap_or(limit.len())];
         let num =
             |key: &str| attribute(limit, key).map(|v| v.trim().parse::<f64>().unwrap_or(f64::NAN));

@@ -289,20 +289,25 @@ fn a_type_after_a_non_ascii_character_is_an_error_not_a_panic() {
     );
 }
 
-/// A branching tree with a link named `tool0` (the ROS-Industrial convention) needs no
-/// `tool_link`; without one it is still an error that says what to do.
-#[test]
-fn tool0_is_the_tool_when_the_tree_branches() {
-    let body = [
+/// Two axes to `tool0` and a finger beside it (the finger's joint with `finger_extra`).
+fn arm_with_finger(finger_extra: &str) -> String {
+    [
         link("base"),
         link("l1"),
         link("tool0"),
         link("finger"),
         joint("j1", "revolute", "base", "l1", ""),
         joint("j2", "revolute", "l1", "tool0", ""),
-        joint("jf", "revolute", "l1", "finger", ""),
+        joint("jf", "revolute", "l1", "finger", finger_extra),
     ]
-    .concat();
+    .concat()
+}
+
+/// A branching tree with a link named `tool0` (the ROS-Industrial convention) needs no
+/// `tool_link`; without one it is still an error that says what to do.
+#[test]
+fn tool0_is_the_tool_when_the_tree_branches() {
+    let body = arm_with_finger("");
     let m = load("tool0.urdf", &robot(&body)).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(m.links[m.tool_link].name, "tool0");
     assert_eq!(m.dof(), 2);
@@ -375,15 +380,5 @@ fn a_mimic_joint_on_the_tool_chain_is_an_error() {
         "mimic.urdf",
         &["joint `j2`", "mimics another joint"],
     );
-    let body = [
-        link("base"),
-        link("l1"),
-        link("tool0"),
-        link("finger"),
-        joint("j1", "revolute", "base", "l1", ""),
-        joint("j2", "revolute", "l1", "tool0", ""),
-        joint("jf", "revolute", "l1", "finger", mimic),
-    ]
-    .concat();
-    load("finger.urdf", &robot(&body)).unwrap_or_else(|e| panic!("{e}"));
+    load("finger.urdf", &robot(&arm_with_finger(mimic))).unwrap_or_else(|e| panic!("{e}"));
 }

@@ -518,13 +518,8 @@ impl Collider {
             let pi = self.body_pose(cell, i, &frames);
             for j in 0..n {
                 let pair = (i.min(j), i.max(j));
-                let (a, b) = (self.bodies[pair.0].owner, self.bodies[pair.1].owner);
-                let never = !matches!(a, Owner::Link { .. })
-                    && !matches!(b, Owner::Link { .. })
-                    && !self.is_held(a)
-                    && !self.is_held(b);
                 if j == i
-                    || never
+                    || self.static_pair(pair)
                     || self.skip_dense[pair.0 * n + pair.1]
                     || self.held_by(pair, cell)
                 {
@@ -664,14 +659,10 @@ impl Collider {
                 if self.skip_dense[pair.0 * n + pair.1] || self.held_by(pair, cell) {
                     continue;
                 }
-                let (a, b) = (&self.bodies[pair.0], &self.bodies[pair.1]);
-                let static_pair = !matches!(a.owner, Owner::Link { .. })
-                    && !matches!(b.owner, Owner::Link { .. })
-                    && !self.is_held(a.owner)
-                    && !self.is_held(b.owner);
-                if static_pair {
+                if self.static_pair(pair) {
                     continue;
                 }
+                let (a, b) = (&self.bodies[pair.0], &self.bodies[pair.1]);
                 let idx = pair.0 * n + pair.1;
                 if self.adaptive && t < self.safe_until[idx] {
                     continue; // provably farther than the clearance until then
@@ -1080,6 +1071,13 @@ impl Collider {
             },
         };
         owner.to_pose() * b.local
+    }
+
+    /// Two bodies neither of which can move (devices and parts nobody holds): never
+    /// checked.
+    fn static_pair(&self, (i, j): (usize, usize)) -> bool {
+        let moves = |o: Owner| matches!(o, Owner::Link { .. }) || self.is_held(o);
+        !moves(self.bodies[i].owner) && !moves(self.bodies[j].owner)
     }
 
     fn is_held(&self, o: Owner) -> bool {

@@ -310,8 +310,6 @@ pub struct Simulation {
     signal_timeout: Vec<Option<(i64, SrcPos)>>,
     /// Per cell global: the last wait on it that timed out (time, robot, position).
     last_timeout: Vec<Option<(i64, usize, SrcPos)>>,
-    /// Per robot: the signal wait it is in (its signal name's string index), if one.
-    signal_wait: Vec<Option<u32>>,
 }
 
 /// How many queue entries the cell may handle at one simulated instant by default: far
@@ -456,7 +454,6 @@ impl Simulation {
             last_signal: vec![None; n],
             signal_timeout: vec![None; n],
             last_timeout: vec![None; cell.linked.globals.len()],
-            signal_wait: vec![None; n],
             cell,
         }
     }
@@ -896,10 +893,7 @@ impl Simulation {
                             "near miss: {a} and {bname} come within {:.2} mm",
                             dist * 1e3
                         );
-                        self.record(b, None, "warning", Detail::Text(format!("\"{m}\"")), None);
-                        let mut issue = self.issue("near_miss", m, None, None);
-                        issue.distance_m = Some(dist);
-                        self.warnings.push(issue);
+                        self.warning(b, None, None, "near_miss", m).distance_m = Some(dist);
                     }
                 }
             }
@@ -924,15 +918,7 @@ impl Simulation {
         self.account(r, &e);
         self.route(r, &e);
         for (t, pos, m) in self.vms[r].take_warnings() {
-            self.record(
-                t,
-                Some(r),
-                "warning",
-                Detail::Text(format!("\"{m}\"")),
-                Some(pos),
-            );
-            let issue = self.issue("slowdown", m, Some(r), Some(pos));
-            self.warnings.push(issue);
+            self.warning(t, Some(r), Some(pos), "slowdown", m);
         }
         if self.outcome.is_none() {
             self.requeue(r);
@@ -963,14 +949,19 @@ impl Simulation {
             EventKind::End | EventKind::Error { .. } | EventKind::RemoteEnd { .. } => {
                 self.stats[r].end_time_ns = e.time;
                 // `stop` in a handler ends a motion or a wait where it is.
-                if let Some(s) = self.moving_since[r].take() {
-                    self.stats[r].moving_ns += e.time - s;
-                }
-                if let Some(s) = self.waiting_since[r].take() {
-                    self.stats[r].waiting_ns += e.time - s;
-                }
+                self.close_intervals(r, e.time);
             }
             _ => {}
+        }
+    }
+
+    /// Robot `r`'s open moving and waiting intervals end at `t`.
+    fn close_intervals(&mut self, r: usize, t: i64) {
+        if let Some(s) = self.moving_since[r].take() {
+            self.stats[r].moving_ns += t - s;
+        }
+        if let Some(s) = self.waiting_since[r].take() {
+            self.stats[r].waiting_ns += t - s;
         }
     }
 
@@ -985,10 +976,6 @@ impl Simulation {
         );
         match &e.kind {
             EventKind::Set { global, value, .. } => self.on_set(r, *global, *value, t, e.pos),
-            EventKind::WaitSignal { name, .. } => {
-                // The receiver knows the signal by the string index of its own module.
-                self.signal_wait[r] = Some(*name);
-            }
             EventKind::WaitUntil { cond, .. } => {
                 let cell = Arc::clone(&self.cell);
                 // A later set at this instant races with this read only if the wait passed
@@ -1040,7 +1027,7 @@ impl Simulation {
                 let stamp = self.tick(r);
                 let timing_out = self.vms[target].wait_deadline() == Some(t)
                     && idx.is_some()
-                    && self.signal_wait[target] == idx;
+                    && self.vms[target].waited_signal() == idx;
                 let timed_out = self.signal_timeout[target]
                     .filter(|(ot, _)| *ot == t)
                     .map(|(_, p)| p);
@@ -1146,7 +1133,8 @@ impl Simulation {
     /// released it had it come first. Remembers the timeout for a set or signal that
     /// comes after it at this instant.
     fn timed_out_race(&mut self, r: usize, t: i64, pos: SrcPos) {
-        if self.signal_wait[r].is_some() {
+        // A condition reads at least one global (E0040), so a wait on none was for a signal.
+        if !self.wait_list.iter().any(|w| w.0.contains(&r)) {
             if let Some((st, sender, spos, _)) = self.last_signal[r]
                 && st == t
             {
@@ -1192,21 +1180,12 @@ impl Simulation {
         for w in &mut self.wait_list {
             w.remove(&r);
         }
-        self.signal_wait[r] = None;
     }
 
     /// A runtime error the SE finds in robot `r`'s event at `t` (a part gripped twice):
     /// an `error` event at the statement, and the run stops.
     fn runtime_error(&mut self, r: usize, t: i64, pos: SrcPos, message: String) {
-        self.record(
-            t,
-            Some(r),
-            "error",
-            Detail::Text(format!("{message:?}")),
-            Some(pos),
-        );
-        let issue = self.issue("runtime", message, Some(r), Some(pos));
-        self.errors.push(issue);
+        self.error(t, Some(r), Some(pos), "runtime", message);
         self.stats[r].end_time_ns = t;
         self.vms[r].halt();
         self.outcome = Some(Outcome::Error);
@@ -1279,15 +1258,45 @@ impl Simulation {
             self.short(r),
             pos
         );
+        self.warning(t, Some(r), Some(pos), "race", m);
+    }
+
+    /// A `warning` trace event (the message quoted) and the run's warning of `kind`;
+    /// returns the warning, for details beyond the message.
+    fn warning(
+        &mut self,
+        t: i64,
+        robot: Option<usize>,
+        pos: Option<SrcPos>,
+        kind: &str,
+        message: String,
+    ) -> &mut Issue {
         self.record(
             t,
-            Some(r),
+            robot,
             "warning",
-            Detail::Text(format!("{m:?}")),
-            Some(pos),
+            Detail::Text(format!("{message:?}")),
+            pos,
         );
-        let issue = self.issue("race", m, Some(r), Some(pos));
+        let issue = self.issue(kind, message, robot, pos);
         self.warnings.push(issue);
+        let last = self.warnings.len() - 1;
+        &mut self.warnings[last]
+    }
+
+    /// An `error` trace event (the message quoted) and the run's error of `kind`. The
+    /// caller sets the outcome.
+    fn error(
+        &mut self,
+        t: i64,
+        robot: Option<usize>,
+        pos: Option<SrcPos>,
+        kind: &str,
+        message: String,
+    ) {
+        self.record(t, robot, "error", Detail::Text(format!("{message:?}")), pos);
+        let issue = self.issue(kind, message, robot, pos);
+        self.errors.push(issue);
     }
 
     /// The globals robot `r`'s last segment read at this instant: a race with a set of
@@ -1373,9 +1382,7 @@ impl Simulation {
         );
         let robot = busy.first().map(|&(_, r)| r);
         let pos = robot.map(|r| self.vms[r].loop_position());
-        self.record(t, robot, "error", Detail::Text(format!("{m:?}")), pos);
-        let issue = self.issue("runtime", m, robot, pos);
-        self.errors.push(issue);
+        self.error(t, robot, pos, "runtime", m);
         self.outcome = Some(Outcome::Error);
     }
 
@@ -1400,27 +1407,14 @@ impl Simulation {
             ));
         }
         let m = format!("deadlock: {}", parts.join("; "));
-        self.record(
-            self.time,
-            None,
-            "error",
-            Detail::Text(format!("{m:?}")),
-            None,
-        );
-        let issue = self.issue("deadlock", m, None, None);
-        self.errors.push(issue);
+        self.error(self.time, None, None, "deadlock", m);
         self.outcome = Some(Outcome::Deadlock);
     }
 
     fn finish(mut self) -> RunResult {
         let end = self.time;
         for r in 0..self.vms.len() {
-            if let Some(s) = self.moving_since[r].take() {
-                self.stats[r].moving_ns += end - s;
-            }
-            if let Some(s) = self.waiting_since[r].take() {
-                self.stats[r].waiting_ns += end - s;
-            }
+            self.close_intervals(r, end);
             let st = &mut self.stats[r];
             st.ended = match self.vms[r].next_event() {
                 Next::Idle => "ended".into(),

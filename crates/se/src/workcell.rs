@@ -658,20 +658,15 @@ pub fn load_with(path: &Path, fs: &dyn Files) -> Result<Cell, CellError> {
                     let v = cx.quantity(x, dim, &format!("{key}.home[{k}]"))?;
                     let j = model.axis(k);
                     if v < j.lower - 1e-9 || v > j.upper + 1e-9 {
-                        let (scale, unit) = if dim == Dim::LENGTH {
-                            (1e3, "mm")
-                        } else {
-                            (180.0 / std::f64::consts::PI, "deg")
-                        };
                         return Err(cx.bad(
                             &format!("{key}.home[{k}]"),
                             format!(
-                                "{:.1}{unit} is outside axis {} `{}`'s range {:.1}{unit} to {:.1}{unit}; choose a home within the limits",
-                                v * scale,
+                                "{} is outside axis {} `{}`'s range {} to {}; choose a home within the limits",
+                                j.display(v),
                                 k + 1,
                                 j.name,
-                                j.lower * scale,
-                                j.upper * scale
+                                j.display(j.lower),
+                                j.display(j.upper)
                             ),
                         ));
                     }

@@ -341,9 +341,6 @@ enum Firing {
 struct Enabled {
     handler: u32,
     target: u32,
-    /// The activation that enabled it: 0 for the program, a remote request's number
-    /// (from 1) for remote work. It is disabled when that activation ends.
-    owner: u64,
     /// Captured slots for the action and for the condition.
     args: Vec<u64>,
     cond_args: Vec<u64>,
@@ -409,40 +406,41 @@ pub struct Vm {
     globals: Vec<u64>,
     /// Warnings to report (e.g. a move slowed by an axis speed limit).
     warnings: Vec<(i64, SrcPos, String)>,
-    /// The activation running on the main thread: 0 for the program, then one number
-    /// per remote request served (from 1).
-    activation: u64,
-    activations: u64,
     /// The simulated instant the budgets below count for, the instructions left at it and
     /// the events performed at it.
     instant: i64,
     instant_budget: u64,
     instant_events: u64,
-    /// Per module global: the instant the main program or a handler last read it, and
-    /// where (for race warnings); `reads` lists the globals first read at this instant
-    /// since the SE last took them.
-    read_at: Vec<std::sync::atomic::AtomicI64>,
-    reads: std::sync::Mutex<Vec<(u32, SrcPos)>>,
+    /// Reads of globals by the main program and handlers, for race warnings.
+    read_log: ReadLog,
+}
+
+/// Which globals the main program and handlers read at the current instant.
+#[derive(Debug, Default)]
+struct ReadLog {
+    /// Per module global: the instant it was last read.
+    at: Vec<i64>,
+    /// The globals first read at their instant since the SE last took them, and where.
+    new: Vec<(u32, SrcPos)>,
 }
 
 struct View<'a> {
     vm: &'a Vm,
     t: i64,
-    /// Whether reads of globals count for race warnings: those of the main program and
+    /// Where reads of globals are noted for race warnings: those of the main program and
     /// of handlers, not of conditions (which `check_wait`/`check_when` re-test).
-    record_reads: bool,
+    reads: Option<&'a std::cell::RefCell<ReadLog>>,
 }
 
 impl Reader for View<'_> {
     fn global(&self, g: u32, pc: u32) -> u64 {
-        if self.record_reads
-            && let Some(at) = self.vm.read_at.get(g as usize)
-            && at.load(std::sync::atomic::Ordering::Relaxed) != self.t
-        {
-            // Once per global and instant: the lock is rare.
-            at.store(self.t, std::sync::atomic::Ordering::Relaxed);
-            if let Ok(mut reads) = self.vm.reads.lock() {
-                reads.push((g, self.vm.m.pos_of(pc)));
+        if let Some(log) = self.reads {
+            let log = &mut *log.borrow_mut();
+            if let Some(at) = log.at.get_mut(g as usize)
+                && *at != self.t
+            {
+                *at = self.t;
+                log.new.push((g, self.vm.m.pos_of(pc)));
             }
         }
         self.vm.globals.get(g as usize).copied().unwrap_or(0)
@@ -545,14 +543,12 @@ impl Vm {
             serving: None,
             source: Source::None,
             signals: Vec::new(),
-            read_at: (0..globals.len())
-                .map(|_| std::sync::atomic::AtomicI64::new(-1))
-                .collect(),
-            reads: std::sync::Mutex::new(Vec::with_capacity(4)),
+            read_log: ReadLog {
+                at: vec![-1; globals.len()],
+                new: Vec::with_capacity(4),
+            },
             globals,
             warnings: Vec::new(),
-            activation: 0,
-            activations: 0,
             instant: -1,
             instant_budget: 0,
             instant_events: 0,
@@ -609,9 +605,7 @@ impl Vm {
     /// reading statement's position: the SE warns of a race when another robot sets one
     /// at the same instant.
     pub fn take_reads(&mut self, out: &mut Vec<(u32, SrcPos)>) {
-        if let Ok(reads) = self.reads.get_mut() {
-            out.append(reads);
-        }
+        out.append(&mut self.read_log.new);
     }
 
     /// Sets how many events the robot may perform at one instant
@@ -644,8 +638,16 @@ impl Vm {
     /// around its current statement (or around the call that leads there), else the
     /// statement.
     pub fn loop_position(&self) -> SrcPos {
-        let e = self.zero_time_loop(self.main.pc, &self.main, String::new());
-        e.pos
+        let pc = self.main.pc;
+        self.m.pos_of(self.loop_start(pc, &self.main).unwrap_or(pc))
+    }
+
+    /// The signal (its name's string index) the robot is blocked waiting for, if one.
+    pub fn waited_signal(&self) -> Option<u32> {
+        match self.state {
+            State::Waiting { signal, .. } => signal,
+            _ => None,
+        }
     }
 
     /// The deadline of the wait the robot is blocked in, if it has a timeout.
@@ -1101,11 +1103,9 @@ impl Vm {
                     EventKind::Log { text }
                 }
             }
-            // `stop` in remote work ends the remote work (the caller's join goes on).
-            Instr::Stop => match self.serving {
-                Some(proc) if !in_handler => EventKind::RemoteEnd { proc },
-                _ => EventKind::End,
-            },
+            // `stop` in remote work ends the remote work (the caller's join goes on). (In a
+            // handler `run_segment` has made it the handler's end.)
+            Instr::Stop => self.end_kind(),
             other => {
                 return Err(format!(
                     "`{}` is not supported by this VM yet",
@@ -1206,20 +1206,13 @@ impl Vm {
             for (i, g) in goal.iter().enumerate().take(n) {
                 let j = self.model.axis(i);
                 if *g < j.lower - 1e-9 || *g > j.upper + 1e-9 {
-                    // In the units a programmer writes: degrees, or millimetres for a
-                    // prismatic axis.
-                    let (k, unit) = if j.kind == vworks_model::model::JointKind::Prismatic {
-                        (1e3, "mm")
-                    } else {
-                        (180.0 / std::f64::consts::PI, "deg")
-                    };
                     return Err(format!(
-                        "joint limit exceeded: axis {} `{}` would go to {:.1}{unit}, outside its range {:.1}{unit} to {:.1}{unit}; choose a target within the range{}",
+                        "joint limit exceeded: axis {} `{}` would go to {}, outside its range {} to {}; choose a target within the range{}",
                         i + 1,
                         j.name,
-                        g * k,
-                        j.lower * k,
-                        j.upper * k,
+                        j.display(*g),
+                        j.display(j.lower),
+                        j.display(j.upper),
                         if target.len() == MAX_AXES {
                             ""
                         } else {
@@ -1652,7 +1645,6 @@ impl Vm {
             }
         };
         self.enabled.push(Enabled {
-            owner: self.activation,
             handler: h,
             target: info.target,
             args,
@@ -1691,8 +1683,12 @@ impl Vm {
         }
     }
 
-    /// The program (not a remote request) ended: handlers go, remote service begins.
+    /// The program or the remote work being served ended: its handlers go (a handler
+    /// belongs to the activation that enabled it, and every enabled handler was enabled by
+    /// the one ending: remote work starts only once the program has ended), and the robot
+    /// serves remote requests.
     fn end_program(&mut self) {
+        self.serving = None;
         self.enabled.clear();
         self.fires.clear();
         self.state = State::Idle;
@@ -1707,27 +1703,20 @@ impl Vm {
             self.motion = None;
         }
         self.pending_motion = None;
-        let kind = match self.serving {
-            Some(proc) => EventKind::RemoteEnd { proc },
-            None => EventKind::End,
-        };
         self.state = State::At(Event {
             robot: self.cfg.robot,
             time: t,
-            kind,
+            kind: self.end_kind(),
             pos,
         });
     }
 
-    /// The remote work being served ended: the handlers it enabled go with it.
-    fn end_activation(&mut self) {
-        let a = self.activation;
-        if a != 0 {
-            self.remove_enabled(|_, e| e.owner == a);
+    /// What `stop` ends: the remote work being served, or the program.
+    fn end_kind(&self) -> EventKind {
+        match self.serving {
+            Some(proc) => EventKind::RemoteEnd { proc },
+            None => EventKind::End,
         }
-        self.activation = 0;
-        self.serving = None;
-        self.state = State::Idle;
     }
 
     /// The enabled condition handlers: (handler procedure, the module globals the
@@ -1760,7 +1749,7 @@ impl Vm {
                         return;
                     }
                     EventKind::RemoteEnd { .. } => {
-                        self.end_activation();
+                        self.end_program();
                         return;
                     }
                     EventKind::MotionStart { duration_ns, .. } => {
@@ -1853,8 +1842,6 @@ impl Vm {
                         };
                         self.main.start(&self.m, *proc, &r.args);
                         self.serving = Some(*proc);
-                        self.activations += 1;
-                        self.activation = self.activations;
                         self.state = State::Run;
                         return;
                     }
@@ -1986,17 +1973,20 @@ impl Vm {
         self.enter_instant(t);
         let mut budget = self.instant_budget;
         let mut vars = std::mem::take(&mut self.vars);
+        // Moved out for the run (the view borrows the VM), and back.
+        let log = std::cell::RefCell::new(std::mem::take(&mut self.read_log));
         let r = th.run(
             &self.m,
             &View {
                 vm: self,
                 t,
-                record_reads,
+                reads: record_reads.then_some(&log),
             },
             &mut vars,
             &mut budget,
             self.cfg.max_depth,
         );
+        self.read_log = log.into_inner();
         self.instant_budget = budget;
         self.vars = vars;
         match r {
@@ -2025,11 +2015,7 @@ impl Vm {
     /// The error of a zero-time loop at `pc` of `th`: it names the innermost loop around
     /// `pc` (or around the call that leads there), or the statement if there is none.
     fn zero_time_loop(&self, pc: u32, th: &Thread, what: String) -> RuntimeError {
-        let calls = th.frames.iter().rev().map(|f| f.ret_pc);
-        let found = std::iter::once(pc)
-            .chain(calls)
-            .find_map(|at| self.loop_around(at));
-        let (at, place) = match found {
+        let (at, place) = match self.loop_start(pc, th) {
             Some(start) => (start, "this loop"),
             None => (pc, "this statement"),
         };
@@ -2040,6 +2026,15 @@ impl Vm {
             pc: at,
             pos: self.m.pos_of(at),
         }
+    }
+
+    /// The start of the innermost loop around `pc` of `th`, or around the call that leads
+    /// there.
+    fn loop_start(&self, pc: u32, th: &Thread) -> Option<u32> {
+        let calls = th.frames.iter().rev().map(|f| f.ret_pc);
+        std::iter::once(pc)
+            .chain(calls)
+            .find_map(|at| self.loop_around(at))
     }
 
     /// The start of the innermost loop around absolute instruction `pc`: the target of the

@@ -56,14 +56,15 @@ fn summary(d: &[Diagnostic]) -> String {
 }
 
 /// The candidate nearest to `name` by edit distance, if one is near enough to be a
-/// likely misspelling (at most a third of its length away): for "did you mean" hints in
-/// programs and in workcell files alike.
+/// likely misspelling (at most 2 edits, and fewer than its length; the first by name on a
+/// tie): for "did you mean" hints in programs (E0010, E0011) and workcell files alike.
 pub fn nearest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
     candidates
         .into_iter()
+        .filter(|c| !c.is_empty())
         .map(|c| (lower::edit_distance(name, c), c))
-        .filter(|(d, c)| *d > 0 && *d <= c.chars().count().div_ceil(3))
-        .min_by_key(|(d, c)| (*d, *c))
+        .filter(|(d, c)| *d <= 2 && *d < c.len())
+        .min()
         .map(|(_, c)| c)
 }
 

@@ -2087,41 +2087,29 @@ impl Compiler<'_> {
         if let Some(f) = self.fns.last() {
             candidates.extend(f.scopes.iter().flatten().map(|l| l.name.clone()));
         }
-        candidates.sort();
-        let best = candidates
-            .iter()
-            .filter(|c| !c.is_empty())
-            .map(|c| (edit_distance(name, c), c))
-            .filter(|(d, c)| *d <= 2 && *d < c.len())
-            .min();
+        let best = crate::nearest(name, candidates.iter().map(String::as_str));
         let mut d = Diagnostic::error(Code::E0010, format!("unknown name `{name}`"), span)
             .with_label("not declared");
         d = match best {
-            Some((_, c)) => d.with_help(format!("did you mean `{c}`?")),
+            Some(c) => d.with_help(format!("did you mean `{c}`?")),
             None => d.with_help("declare it with `var`, `const` or `global` before using it"),
         };
         self.err(d);
     }
 
     fn unknown_proc(&mut self, name: &str, span: Span) {
-        let mut names: Vec<&str> = self
+        let names = self
             .sigs
             .iter()
             .map(|s| s.name.as_str())
-            .chain(BUILTINS.iter().copied())
-            .collect();
-        names.sort_unstable();
-        let best = names
-            .iter()
-            .map(|c| (edit_distance(name, c), *c))
-            .filter(|(d, c)| *d <= 2 && *d < c.len())
-            .min();
+            .chain(BUILTINS.iter().copied());
+        let best = crate::nearest(name, names);
         let mut d = Diagnostic::error(
             Code::E0011,
             format!("unknown procedure or function `{name}`"),
             span,
         );
-        if let Some((_, c)) = best {
+        if let Some(c) = best {
             d = d.with_help(format!("did you mean `{c}`?"));
         }
         self.err(d);

@@ -99,10 +99,9 @@ pub fn read_log_bytes(file: &str, bytes: &[u8]) -> Result<LogContents, LogError>
     // stream would allocate at once (2^56 bytes; a 4 GB string: found by fuzzing). So the
     // log is read with its sans-io reader and a record size limit, every length checked
     // before a record is parsed, and messages taken from their records here.
-    let (bytes, bad_chunk) = sane_prefix(bytes);
     let mut out = LogContents::default();
     let damage = scan(bytes, &mut out, &invalid)?;
-    if let Some(why) = bad_chunk.or(damage) {
+    if let Some(why) = damage {
         let read = out.counts.values().sum();
         out.damage = Some((read, why));
     }
@@ -119,7 +118,7 @@ fn scan(
     use mcap::records::op;
     use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
     let mut reader = LinearReader::new_with_options(
-        LinearReaderOptions::default().with_record_length_limit(MAX_CHUNK as usize),
+        LinearReaderOptions::default().with_record_length_limit(MAX_RECORD),
     );
     let mut rest = bytes;
     let mut messages = 0u64;
@@ -267,39 +266,5 @@ fn lengths_fit(opcode: u8, data: &[u8]) -> bool {
     }
 }
 
-/// The largest uncompressed chunk a log may claim (vworks writes chunks of about 10 kB).
-const MAX_CHUNK: u64 = 256 << 20;
-
-/// The bytes up to the first chunk record that claims more than [`MAX_CHUNK`] bytes
-/// uncompressed, and why they stop there; all of them if there is none. Walks the
-/// top-level records (opcode, length, content) after the magic.
-fn sane_prefix(bytes: &[u8]) -> (&[u8], Option<String>) {
-    const CHUNK: u8 = 0x06;
-    let u64_at = |at: usize| -> Option<u64> {
-        let b = bytes.get(at..at.checked_add(8)?)?;
-        Some(u64::from_le_bytes(b.try_into().ok()?))
-    };
-    let mut pos = mcap::MAGIC.len();
-    while let (Some(&op), Some(len)) = (bytes.get(pos), u64_at(pos + 1)) {
-        // A chunk: start time, end time, then the uncompressed size.
-        if op == CHUNK
-            && let Some(size) = u64_at(pos + 9 + 16)
-            && size > MAX_CHUNK
-        {
-            return (
-                &bytes[..pos],
-                Some(format!(
-                    "the chunk at byte {pos} claims {size} bytes uncompressed (at most {MAX_CHUNK}): the file is damaged there"
-                )),
-            );
-        }
-        match usize::try_from(len)
-            .ok()
-            .and_then(|l| (pos + 9).checked_add(l))
-        {
-            Some(next) if next <= bytes.len() => pos = next,
-            _ => break,
-        }
-    }
-    (bytes, None)
-}
+/// The largest record a log may hold (vworks writes chunks of about 10 kB).
+const MAX_RECORD: usize = 256 << 20;
