@@ -1303,6 +1303,9 @@ impl Simulation {
     /// another robot at the same instant that `r` has not seen (either order), as for
     /// `wait_until` conditions.
     fn note_reads(&mut self, r: usize) {
+        if !self.vms[r].has_reads() {
+            return;
+        }
         let mut reads = std::mem::take(&mut self.reads);
         self.vms[r].take_reads(&mut reads);
         let (t, n) = (self.time, self.vms.len());

@@ -608,6 +608,12 @@ impl Vm {
         out.append(&mut self.read_log.new);
     }
 
+    /// Whether [`Vm::take_reads`] has anything to give.
+    #[inline]
+    pub fn has_reads(&self) -> bool {
+        !self.read_log.new.is_empty()
+    }
+
     /// Sets how many events the robot may perform at one instant
     /// ([`VmConfig::instant_events`]).
     pub fn set_instant_events(&mut self, limit: u64) {
@@ -1973,20 +1979,24 @@ impl Vm {
         self.enter_instant(t);
         let mut budget = self.instant_budget;
         let mut vars = std::mem::take(&mut self.vars);
-        // Moved out for the run (the view borrows the VM), and back.
-        let log = std::cell::RefCell::new(std::mem::take(&mut self.read_log));
+        // Moved out for the run (the view borrows the VM), and back; not at all when the
+        // module has no globals to read.
+        let log = (record_reads && !self.read_log.at.is_empty())
+            .then(|| std::cell::RefCell::new(std::mem::take(&mut self.read_log)));
         let r = th.run(
             &self.m,
             &View {
                 vm: self,
                 t,
-                reads: record_reads.then_some(&log),
+                reads: log.as_ref(),
             },
             &mut vars,
             &mut budget,
             self.cfg.max_depth,
         );
-        self.read_log = log.into_inner();
+        if let Some(log) = log {
+            self.read_log = log.into_inner();
+        }
         self.instant_budget = budget;
         self.vars = vars;
         match r {
