@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use vworks_se::workcell::MemoryFiles;
+use vworks_cell::MemoryFiles;
 
 pub fn files_of(data: &[u8]) -> MemoryFiles {
     let mut files = MemoryFiles::default();

@@ -6,7 +6,7 @@ use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
     if let Ok(contents) = vworks_se::mcaplog::read_log_bytes("fuzz.mcap", data) {
-        let report = vworks_se::report::Report::from_log(&contents);
-        let _ = vworks_se::report::html(&report, &contents.events, "fuzz.mcap");
+        let report = vworks_report::Report::from_log(&contents);
+        let _ = vworks_report::html(&report, &contents.events, "fuzz.mcap");
     }
 });

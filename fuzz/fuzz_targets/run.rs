@@ -17,7 +17,7 @@ const WALL: Duration = Duration::from_secs(10);
 
 fuzz_target!(|data: &[u8]| {
     let files = cellfiles::files_of(data);
-    let Ok(cell) = vworks_se::workcell::load_with(cellfiles::cell_path(), &files) else { return };
+    let Ok(cell) = vworks_cell::load_with(cellfiles::cell_path(), &files) else { return };
     // Small cells only: the point is the engine, not 64 robots' FK.
     if cell.robots.len() > 4 || cell.devices.len() + cell.parts.len() > 8 {
         return;

@@ -9,7 +9,7 @@ mod cellfiles;
 
 fuzz_target!(|data: &[u8]| {
     let files = cellfiles::files_of(data);
-    match vworks_se::workcell::load_with(cellfiles::cell_path(), &files) {
+    match vworks_cell::load_with(cellfiles::cell_path(), &files) {
         Ok(cell) => {
             let _ = cell.render_warnings(false);
             assert!(cell.cycle_ns > 0);

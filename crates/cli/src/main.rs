@@ -202,18 +202,11 @@ fn parse_time(s: &str) -> Result<i64, String> {
             "--until `{s}` is before the run starts; give a time from 0, e.g. 10s"
         ));
     }
-    let mut diags = Vec::new();
-    let toks = vworks_wslc::lexer::lex(s.trim(), &mut diags);
-    use vworks_wslc::lexer::TokKind;
-    let secs = match toks.first().map(|t| &t.kind) {
-        Some(TokKind::Quantity(x, d)) if *d == vworks_vm::Dim::TIME && toks.len() == 2 => *x,
-        Some(TokKind::Int(i)) if toks.len() == 2 => *i as f64,
-        Some(TokKind::Num(x)) if toks.len() == 2 => *x,
-        _ => {
-            return Err(format!(
-                "--until `{s}` is not a time; write e.g. 10s or 250ms"
-            ));
-        }
+    let quantity = vworks_wslc::units::parse_quantity(s).map(|q| q.si(vworks_vm::Dim::TIME));
+    let Some(Ok(secs)) = quantity else {
+        return Err(format!(
+            "--until `{s}` is not a time; write e.g. 10s or 250ms"
+        ));
     };
     if secs < 0.0 || !secs.is_finite() {
         return Err(format!(
@@ -237,7 +230,7 @@ fn read_log(what: LogCommand) -> Result<ExitCode, String> {
     match &what {
         LogCommand::Events { kind, robot, .. } => {
             for e in &log.events {
-                if kind.as_deref().is_some_and(|want| want != e.kind)
+                if kind.as_deref().is_some_and(|want| want != e.kind.name())
                     || robot
                         .as_deref()
                         .is_some_and(|want| Some(want) != e.robot.as_deref())
@@ -353,8 +346,8 @@ fn new_cell(dir: &Path) -> Result<ExitCode, String> {
 
 fn write_report(log: &Path, output: Option<PathBuf>) -> Result<ExitCode, String> {
     let contents = vworks_se::mcaplog::read_log(log).map_err(|e| e.to_string())?;
-    let report = vworks_se::report::Report::from_log(&contents);
-    let page = vworks_se::report::html(&report, &contents.events, &log.display().to_string());
+    let report = vworks_report::Report::from_log(&contents);
+    let page = vworks_report::html(&report, &contents.events, &log.display().to_string());
     let out = output.unwrap_or_else(|| log.with_extension("html"));
     std::fs::write(&out, page).map_err(|e| {
         format!(
@@ -429,16 +422,7 @@ fn simulate(
 }
 
 /// A warning or error as `run --json` lists them.
-fn json_issue(
-    kind: &str,
-    message: &str,
-    robot: Option<&str>,
-    file: Option<&str>,
-    line: u32,
-    col: u32,
-) -> serde_json::Value {
-    serde_json::json!({"kind": kind, "message": message, "robot": robot, "file": file, "line": line, "col": col})
-}
+use vworks_se::result::issue_json as json_issue;
 
 /// How `vworks run` was asked to run a cell.
 struct RunOptions<'a> {
@@ -475,9 +459,9 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
         Ok(u) => u,
         Err(e) => return cannot_start(vec![json_issue("usage", &e, None, None, 0, 0)], e),
     };
-    let cell = match vworks_se::workcell::load(path) {
+    let cell = match vworks_cell::load(path) {
         Ok(c) => std::sync::Arc::new(c),
-        Err(vworks_se::workcell::CellError::Program {
+        Err(vworks_cell::CellError::Program {
             rendered,
             diagnostics,
         }) => {
@@ -533,45 +517,9 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
             out!("{}", e.line(&cell));
         }
     }
-    let issue = |i: &vworks_se::engine::Issue| {
-        let mut v = json_issue(
-            &i.kind,
-            &i.message,
-            i.robot.as_deref(),
-            i.file.as_deref(),
-            i.line,
-            i.col,
-        );
-        if let Some(d) = i.distance_m {
-            v["distance_m"] = d.into();
-        }
-        v
-    };
     if json {
-        let v = serde_json::json!({
-            "cell": cell.name,
-            "outcome": r.outcome.name(),
-            "end_time_ns": r.end_time_ns,
-            "robots": r.robots.iter().map(|s| serde_json::json!({
-                "name": s.name, "moving_ns": s.moving_ns, "waiting_ns": s.waiting_ns, "idle_ns": s.idle_ns,
-                "handler_ns": s.handler_ns, "motions": s.motions, "end_time_ns": s.end_time_ns, "ended": s.ended,
-            })).collect::<Vec<_>>(),
-            "collisions": r.collisions.iter().map(|c| serde_json::json!({"time_ns": c.time_ns, "a": c.a, "b": c.b, "depth_m": c.depth, "point_m": c.point})).collect::<Vec<_>>(),
-            "warnings": r.warnings.iter().map(issue).collect::<Vec<_>>(),
-            "errors": r.errors.iter().map(issue).collect::<Vec<_>>(),
-            "globals": r.globals.iter().map(|(k, v)| (k.clone(), serde_json::Value::String(v.clone()))).collect::<serde_json::Map<_, _>>(),
-            "cycles": r.cycles,
-            "collision_queries": r.queries,
-            // Narrow-phase queries per cycle boundary (adaptive checking and the sweep
-            // between boundaries included).
-            "queries_per_cycle": if r.cycles > 0 { r.queries as f64 / r.cycles as f64 } else { 0.0 },
-            "events": r.trace.len(),
-            "log": log.map(|p| serde_json::json!({
-                "file": p.display().to_string(),
-                "messages": r.log_counts,
-                "error": r.log_error.as_ref().map(ToString::to_string),
-            })),
-        });
+        let log_file = log.map(|p| p.display().to_string());
+        let v = r.to_json(&cell.name, log_file.as_deref());
         out!(
             "{}",
             serde_json::to_string_pretty(&v).map_err(|e| e.to_string())?
@@ -584,24 +532,22 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
             secs(r.end_time_ns)
         );
         out!(
-            "{:<10} {:>10} {:>10} {:>10} {:>10} {:>8}  ended",
+            "{:<10} {:>10} {:>10} {:>10} {:>8}  ended",
             "robot",
             "moving",
             "waiting",
             "idle",
-            "handlers",
             "motions"
         );
         for s in &r.robots {
             out!(
-                "{:<10} {:>10} {:>10} {:>10} {:>10} {:>8}  {} at {}",
+                "{:<10} {:>10} {:>10} {:>10} {:>8}  {} at {}",
                 s.name,
                 secs(s.moving_ns),
                 secs(s.waiting_ns),
                 secs(s.idle_ns),
-                secs(s.handler_ns),
                 s.motions,
-                s.ended,
+                s.ended.name(),
                 secs(s.end_time_ns)
             );
         }

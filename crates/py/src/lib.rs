@@ -17,9 +17,9 @@ use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyIndexError, PyKeyError, PyRuntimeWarning, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PySlice};
+use vworks_cell::CellError as WorkcellError;
 use vworks_se::engine::{Issue, Outcome, RunResult, TraceEvent, Value};
 use vworks_se::mcaplog::{LoggedEvent, McapLog};
-use vworks_se::workcell::CellError as WorkcellError;
 use vworks_wslc::Diagnostic as WslDiagnostic;
 
 create_exception!(
@@ -227,14 +227,14 @@ fn compile(py: Python<'_>, source: &str, path: &str) -> PyResult<Module> {
 /// parts. Run it whole (`run`) or step by step (`simulation`); a cell can be run many times.
 #[pyclass(frozen, module = "vworks")]
 struct Cell {
-    cell: Arc<vworks_se::workcell::Cell>,
+    cell: Arc<vworks_cell::Cell>,
 }
 
 /// Loads the workcell file at `path` (TOML). Raises `CellError` for a wrong workcell or
 /// robot model, `CompileError` or `LinkError` (with `.diagnostics`) for its programs.
 #[pyfunction]
 fn load_cell(py: Python<'_>, path: PathBuf) -> PyResult<Cell> {
-    match py.detach(|| vworks_se::workcell::load(&path)) {
+    match py.detach(|| vworks_cell::load(&path)) {
         Ok(cell) => Ok(Cell {
             cell: Arc::new(cell),
         }),
@@ -356,26 +356,36 @@ impl Cell {
     }
 }
 
-/// One event of a run: a trace line's fields.
-#[pyclass(frozen, module = "vworks", get_all)]
+/// One event of a run: a trace line's fields, and its typed details (`data`).
+#[pyclass(frozen, module = "vworks")]
 #[derive(Clone)]
 struct Event {
     /// Simulated time (s).
+    #[pyo3(get)]
     time: f64,
     /// Simulated time (ns).
+    #[pyo3(get)]
     time_ns: i64,
     /// The robot, or `None` for cell events (a collision, a deadlock).
+    #[pyo3(get)]
     robot: Option<String>,
     /// Kind, e.g. `motion_start`, `set`, `wait_until`, `collision_start`, `end`.
-    kind: String,
+    #[pyo3(get)]
+    kind: &'static str,
     /// What the trace line shows between kind and position (may be empty).
+    #[pyo3(get)]
     details: String,
     /// The WSL file, if the event has a source position.
+    #[pyo3(get)]
     file: Option<String>,
     /// Its line (0 if none).
+    #[pyo3(get)]
     line: u32,
     /// Its column (0 if none).
+    #[pyo3(get)]
     col: u32,
+    /// The whole typed event.
+    typed: LoggedEvent,
 }
 
 #[pymethods]
@@ -383,16 +393,14 @@ impl Event {
     /// The event as a trace line: `time_ns robot kind details file:line:col`, `-` for an
     /// empty field (the golden traces' and `vworks log events`' format).
     fn trace_line(&self) -> String {
-        LoggedEvent {
-            time_ns: self.time_ns,
-            robot: self.robot.clone(),
-            kind: self.kind.clone(),
-            details: self.details.clone(),
-            file: self.file.clone(),
-            line: self.line,
-            col: self.col,
-        }
-        .line()
+        self.typed.line()
+    }
+
+    /// The typed details as a dict (keys by kind, as in the log's `/events` `data`:
+    /// docs/log.md), or `None` for events without details.
+    #[getter]
+    fn data(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        json_object(py, &self.typed.data.to_json())
     }
 
     fn __repr__(&self) -> String {
@@ -400,32 +408,29 @@ impl Event {
     }
 }
 
-fn event(cell: &vworks_se::workcell::Cell, e: &TraceEvent) -> Event {
-    Event {
-        time: secs(e.time),
-        time_ns: e.time,
-        robot: e
-            .robot
-            .and_then(|r| cell.robots.get(r))
-            .map(|r| r.name.clone()),
-        kind: e.kind.to_string(),
-        details: e.details(cell),
-        file: e.file(cell).map(str::to_string),
-        line: e.pos.map_or(0, |p| p.line),
-        col: e.pos.map_or(0, |p| p.col),
-    }
+/// A JSON value as the Python object `json.loads` gives.
+fn json_object(py: Python<'_>, v: &serde_json::Value) -> PyResult<Py<PyAny>> {
+    Ok(py
+        .import("json")?
+        .call_method1("loads", (v.to_string(),))?
+        .unbind())
+}
+
+fn event(cell: &vworks_cell::Cell, e: &TraceEvent) -> Event {
+    logged_event(e.resolve(cell))
 }
 
 fn logged_event(e: LoggedEvent) -> Event {
     Event {
         time: secs(e.time_ns),
         time_ns: e.time_ns,
-        robot: e.robot,
-        kind: e.kind,
-        details: e.details,
-        file: e.file,
+        robot: e.robot.clone(),
+        kind: e.kind.name(),
+        details: e.details.clone(),
+        file: e.file.clone(),
         line: e.line,
         col: e.col,
+        typed: e,
     }
 }
 
@@ -487,7 +492,7 @@ impl EventList {
             "robot",
             e.iter().map(|e| e.robot.clone()).collect::<Vec<_>>(),
         )?;
-        columns.set_item("kind", e.iter().map(|e| e.kind.clone()).collect::<Vec<_>>())?;
+        columns.set_item("kind", e.iter().map(|e| e.kind).collect::<Vec<_>>())?;
         columns.set_item(
             "details",
             e.iter().map(|e| e.details.clone()).collect::<Vec<_>>(),
@@ -513,10 +518,9 @@ struct RobotStats {
     moving: f64,
     /// Seconds waiting (conditions, signals, joins).
     waiting: f64,
-    /// Seconds neither moving nor waiting (delays, and after the program ended).
+    /// Seconds neither moving nor waiting, from 0 to the run's end (delays, and after
+    /// the program ended).
     idle: f64,
-    /// Seconds in handlers (always 0: handlers run in zero simulated time).
-    handler: f64,
     /// Motions started.
     motions: u32,
     /// When its program ended (s): its cycle time.
@@ -630,7 +634,7 @@ struct RunReport {
 }
 
 impl RunReport {
-    fn new(cell: &vworks_se::workcell::Cell, r: RunResult) -> RunReport {
+    fn new(cell: &vworks_cell::Cell, r: RunResult) -> RunReport {
         RunReport {
             outcome: r.outcome.name().to_string(),
             end_time_ns: r.end_time_ns,
@@ -642,11 +646,10 @@ impl RunReport {
                     moving: secs(s.moving_ns),
                     waiting: secs(s.waiting_ns),
                     idle: secs(s.idle_ns),
-                    handler: secs(s.handler_ns),
                     motions: s.motions,
                     end_time: secs(s.end_time_ns),
                     end_time_ns: s.end_time_ns,
-                    ended: s.ended.clone(),
+                    ended: s.ended.name().to_string(),
                 })
                 .collect(),
             collisions: r
@@ -811,7 +814,7 @@ impl RunReport {
 /// A running simulation of a cell: step it and look at it.
 #[pyclass(module = "vworks")]
 struct Simulation {
-    cell: Arc<vworks_se::workcell::Cell>,
+    cell: Arc<vworks_cell::Cell>,
     /// `None` once `result()` ended it.
     sim: Option<vworks_se::engine::Simulation>,
     result: Option<Py<RunReport>>,
@@ -1075,8 +1078,8 @@ fn write_report(py: Python<'_>, log: PathBuf, output: Option<PathBuf>) -> PyResu
     let out = output.unwrap_or_else(|| log.with_extension("html"));
     py.detach(|| {
         let contents = vworks_se::mcaplog::read_log(&log).map_err(|e| e.to_string())?;
-        let report = vworks_se::report::Report::from_log(&contents);
-        let page = vworks_se::report::html(&report, &contents.events, &log.display().to_string());
+        let report = vworks_report::Report::from_log(&contents);
+        let page = vworks_report::html(&report, &contents.events, &log.display().to_string());
         std::fs::write(&out, page).map_err(|e| format!("cannot write `{}`: {e}", out.display()))
     })
     .map_err(Error::new_err)?;

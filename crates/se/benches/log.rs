@@ -18,9 +18,9 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use vworks_cell::{Cell, load};
 use vworks_se::engine::{RunResult, Simulation};
 use vworks_se::mcaplog::{Encoding, LogOptions, McapLog};
-use vworks_se::workcell::{Cell, load};
 
 fn logged(cell: &Arc<Cell>, path: &Path, encoding: Encoding) -> RunResult {
     let log = McapLog::create_with(path, cell, LogOptions::new(1, encoding)).unwrap();

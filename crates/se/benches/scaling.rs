@@ -19,9 +19,9 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use vworks_cell::{Cell, load};
 use vworks_se::engine::Simulation;
 use vworks_se::mcaplog::McapLog;
-use vworks_se::workcell::{Cell, load};
 
 /// A cell of `n` arms 1.2 m apart on a square grid; each moves back and forth `rounds`
 /// times (about 2.9 s per round).

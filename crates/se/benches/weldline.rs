@@ -12,7 +12,7 @@ use vworks_se::engine::Simulation;
 
 fn weldline(c: &mut Criterion) {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../workcells/weldline/cell.toml");
-    let cell = Arc::new(vworks_se::workcell::load(&path).unwrap());
+    let cell = Arc::new(vworks_cell::load(&path).unwrap());
     let probe = Simulation::new(Arc::clone(&cell)).run(None);
     let t0 = std::time::Instant::now();
     let runs = 5;

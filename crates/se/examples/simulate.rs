@@ -8,7 +8,7 @@ fn main() {
         std::process::exit(2);
     };
     let runs: u32 = args.next().and_then(|n| n.parse().ok()).unwrap_or(10);
-    let cell = match vworks_se::workcell::load(std::path::Path::new(&path)) {
+    let cell = match vworks_cell::load(std::path::Path::new(&path)) {
         Ok(c) => std::sync::Arc::new(c),
         Err(e) => {
             eprintln!("error: {e}");

@@ -27,7 +27,9 @@ use parry3d::shape::SharedShape;
 use vworks_model::math::Iso;
 use vworks_vm::machine::Vm;
 
-use crate::workcell::Cell;
+use vworks_cell::Cell;
+
+use crate::world::World;
 
 /// A collision that started.
 #[derive(Clone, Debug, PartialEq)]
@@ -242,13 +244,8 @@ pub struct Collider {
     /// gripper closed on its part): not a collision until they are farther apart than
     /// the clearance, as MoveIt's touch links of an attached object.
     exempt: BTreeSet<(usize, usize)>,
-    /// Per part: the robot holding it and the part's pose in that robot's tool-link frame.
-    held: Vec<Option<(usize, Iso)>>,
-    /// Per part: pose in the cell when not held.
-    part_pose: Vec<Iso>,
-    frames: Vec<Vec<Iso>>,
-    /// Per robot: the joints `frames` were computed for (NaN before the first check).
-    frames_q: Vec<[f64; vworks_vm::MAX_AXES]>,
+    /// The robots' joints and link frames and the parts' poses, as of the last check.
+    world: World,
     dirty: bool,
     /// Narrow-phase queries made so far.
     pub queries: u64,
@@ -282,7 +279,7 @@ fn matches(name: &str, owner: Owner, cell: &Cell, pattern: &str) -> bool {
             match pattern.split_once('.') {
                 None => r.name == pattern,
                 Some((rn, ln)) => {
-                    rn == r.name && crate::workcell::same_link(&r.model.links[link].name, ln)
+                    rn == r.name && vworks_cell::same_link(&r.model.links[link].name, ln)
                 }
             }
         }
@@ -416,14 +413,7 @@ impl Collider {
             touching: BTreeSet::new(),
             near: BTreeSet::new(),
             exempt: BTreeSet::new(),
-            held: vec![None; cell.parts.len()],
-            part_pose: cell.parts.iter().map(|p| p.pose).collect(),
-            frames: cell
-                .robots
-                .iter()
-                .map(|r| r.model.frames_buffer())
-                .collect(),
-            frames_q: vec![[f64::NAN; vworks_vm::MAX_AXES]; cell.robots.len()],
+            world: World::new(cell),
             dirty: true,
             queries: 0,
             sweep_scratch: SweepScratch::default(),
@@ -454,7 +444,7 @@ impl Collider {
         for i in 0..n {
             let mine = match self.bodies[i].owner {
                 Owner::Link { robot, .. } => robot == r,
-                Owner::Part(p) => self.held[p].is_some_and(|(h, _)| h == r),
+                Owner::Part(p) => self.world.held[p].is_some_and(|(h, _)| h == r),
                 Owner::Device => false,
             };
             if mine {
@@ -477,15 +467,15 @@ impl Collider {
 
     /// The robot holding part `p`, if one does.
     pub fn holder(&self, p: usize) -> Option<usize> {
-        self.held.get(p).copied().flatten().map(|(r, _)| r)
+        self.world.holder(p)
     }
 
     /// Robot `r` grips part `p` at time `t`: from now on the part moves with its tool link.
     /// Pairs of the part touching at that instant are exempt until they separate.
     pub fn grip(&mut self, p: usize, r: usize, vms: &[Vm], cell: &Cell, t: i64) {
         let tool = Collider::tool_world(cell, &vms[r], r, t);
-        let pose = self.part_pose[p];
-        self.held[p] = Some((r, tool.inverse().mul(&pose)));
+        let pose = self.world.part_pose[p];
+        self.world.held[p] = Some((r, tool.inverse().mul(&pose)));
         self.dirty = true;
         self.motions_changed();
         self.exempt_touching(p, cell, vms, t);
@@ -494,11 +484,11 @@ impl Collider {
     /// Part `p` is released at time `t` and stays where it is. Pairs of the part touching
     /// at that instant are exempt until they separate.
     pub fn release(&mut self, p: usize, vms: &[Vm], cell: &Cell, t: i64) {
-        if let Some((r, offset)) = self.held[p] {
+        if let Some((r, offset)) = self.world.held[p] {
             let tool = Collider::tool_world(cell, &vms[r], r, t);
-            self.part_pose[p] = tool.mul(&offset);
+            self.world.part_pose[p] = tool.mul(&offset);
         }
-        self.held[p] = None;
+        self.world.held[p] = None;
         self.dirty = true;
         self.motions_changed();
         self.exempt_touching(p, cell, vms, t);
@@ -506,7 +496,7 @@ impl Collider {
 
     /// Exempts every checked pair of part `p`'s bodies that touches at time `t`.
     fn exempt_touching(&mut self, p: usize, cell: &Cell, vms: &[Vm], t: i64) {
-        let mut frames = self.frames.clone();
+        let mut frames = self.world.frames.clone();
         for (r, f) in frames.iter_mut().enumerate() {
             self.robot_frame_at(cell, vms, r, t, f);
         }
@@ -542,25 +532,10 @@ impl Collider {
         }
     }
 
-    /// Every robot's link frames in the cell as of the last [`Collider::check`] (which
-    /// brings all of them up to date: robots it skipped have not moved).
-    pub fn frames(&self) -> &[Vec<Iso>] {
-        &self.frames
-    }
-
-    /// Every robot's joints as of the last [`Collider::check`] (the joints its frames are
-    /// the forward kinematics of; `MAX_AXES` slots, the robot's axes first).
-    pub fn joints(&self) -> &[[f64; vworks_vm::MAX_AXES]] {
-        &self.frames_q
-    }
-
-    /// The pose of every part as of the last [`Collider::check`], into `out` (reused).
-    pub fn part_poses_into(&self, cell: &Cell, out: &mut Vec<Iso>) {
-        out.clear();
-        out.extend((0..cell.parts.len()).map(|p| match self.held[p] {
-            Some((r, offset)) => self.frames[r][cell.robots[r].model.tool_link].mul(&offset),
-            None => self.part_pose[p],
-        }));
+    /// The cell's state as of the last [`Collider::check`] (which brings every robot's
+    /// frames up to date: robots it skipped have not moved).
+    pub fn world(&self) -> &World {
+        &self.world
     }
 
     /// Checks the cell at boundary time `t`; `moving[r]` says whether robot r moves.
@@ -584,9 +559,9 @@ impl Collider {
                 Some(q) if swept => *q,
                 _ => vm.joints_at(t),
             };
-            let changed = moving[r] || q != self.frames_q[r];
+            let changed = moving[r] || q != self.world.joints[r];
             if changed {
-                self.frames_q[r] = q;
+                self.world.joints[r] = q;
             }
             any |= changed;
             if r < update.len() {
@@ -606,27 +581,29 @@ impl Collider {
             if !u {
                 continue;
             }
-            let q = &self.frames_q[r][..robot.model.dof()];
+            let q = &self.world.joints[r][..robot.model.dof()];
             robot
                 .model
-                .fk_into_from(&robot.base, q, &mut self.frames[r]);
+                .fk_into_from(&robot.base, q, &mut self.world.frames[r]);
         }
         let updated = |r: usize| r >= update.len() || update[r];
         let margin = cell.clearance;
         for (i, b) in self.bodies.iter().enumerate() {
             let owner_pose = match b.owner {
-                Owner::Link { robot, link } if updated(robot) => self.frames[robot][link].to_pose(),
+                Owner::Link { robot, link } if updated(robot) => {
+                    self.world.frames[robot][link].to_pose()
+                }
                 Owner::Device if all => cell
                     .devices
                     .iter()
                     .find(|d| d.name == b.name)
                     .map_or(Pose::IDENTITY, |d| d.pose.to_pose()),
-                Owner::Part(p) => match self.held[p] {
-                    Some((r, offset)) if updated(r) || all => self.frames[r]
+                Owner::Part(p) => match self.world.held[p] {
+                    Some((r, offset)) if updated(r) || all => self.world.frames[r]
                         [cell.robots[r].model.tool_link]
                         .mul(&offset)
                         .to_pose(),
-                    None if all => self.part_pose[p].to_pose(),
+                    None if all => self.world.part_pose[p].to_pose(),
                     _ => continue,
                 },
                 _ => continue,
@@ -815,8 +792,8 @@ impl Collider {
         }
         // A held part moves with its robot's tool link: its reach from each joint
         // (recomputed only when what is held changes).
-        sw.held_reach.resize_with(self.held.len(), Vec::new);
-        for (p, held) in self.held.iter().enumerate() {
+        sw.held_reach.resize_with(self.world.held.len(), Vec::new);
+        for (p, held) in self.world.held.iter().enumerate() {
             let holder = *held;
             if sw.held_by.get(p) == Some(&holder) {
                 continue;
@@ -854,7 +831,7 @@ impl Collider {
             sw.start.clone_from(&self.poses);
             sw.frames_ready = false;
         } else {
-            sw.frames.clone_from(&self.frames);
+            sw.frames.clone_from(&self.world.frames);
             sw.frames_ready = true;
             for r in 0..n {
                 if sw.moving[r] {
@@ -921,7 +898,7 @@ impl Collider {
     ) -> Option<(usize, &'a [(usize, f64)])> {
         match b.owner {
             Owner::Link { robot, .. } => Some((robot, &b.reach)),
-            Owner::Part(p) => match (self.held[p], held_reach.get(p)) {
+            Owner::Part(p) => match (self.world.held[p], held_reach.get(p)) {
                 (Some((r, _)), Some(reach)) => Some((r, reach.as_slice())),
                 _ => None,
             },
@@ -994,7 +971,7 @@ impl Collider {
         let (i, j) = if swapped { (j, i) } else { (i, j) };
         let robot_of = |c: &Collider, body: usize| match c.bodies[body].owner {
             Owner::Link { robot, .. } => Some(robot),
-            Owner::Part(p) => c.held[p].map(|(r, _)| r),
+            Owner::Part(p) => c.world.held[p].map(|(r, _)| r),
             Owner::Device => None,
         };
         let (ri, rj) = (robot_of(self, i), robot_of(self, j));
@@ -1005,7 +982,7 @@ impl Collider {
                 (sw.start[i], sw.start[j])
             } else {
                 if !sw.frames_ready {
-                    sw.frames.clone_from(&self.frames); // the frames at `from`
+                    sw.frames.clone_from(&self.world.frames); // the frames at `from`
                     sw.frames_ready = true;
                 }
                 for r in [ri, rj].into_iter().flatten() {
@@ -1065,9 +1042,9 @@ impl Collider {
         let owner = match b.owner {
             Owner::Link { robot, link } => frames[robot][link],
             Owner::Device => return b.fixed,
-            Owner::Part(p) => match self.held[p] {
+            Owner::Part(p) => match self.world.held[p] {
                 Some((r, offset)) => frames[r][cell.robots[r].model.tool_link].mul(&offset),
-                None => self.part_pose[p],
+                None => self.world.part_pose[p],
             },
         };
         owner.to_pose() * b.local
@@ -1081,14 +1058,14 @@ impl Collider {
     }
 
     fn is_held(&self, o: Owner) -> bool {
-        matches!(o, Owner::Part(p) if self.held[p].is_some())
+        matches!(o, Owner::Part(p) if self.world.held[p].is_some())
     }
 
     /// A held part and the tool link of the robot holding it.
     fn held_by(&self, (i, j): (usize, usize), cell: &Cell) -> bool {
         let (a, b) = (self.bodies[i].owner, self.bodies[j].owner);
         let check = |part: Owner, link: Owner| match (part, link) {
-            (Owner::Part(p), Owner::Link { robot, link }) => self.held[p]
+            (Owner::Part(p), Owner::Link { robot, link }) => self.world.held[p]
                 .is_some_and(|(r, _)| r == robot && link == cell.robots[r].model.tool_link),
             _ => false,
         };

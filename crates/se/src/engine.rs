@@ -26,164 +26,13 @@ use vworks_vm::machine::{Event, EventKind, Next, Vm, VmConfig};
 use vworks_vm::types::fmt_quantity;
 
 use crate::collide::{Collider, Contact};
-use crate::workcell::Cell;
-
-/// How the run ended.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Outcome {
-    /// Every robot's program ended and no remote work is queued.
-    Completed,
-    /// A collision with `on_collision = "stop"`.
-    Collision,
-    /// Every unfinished robot waits and no timed event is pending.
-    Deadlock,
-    /// A runtime error.
-    Error,
-    /// The `until` time was reached.
-    Until,
-    /// Stopped from outside (Ctrl-C) through [`Simulation::with_stop`].
-    Interrupted,
-}
-
-impl Outcome {
-    /// As in `run --json`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Outcome::Completed => "completed",
-            Outcome::Collision => "collision",
-            Outcome::Deadlock => "deadlock",
-            Outcome::Error => "error",
-            Outcome::Until => "until",
-            Outcome::Interrupted => "interrupted",
-        }
-    }
-}
-
-/// One line of the event trace. Recording one allocates nothing: its details are kept
-/// unformatted ([`Detail`]) and formatted on demand with the cell's names
-/// ([`TraceEvent::details`], [`TraceEvent::line`]).
-#[derive(Clone, Debug, PartialEq)]
-pub struct TraceEvent {
-    /// Time (ns).
-    pub time: i64,
-    /// Robot index, if the event belongs to one.
-    pub robot: Option<usize>,
-    /// Kind, e.g. `motion_start`.
-    pub kind: &'static str,
-    /// What the event says beyond its kind, unformatted.
-    pub detail: Detail,
-    /// Source position in the robot's program (see [`TraceEvent::file`]).
-    pub pos: Option<SrcPos>,
-}
-
-/// The details of a trace event, as recorded: indices into the cell and the robot's
-/// module rather than text, so that the hot path formats nothing.
-#[derive(Clone, Debug, PartialEq)]
-#[non_exhaustive]
-pub enum Detail {
-    /// No details.
-    None,
-    /// An event of the robot's VM, formatted with its module's names.
-    Vm(EventKind),
-    /// `check_wait` / `check_when`: the cell global whose change caused it.
-    Global(u32),
-    /// Text formatted when recorded (collisions, warnings, errors: rare).
-    Text(String),
-}
-
-/// A warning or error of the run.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Issue {
-    /// `race`, `near_miss`, `slowdown`, `runtime`, `deadlock`, …
-    pub kind: String,
-    /// The message.
-    pub message: String,
-    /// The robot, if one.
-    pub robot: Option<String>,
-    /// Source position, if known.
-    pub file: Option<String>,
-    /// Line (0 if unknown).
-    pub line: u32,
-    /// Column (0 if unknown).
-    pub col: u32,
-    /// For a near miss, how close the bodies came (m), exactly; the message rounds it.
-    pub distance_m: Option<f64>,
-}
-
-/// Time spent per robot.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct RobotStats {
-    /// Name.
-    pub name: String,
-    /// In motion.
-    pub moving_ns: i64,
-    /// Waiting (conditions, signals, joins).
-    pub waiting_ns: i64,
-    /// Neither (delays, and after the program ended).
-    pub idle_ns: i64,
-    /// In handlers: they run in zero simulated time, so always 0.
-    pub handler_ns: i64,
-    /// Motions started.
-    pub motions: u32,
-    /// When its program ended (or the run ended).
-    pub end_time_ns: i64,
-    /// How it ended: `ended`, `error`, `waiting`, `running`.
-    pub ended: String,
-}
-
-/// The value of a global.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[non_exhaustive]
-pub enum Value {
-    /// A `bool` global.
-    Bool(bool),
-    /// An `int` global.
-    Int(i64),
-    /// A `num` global, in SI units (m, rad, s, …).
-    Num(f64),
-}
-
-impl Value {
-    fn of(bits: u64, ty: Type) -> Value {
-        match ty {
-            Type::Bool => Value::Bool(bits != 0),
-            Type::Int => Value::Int(bits as i64),
-            // Globals are scalars; a wider type never reaches here.
-            _ => Value::Num(f64::from_bits(bits)),
-        }
-    }
-}
-
-/// What a run produced.
-#[derive(Clone, Debug)]
-pub struct RunResult {
-    /// How it ended.
-    pub outcome: Outcome,
-    /// Simulated end time (ns).
-    pub end_time_ns: i64,
-    /// Per robot.
-    pub robots: Vec<RobotStats>,
-    /// Collisions that started.
-    pub collisions: Vec<Contact>,
-    /// Warnings.
-    pub warnings: Vec<Issue>,
-    /// Errors (runtime errors, deadlock).
-    pub errors: Vec<Issue>,
-    /// Final values of the globals, by name, formatted with units (as `run` prints them).
-    pub globals: Vec<(String, String)>,
-    /// Final values of the globals, by name.
-    pub global_values: Vec<(String, Value)>,
-    /// The event trace.
-    pub trace: Vec<TraceEvent>,
-    /// Cycle boundaries passed and collision queries made.
-    pub cycles: u64,
-    /// Narrow-phase queries made.
-    pub queries: u64,
-    /// Messages written to the MCAP log per topic (empty without a log).
-    pub log_counts: BTreeMap<&'static str, u64>,
-    /// Why the log could not be written completely, if it could not.
-    pub log_error: Option<String>,
-}
+pub use crate::result::{Outcome, RunResult};
+use crate::sink::{RunEnd, RunSink};
+use crate::stats::Fold;
+pub use crate::stats::{Ending, RobotStats};
+use crate::trace::format_value;
+pub use crate::trace::{Detail, Issue, Kind, TraceEvent, Value};
+use vworks_cell::Cell;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Entry {
@@ -267,10 +116,8 @@ pub struct Simulation {
     signal_to: Vec<Vec<(usize, Option<u32>)>>,
     /// Remote requests each robot serves, in order: (caller, request number).
     serving: Vec<std::collections::VecDeque<(usize, u64)>>,
-    /// Open intervals per robot: motion start, wait start.
-    moving_since: Vec<Option<i64>>,
-    waiting_since: Vec<Option<i64>>,
-    stats: Vec<RobotStats>,
+    /// Time per robot, folded over the events as they are recorded.
+    fold: Fold,
     collider: Collider,
     next_boundary: i64,
     time: i64,
@@ -280,13 +127,12 @@ pub struct Simulation {
     collisions: Vec<Contact>,
     outcome: Option<Outcome>,
     cycles: u64,
-    /// The MCAP log, if one is written, and the first error writing it.
-    log: Option<crate::mcaplog::McapLog>,
+    /// Consumers of the run (the MCAP log), and the first error one of them had (a sink
+    /// that fails is dropped).
+    sinks: Vec<Box<dyn RunSink>>,
     log_error: Option<String>,
     /// Whether each robot moves at the boundary being processed (reused).
     moving: Vec<bool>,
-    /// The parts' poses at a logged boundary (reused).
-    log_parts: Vec<Iso>,
     /// Whether every robot has been queued (the first step does it).
     started: bool,
     /// Time up to which contacts between boundaries have been swept for.
@@ -316,15 +162,6 @@ pub struct Simulation {
 /// more than any program needs, few enough to stop a zero-time livelock of several
 /// robots in well under a second.
 pub const INSTANT_LIMIT: u64 = 1_000_000;
-
-fn format_value(v: u64, ty: Type) -> String {
-    match ty {
-        Type::Bool => (v != 0).to_string(),
-        Type::Int => (v as i64).to_string(),
-        Type::Num(d) => fmt_quantity(f64::from_bits(v), d),
-        _ => format!("{v:#x}"),
-    }
-}
 
 impl Simulation {
     /// A simulation of `cell` at time 0, every VM created (none has run yet).
@@ -384,14 +221,7 @@ impl Simulation {
             .iter()
             .map(|r| Arc::<str>::from(r.program.as_str()))
             .collect();
-        let stats = cell
-            .robots
-            .iter()
-            .map(|r| RobotStats {
-                name: r.name.clone(),
-                ..RobotStats::default()
-            })
-            .collect();
+        let fold = Fold::new(cell.robots.iter().map(|r| r.name.clone()).collect(), false);
         let collider = Collider::new(&cell);
         // The programs' compile and link warnings open the run's warnings (kind: the code).
         let warnings = cell
@@ -426,9 +256,7 @@ impl Simulation {
             wait_list: vec![Default::default(); cell.linked.globals.len()],
             when_list: vec![Default::default(); cell.linked.globals.len()],
             serving: vec![Default::default(); n],
-            moving_since: vec![None; n],
-            waiting_since: vec![None; n],
-            stats,
+            fold,
             collider,
             next_boundary: 0,
             time: 0,
@@ -438,13 +266,12 @@ impl Simulation {
             collisions: Vec::new(),
             outcome: None,
             cycles: 0,
-            log: None,
+            sinks: Vec::new(),
             log_error: None,
             moving: Vec::with_capacity(cell.robots.len()),
             started: false,
             swept: 0,
             sweep: true,
-            log_parts: Vec::new(),
             stop: None,
             instant: -1,
             instant_entries: 0,
@@ -459,8 +286,14 @@ impl Simulation {
     }
 
     /// Writes the run to an MCAP log (see [`crate::mcaplog`]).
-    pub fn with_log(mut self, log: crate::mcaplog::McapLog) -> Simulation {
-        self.log = Some(log);
+    pub fn with_log(self, log: crate::mcaplog::McapLog) -> Simulation {
+        self.with_sink(Box::new(log))
+    }
+
+    /// Hands every event and cycle boundary of the run to `sink` as well (see
+    /// [`RunSink`]); sinks are called in the order they were attached.
+    pub fn with_sink(mut self, sink: Box<dyn RunSink>) -> Simulation {
+        self.sinks.push(sink);
         self
     }
 
@@ -664,7 +497,7 @@ impl Simulation {
         &mut self,
         time: i64,
         robot: Option<usize>,
-        kind: &'static str,
+        kind: Kind,
         detail: Detail,
         pos: Option<SrcPos>,
     ) {
@@ -672,6 +505,7 @@ impl Simulation {
             (Some(_), Some(p)) if p.line > 0 => Some(p),
             _ => None,
         };
+        self.fold.event(time, robot, kind);
         self.trace.push(TraceEvent {
             time,
             robot,
@@ -679,29 +513,36 @@ impl Simulation {
             detail,
             pos,
         });
-        if let (Some(log), Some(e)) = (self.log.as_mut(), self.trace.last())
-            && let Err(err) = log.event(&self.cell, e)
+        if !self.sinks.is_empty()
+            && let Some(e) = self.trace.last()
         {
-            self.log_error.get_or_insert(err.to_string());
-            self.log = None;
+            let cell = &self.cell;
+            let failed = &mut self.log_error;
+            self.sinks.retain_mut(|s| match s.event(cell, e) {
+                Ok(()) => true,
+                Err(err) => {
+                    failed.get_or_insert(err);
+                    false
+                }
+            });
         }
     }
 
     /// Logs the state at boundary `b` (only when a log is written); runs after the
     /// collision check at `b`, whose link frames it reuses.
     fn log_cycle(&mut self, b: i64) {
-        let Some(log) = self.log.as_mut() else { return };
-        if !log.logs_next_boundary() {
-            log.skip_boundary();
+        if self.sinks.is_empty() {
             return;
         }
-        self.collider
-            .part_poses_into(&self.cell, &mut self.log_parts);
-        let (joints, frames) = (self.collider.joints(), self.collider.frames());
-        if let Err(err) = log.cycle(&self.cell, b, joints, frames, &self.log_parts) {
-            self.log_error.get_or_insert(err.to_string());
-            self.log = None;
-        }
+        let (cell, world) = (&self.cell, self.collider.world());
+        let failed = &mut self.log_error;
+        self.sinks.retain_mut(|s| match s.cycle(cell, b, world) {
+            Ok(()) => true,
+            Err(err) => {
+                failed.get_or_insert(err);
+                false
+            }
+        });
     }
 
     fn issue(
@@ -798,7 +639,7 @@ impl Simulation {
                 self.perform(r);
             }
             Entry::CheckWait(r, cg) => {
-                self.record(t, Some(r), "check_wait", Detail::Global(cg), None);
+                self.record(t, Some(r), Kind::CheckWait, Detail::Global(cg), None);
                 if self.vms[r].check_wait(t) {
                     // What r does next follows the set that released it.
                     self.merge_clock(r, Seen::Set(cg as usize));
@@ -806,7 +647,7 @@ impl Simulation {
                 }
             }
             Entry::CheckWhen(r, cg) => {
-                self.record(t, Some(r), "check_when", Detail::Global(cg), None);
+                self.record(t, Some(r), Kind::CheckWhen, Detail::Global(cg), None);
                 if self.vms[r].check_when(t) > 0 {
                     // The handlers it fires follow the set that made them fire.
                     self.merge_clock(r, Seen::Set(cg as usize));
@@ -819,17 +660,9 @@ impl Simulation {
 
     /// Records a collision that started; true if the run stops on it.
     fn collision_started(&mut self, contact: Contact) -> bool {
-        let d = format!(
-            "{} {} depth={} point=({:.4}, {:.4}, {:.4})",
-            contact.a,
-            contact.b,
-            fmt_quantity(contact.depth, vworks_vm::Dim::LENGTH),
-            contact.point[0],
-            contact.point[1],
-            contact.point[2]
-        );
         let t = contact.time_ns;
-        self.record(t, None, "collision_start", Detail::Text(d), None);
+        let detail = Detail::Collision(Box::new(contact.clone()));
+        self.record(t, None, Kind::CollisionStart, detail, None);
         self.collisions.push(contact);
         if self.cell.stop_on_collision {
             self.time = t;
@@ -879,13 +712,10 @@ impl Simulation {
                             return;
                         }
                     }
-                    crate::collide::CollisionEvent::End(a, bname) => self.record(
-                        b,
-                        None,
-                        "collision_end",
-                        Detail::Text(format!("{a} {bname}")),
-                        None,
-                    ),
+                    crate::collide::CollisionEvent::End(a, bname) => {
+                        let detail = Detail::CollisionEnd(Box::new((a, bname)));
+                        self.record(b, None, Kind::CollisionEnd, detail, None)
+                    }
                     crate::collide::CollisionEvent::NearMiss(a, bname, dist) => {
                         // Hundredths of a millimetre in words; the exact distance in
                         // `Issue::distance_m` (JSON, Python).
@@ -893,13 +723,15 @@ impl Simulation {
                             "near miss: {a} and {bname} come within {:.2} mm",
                             dist * 1e3
                         );
-                        self.warning(b, None, None, "near_miss", m).distance_m = Some(dist);
+                        let mut issue = self.issue("near_miss", m, None, None);
+                        issue.distance_m = Some(dist);
+                        self.add_warning(b, None, None, issue);
                     }
                 }
             }
             // With nothing queued before the next boundary and nothing moving, skip ahead.
-            // (Not when a log records every boundary.)
-            if self.log.is_none() && !self.moving.iter().any(|m| *m) {
+            // (Not when a sink records every boundary.)
+            if !self.sinks.iter().any(|s| s.records_cycles()) && !self.moving.iter().any(|m| *m) {
                 let next_event = self.queue.peek().map_or(t, |Reverse(q)| q.time).min(t);
                 if next_event > self.next_boundary {
                     let skip = (next_event - self.next_boundary) / c;
@@ -926,54 +758,28 @@ impl Simulation {
     }
 
     fn account(&mut self, r: usize, e: &Event) {
-        match &e.kind {
-            EventKind::MotionStart { .. } => {
-                // Speed bounds behind skipped collision queries change with the motion.
-                self.collider.motion_started(r);
-                self.stats[r].motions += 1;
-                self.moving_since[r] = Some(e.time);
-            }
-            EventKind::MotionEnd => {
-                if let Some(s) = self.moving_since[r].take() {
-                    self.stats[r].moving_ns += e.time - s;
-                }
-            }
-            EventKind::WaitUntil { .. } | EventKind::WaitSignal { .. } | EventKind::Join => {
-                self.waiting_since[r] = Some(e.time)
-            }
-            EventKind::WaitEnd { .. } => {
-                if let Some(s) = self.waiting_since[r].take() {
-                    self.stats[r].waiting_ns += e.time - s;
-                }
-            }
-            EventKind::End | EventKind::Error { .. } | EventKind::RemoteEnd { .. } => {
-                self.stats[r].end_time_ns = e.time;
-                // `stop` in a handler ends a motion or a wait where it is.
-                self.close_intervals(r, e.time);
-            }
-            _ => {}
-        }
-    }
-
-    /// Robot `r`'s open moving and waiting intervals end at `t`.
-    fn close_intervals(&mut self, r: usize, t: i64) {
-        if let Some(s) = self.moving_since[r].take() {
-            self.stats[r].moving_ns += t - s;
-        }
-        if let Some(s) = self.waiting_since[r].take() {
-            self.stats[r].waiting_ns += t - s;
+        if let EventKind::MotionStart { .. } = e.kind {
+            // Speed bounds behind skipped collision queries change with the motion.
+            self.collider.motion_started(r);
         }
     }
 
     fn route(&mut self, r: usize, e: &Event) {
         let t = e.time;
-        self.record(
-            t,
-            Some(r),
-            e.kind.name(),
-            Detail::Vm(e.kind.clone()),
-            Some(e.pos),
-        );
+        let detail = match e.kind {
+            // A set is recorded with the cell's global and the value it replaces.
+            EventKind::Set { global, value, .. } => {
+                let cg = self.cell.linked.robots[r].globals[global as usize];
+                let old = self.globals[cg as usize].0;
+                Detail::Set {
+                    global: cg,
+                    old,
+                    new: value,
+                }
+            }
+            _ => Detail::Vm(e.kind.clone()),
+        };
+        self.record(t, Some(r), Kind::of(&e.kind), detail, Some(e.pos));
         match &e.kind {
             EventKind::Set { global, value, .. } => self.on_set(r, *global, *value, t, e.pos),
             EventKind::WaitUntil { cond, .. } => {
@@ -1186,7 +992,6 @@ impl Simulation {
     /// an `error` event at the statement, and the run stops.
     fn runtime_error(&mut self, r: usize, t: i64, pos: SrcPos, message: String) {
         self.error(t, Some(r), Some(pos), "runtime", message);
-        self.stats[r].end_time_ns = t;
         self.vms[r].halt();
         self.outcome = Some(Outcome::Error);
     }
@@ -1261,8 +1066,7 @@ impl Simulation {
         self.warning(t, Some(r), Some(pos), "race", m);
     }
 
-    /// A `warning` trace event (the message quoted) and the run's warning of `kind`;
-    /// returns the warning, for details beyond the message.
+    /// A `warning` trace event and the run's warning of `kind`.
     fn warning(
         &mut self,
         t: i64,
@@ -1270,18 +1074,15 @@ impl Simulation {
         pos: Option<SrcPos>,
         kind: &str,
         message: String,
-    ) -> &mut Issue {
-        self.record(
-            t,
-            robot,
-            "warning",
-            Detail::Text(format!("{message:?}")),
-            pos,
-        );
+    ) {
         let issue = self.issue(kind, message, robot, pos);
-        self.warnings.push(issue);
-        let last = self.warnings.len() - 1;
-        &mut self.warnings[last]
+        self.add_warning(t, robot, pos, issue);
+    }
+
+    /// A `warning` trace event and the run's warning `issue`.
+    fn add_warning(&mut self, t: i64, robot: Option<usize>, pos: Option<SrcPos>, issue: Issue) {
+        self.warnings.push(issue.clone());
+        self.record(t, robot, Kind::Warning, Detail::Issue(Box::new(issue)), pos);
     }
 
     /// An `error` trace event (the message quoted) and the run's error of `kind`. The
@@ -1294,9 +1095,9 @@ impl Simulation {
         kind: &str,
         message: String,
     ) {
-        self.record(t, robot, "error", Detail::Text(format!("{message:?}")), pos);
         let issue = self.issue(kind, message, robot, pos);
-        self.errors.push(issue);
+        self.errors.push(issue.clone());
+        self.record(t, robot, Kind::Error, Detail::Issue(Box::new(issue)), pos);
     }
 
     /// The globals robot `r`'s last segment read at this instant: a race with a set of
@@ -1416,25 +1217,17 @@ impl Simulation {
 
     fn finish(mut self) -> RunResult {
         let end = self.time;
-        for r in 0..self.vms.len() {
-            self.close_intervals(r, end);
-            let st = &mut self.stats[r];
-            st.ended = match self.vms[r].next_event() {
-                Next::Idle => "ended".into(),
-                Next::Done => "error".into(),
-                Next::Blocked => "waiting".into(),
-                Next::Event(_) => "running".into(),
-            };
-            if st.end_time_ns == 0 || st.ended != "ended" {
-                st.end_time_ns = if st.ended == "ended" {
-                    st.end_time_ns
-                } else {
-                    end
-                };
-            }
-            st.idle_ns = (end - st.moving_ns - st.waiting_ns).max(0);
-        }
-        let global_values = self
+        let endings: Vec<Ending> = (0..self.vms.len())
+            .map(|r| match self.vms[r].next_event() {
+                Next::Idle => Ending::Ended,
+                Next::Done => Ending::Error,
+                Next::Blocked => Ending::Waiting,
+                Next::Event(_) => Ending::Running,
+            })
+            .collect();
+        let fold = std::mem::replace(&mut self.fold, Fold::new(Vec::new(), false));
+        let (robots, _) = fold.finish(end, &|r| endings.get(r).copied());
+        let global_values: Vec<(String, Value)> = self
             .global_values()
             .into_iter()
             .map(|(n, v)| (n.to_string(), v))
@@ -1447,21 +1240,27 @@ impl Simulation {
             .zip(&self.globals)
             .map(|(g, (v, ty))| (g.name.clone(), format_value(*v, *ty)))
             .collect();
+        let outcome = self.outcome.unwrap_or(Outcome::Completed);
+        let run_end = RunEnd {
+            outcome,
+            end_time_ns: end,
+            robots: &robots,
+        };
         let mut log_counts = BTreeMap::new();
-        if let Some(log) = self.log.take() {
-            match log.finish() {
-                Ok(c) => log_counts = c,
+        for mut sink in std::mem::take(&mut self.sinks) {
+            match sink.finish(&run_end) {
+                Ok(c) => log_counts.extend(c),
                 Err(e) => {
-                    self.log_error.get_or_insert(e.to_string());
+                    self.log_error.get_or_insert(e);
                 }
             }
         }
         RunResult {
             log_counts,
             log_error: self.log_error,
-            outcome: self.outcome.unwrap_or(Outcome::Completed),
+            outcome,
             end_time_ns: end,
-            robots: self.stats,
+            robots,
             collisions: self.collisions,
             warnings: self.warnings,
             errors: self.errors,
@@ -1471,113 +1270,6 @@ impl Simulation {
             cycles: self.cycles,
             queries: self.collider.queries,
         }
-    }
-}
-
-impl TraceEvent {
-    /// The details as trace lines show them (empty when there are none).
-    pub fn details(&self, cell: &Cell) -> String {
-        match &self.detail {
-            Detail::None => String::new(),
-            Detail::Vm(kind) => self
-                .robot
-                .and_then(|r| cell.robots.get(r))
-                .map_or_else(String::new, |robot| vm_details(kind, &robot.module)),
-            Detail::Global(g) => cell
-                .linked
-                .globals
-                .get(*g as usize)
-                .map_or_else(String::new, |g| g.name.clone()),
-            Detail::Text(text) => text.clone(),
-        }
-    }
-
-    /// The program file the source position refers to (the robot's program).
-    pub fn file<'c>(&self, cell: &'c Cell) -> Option<&'c str> {
-        self.pos?;
-        self.robot
-            .and_then(|r| cell.robots.get(r))
-            .map(|r| r.program.as_str())
-    }
-
-    /// The trace line: `time_ns robot kind details file:line:col`, `-` for empty fields.
-    pub fn line(&self, cell: &Cell) -> String {
-        let robot = self
-            .robot
-            .map_or("-".to_string(), |r| cell.robots[r].name.clone());
-        let mut details = self.details(cell);
-        if details.is_empty() {
-            details.push('-');
-        }
-        let pos = match (self.file(cell), self.pos) {
-            (Some(f), Some(p)) => {
-                let rel = std::path::Path::new(f)
-                    .file_name()
-                    .map_or(f.to_string(), |n| n.to_string_lossy().into_owned());
-                format!("{rel}:{}:{}", p.line, p.col)
-            }
-            _ => "-".to_string(),
-        };
-        format!("{} {robot} {} {details} {pos}", self.time, self.kind)
-    }
-}
-
-/// A VM event's details as trace lines show them, with the names of module `m`.
-fn vm_details(kind: &EventKind, m: &vworks_vm::bytecode::Module) -> String {
-    match kind {
-        EventKind::MotionStart {
-            command,
-            duration_ns,
-        } => format!("{command} duration={duration_ns}"),
-        EventKind::Delay { duration_ns } => format!("duration={duration_ns}"),
-        EventKind::Set { global, value, ty } => format!(
-            "{}={}",
-            m.str(m.globals[*global as usize].name),
-            format_value(*value, *ty)
-        ),
-        EventKind::WaitUntil { cond, deadline } => {
-            let names: Vec<&str> = m.conds[*cond as usize]
-                .globals
-                .iter()
-                .map(|g| m.str(m.globals[*g as usize].name))
-                .collect();
-            format!(
-                "condition({}){}",
-                names.join(","),
-                deadline.map_or(String::new(), |d| format!(" deadline={d}"))
-            )
-        }
-        EventKind::WaitSignal { name, deadline } => format!(
-            "signal={}{}",
-            m.str(*name),
-            deadline.map_or(String::new(), |d| format!(" deadline={d}"))
-        ),
-        EventKind::WaitEnd { timed_out } => {
-            (if *timed_out { "timeout" } else { "released" }).into()
-        }
-        EventKind::Signal { site } => {
-            let s = &m.signals_sent[*site as usize];
-            format!("{}.{}", m.str(s.robot), m.str(s.name))
-        }
-        EventKind::Grip { site } | EventKind::Release { site } => {
-            m.str(m.parts[*site as usize].part).to_string()
-        }
-        EventKind::Log { text } => format!("{text:?}"),
-        EventKind::Error { message } => format!("{message:?}"),
-        EventKind::EnableWhen { handler }
-        | EventKind::WhenFire { handler }
-        | EventKind::WhenEnd { handler } => m
-            .str(m.procs[m.handlers[*handler as usize].target as usize].name)
-            .to_string(),
-        EventKind::DisableWhen { proc } => m.str(m.procs[*proc as usize].name).to_string(),
-        EventKind::RemoteCall { site, .. } => {
-            let s = &m.remotes[*site as usize];
-            format!("{}.{}", m.str(s.robot), m.str(s.proc))
-        }
-        EventKind::RemoteStart { proc } | EventKind::RemoteEnd { proc } => {
-            m.str(m.procs[*proc as usize].name).to_string()
-        }
-        _ => String::new(),
     }
 }
 

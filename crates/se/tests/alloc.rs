@@ -22,7 +22,7 @@ fn four_arms_run_for_thousands_of_cycles_without_allocating() {
         .lock()
         .unwrap_or_else(std::sync::PoisonError::into_inner);
     let cell = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../bench/cells/grid4/cell.toml");
-    let cell = Arc::new(vworks_se::workcell::load(&cell).unwrap());
+    let cell = Arc::new(vworks_cell::load(&cell).unwrap());
     let mut sim = vworks_se::engine::Simulation::new(cell);
     // Warm up: the first motions, scratch buffers sized.
     sim.advance_to(3_000_000_000);
@@ -66,7 +66,7 @@ fn a_ring_of_robots_handing_a_global_round_allocates_nothing_per_event() {
         );
     }
     std::fs::write(dir.join("cell.toml"), toml).unwrap();
-    let cell = Arc::new(vworks_se::workcell::load(&dir.join("cell.toml")).unwrap());
+    let cell = Arc::new(vworks_cell::load(&dir.join("cell.toml")).unwrap());
     let _ = std::fs::remove_dir_all(&dir);
     let mut sim = vworks_se::engine::Simulation::new(cell);
     for _ in 0..5_000 {

@@ -6,8 +6,10 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
+use vworks_cell::{Cell, CellError, load};
+use vworks_se::engine::Ending;
 use vworks_se::engine::{Outcome, RunResult, Simulation};
-use vworks_se::workcell::{Cell, CellError, load};
+use vworks_se::trace::Kind;
 
 /// Writes the files into a fresh directory and returns the path of `cell.toml`.
 fn write_cell(name: &str, files: &[(&str, &str)]) -> PathBuf {
@@ -397,8 +399,8 @@ allow_collision = [["r1.tool0", "block"], ["r1.link_6", "block"]]
     let kinds: Vec<(&str, String)> = r
         .trace
         .iter()
-        .filter(|e| e.kind.starts_with("collision"))
-        .map(|e| (e.kind, e.details(&cell)))
+        .filter(|e| matches!(e.kind, Kind::CollisionStart | Kind::CollisionEnd))
+        .map(|e| (e.kind.name(), e.details(&cell)))
         .collect();
     // Only the carried block (gripped 200 mm away from the post) meets the post: it starts
     // touching, and stops when it has passed.
@@ -426,5 +428,5 @@ fn until_stops_the_run_at_that_time() {
     assert_eq!(r.end_time_ns, 1_500_000_000);
     // b's 180° move at 90°/s takes 2.3 s: at 1.5 s it is still moving.
     assert_eq!(r.robots[1].moving_ns, 1_500_000_000);
-    assert_eq!(r.robots[1].ended, "running");
+    assert_eq!(r.robots[1].ended, Ending::Running);
 }

@@ -9,8 +9,9 @@ use std::sync::Arc;
 
 use expect_test::expect_file;
 use proptest::prelude::*;
+use vworks_cell::{Cell, load};
 use vworks_se::engine::{Outcome, RunResult, Simulation};
-use vworks_se::workcell::{Cell, load};
+use vworks_se::trace::Kind;
 
 const EXAMPLES: &[(&str, Outcome)] = &[
     ("handoff", Outcome::Completed),
@@ -47,7 +48,7 @@ fn per_robot(cell: &Cell, r: &RunResult) -> BTreeMap<String, Vec<(i64, String, S
     let mut m: BTreeMap<String, Vec<(i64, String, String)>> = BTreeMap::new();
     for e in &r.trace {
         if let Some(i) = e.robot
-            && !matches!(e.kind, "check_wait" | "check_when")
+            && !matches!(e.kind, Kind::CheckWait | Kind::CheckWhen)
         {
             m.entry(cell.robots[i].name.clone()).or_default().push((
                 e.time,

@@ -9,10 +9,11 @@ use std::sync::Arc;
 
 use foxglove::messages::FrameTransforms;
 use prost::Message as _;
+use vworks_cell::{Cell, load};
 use vworks_model::math::Iso;
 use vworks_se::engine::{Outcome, RunResult, Simulation};
 use vworks_se::mcaplog::{Encoding, LogOptions, McapLog};
-use vworks_se::workcell::{Cell, load};
+use vworks_se::trace::Kind;
 
 /// `vworks.CycleState` as the log's descriptor defines it (the descriptor itself is checked
 /// in the unit tests and, independently, by the Python tests).
@@ -204,7 +205,7 @@ fn thinning_keeps_every_event_and_every_nth_state() {
 #[test]
 fn the_cell_and_its_programs_are_attached() {
     let cell = Arc::new(load(&root().join("workcells/handoff/cell.toml")).unwrap());
-    let (_, bytes) = run_logged(&cell, 100, Some(1_000_000_000), "attach");
+    let (r, bytes) = run_logged(&cell, 100, Some(1_000_000_000), "attach");
     let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
     let names: Vec<String> = summary
         .attachment_indexes
@@ -219,8 +220,21 @@ fn the_cell_and_its_programs_are_attached() {
         .collect();
     assert_eq!(names, ["cell.toml", "r1.wsl", "r2.wsl"]);
     let meta = &summary.metadata_indexes;
-    assert_eq!(meta.len(), 1);
-    assert_eq!(meta[0].name, "vworks");
+    let names: Vec<&str> = meta.iter().map(|m| m.name.as_str()).collect();
+    assert_eq!(names, ["vworks", "vworks_result"]);
+    // The run's result closes the log: outcome, end time, each robot's ending, as the
+    // run itself gave them.
+    let log = vworks_se::mcaplog::read_log_bytes("attach.mcap", &bytes).unwrap();
+    assert_eq!(log.metadata["log_version"], "2");
+    assert_eq!(log.result["outcome"], "until");
+    assert_eq!(log.result["end_time_ns"], "1000000000");
+    let ended: Vec<String> = r
+        .robots
+        .iter()
+        .map(|s| format!("{}={}", s.name, s.ended.name()))
+        .collect();
+    assert_eq!(log.result["ended"], ended.join(","));
+    assert_eq!(log.result["ended"], "r1=running,r2=waiting");
 }
 
 #[test]
@@ -608,14 +622,14 @@ fn bodies_turn_red_while_they_touch() {
     let changes: Vec<(i64, bool, String, String)> = r
         .trace
         .iter()
-        .filter(|e| matches!(e.kind, "collision_start" | "collision_end"))
+        .filter(|e| matches!(e.kind, Kind::CollisionStart | Kind::CollisionEnd))
         .map(|e| {
             let details = e.details(&cell);
             let mut n = details.split(' ');
             let (a, b) = (n.next().unwrap(), n.next().unwrap());
             (
                 e.time,
-                e.kind == "collision_start",
+                e.kind == Kind::CollisionStart,
                 a.to_string(),
                 b.to_string(),
             )

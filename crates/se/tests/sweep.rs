@@ -8,8 +8,9 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
+use vworks_cell::load;
 use vworks_se::engine::{Outcome, RunResult, Simulation};
-use vworks_se::workcell::load;
+use vworks_se::trace::Kind;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -105,8 +106,8 @@ pose = { xyz = ["610mm", "0mm", "500mm"] }
     let kinds: Vec<(i64, &str)> = r
         .trace
         .iter()
-        .filter(|e| e.kind.starts_with("collision"))
-        .map(|e| (e.time, e.kind))
+        .filter(|e| matches!(e.kind, Kind::CollisionStart | Kind::CollisionEnd))
+        .map(|e| (e.time, e.kind.name()))
         .collect();
     assert_eq!(
         kinds,

@@ -25,6 +25,7 @@ pub mod link;
 mod lower;
 pub mod parser;
 pub mod syntax;
+pub mod units;
 
 pub use diag::{Code, Diagnostic, Severity, Sources, render};
 pub use vworks_vm::Module;

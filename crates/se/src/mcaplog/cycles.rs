@@ -21,7 +21,7 @@ use vworks_model::model::RobotModel;
 use vworks_vm::MAX_AXES;
 
 use super::{Encoding, KEYFRAME_NS, json, proto};
-use crate::workcell::Cell;
+use vworks_cell::Cell;
 
 /// Bytes of one pose in a cycle record: rotation (9) and translation (3), f64 each.
 const POSE_BYTES: usize = 12 * 8;

@@ -6,7 +6,7 @@ use vworks_model::math::Iso;
 
 use super::proto::quat;
 
-pub(crate) const EVENT_SCHEMA: &str = r#"{"title":"vworks.Event","type":"object","properties":{"time_ns":{"type":"integer"},"robot":{"type":["string","null"]},"kind":{"type":"string"},"details":{"type":"string"},"file":{"type":["string","null"]},"line":{"type":"integer"},"col":{"type":"integer"}}}"#;
+pub(crate) const EVENT_SCHEMA: &str = r#"{"title":"vworks.Event","type":"object","properties":{"time_ns":{"type":"integer"},"robot":{"type":["string","null"]},"kind":{"type":"string"},"details":{"type":"string"},"file":{"type":["string","null"]},"line":{"type":"integer"},"col":{"type":"integer"},"data":{"type":["object","null"],"description":"the details, typed by kind (docs/log.md)"}}}"#;
 pub(crate) const STATE_SCHEMA: &str = r#"{"title":"vworks.CycleState","type":"object","properties":{"time_ns":{"type":"integer"},"cycle":{"type":"integer"},"robots":{"type":"array","items":{"type":"object","properties":{"name":{"type":"string"},"joints":{"type":"array","items":{"type":"number"}},"tcp":{"type":"object","properties":{"position":{"type":"object"},"orientation":{"type":"object"}}}}}}}}"#;
 const TIME: &str = r#"{"type":"object","properties":{"sec":{"type":"integer","minimum":0},"nsec":{"type":"integer","minimum":0}}}"#;
 const VEC3: &str = r#"{"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"},"z":{"type":"number"}}}"#;

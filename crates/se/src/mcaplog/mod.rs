@@ -3,7 +3,8 @@
 //!
 //! Topics (chunked and zstd-compressed; see `docs/log.md`):
 //! - `/events` (`vworks.Event`, JSON): one message per event — time, robot, kind,
-//!   details, source position — the same content as a trace line.
+//!   details text, source position, and the typed details (`data`,
+//!   [`crate::trace::Data`]) — written from and read back into [`crate::trace::Event`].
 //! - `/state` (`vworks.CycleState`, protobuf by default): per cycle boundary (every
 //!   `every`-th), every robot's joints and TCP.
 //! - `/tf` (`foxglove.FrameTransforms`, protobuf by default): per logged boundary, the
@@ -16,7 +17,9 @@
 //! - `/log` (`foxglove.Log`, JSON): `log` output, warnings and errors.
 //!
 //! The workcell file, every program source, every URDF and every mesh are attachments;
-//! `vworks` metadata holds the version, the cell name, the cycle and the seed.
+//! `vworks` metadata holds the version, the cell name, the cycle and the seed, and
+//! `vworks_result` metadata, written at the end, the outcome, the end time and how each
+//! robot ended ([`RESULT_METADATA`]).
 //!
 //! The simulation's thread only appends records to batches: per logged boundary the
 //! joints, TCPs and part poses, per event its JSON message. The log's writer thread
@@ -41,10 +44,24 @@ use std::sync::{Arc, OnceLock};
 use foxglove::messages::FrameTransforms;
 use vworks_model::math::Iso;
 
-pub use read::{LogContents, LoggedEvent, read_log, read_log_bytes};
+pub use read::{LogContents, read_log, read_log_bytes};
 
-use crate::engine::TraceEvent;
-use crate::workcell::Cell;
+use crate::sink::{RunEnd, RunSink};
+use crate::trace::{Data, Kind, TraceEvent};
+use crate::world::World;
+use vworks_cell::Cell;
+
+/// An event as a log holds it: the run's typed event with names.
+pub type LoggedEvent = crate::trace::Event;
+
+/// The version of the log's layout and `/events` schema, in the `vworks` metadata as
+/// `log_version`: 2 since events carry typed `data` and the log ends with
+/// [`RESULT_METADATA`]; logs without it are version 1 (read too, without typed data).
+pub const LOG_VERSION: u32 = 2;
+
+/// The name of the metadata record written at the end of a run: `outcome`,
+/// `end_time_ns`, and `ended`, each robot's ending (`r1=ended,r2=waiting`).
+pub const RESULT_METADATA: &str = "vworks_result";
 
 /// Why the log could not be written.
 #[derive(Debug, thiserror::Error)]
@@ -151,6 +168,8 @@ pub struct McapLog {
     file: String,
     every: u64,
     boundary: u64,
+    /// The parts' poses at a logged boundary (reused).
+    parts: Vec<Iso>,
 }
 
 /// How the per-cycle topics `/state` and `/tf` are encoded. `docs/log.md` has the
@@ -261,6 +280,7 @@ fn open(
         "vworks_version".to_string(),
         env!("CARGO_PKG_VERSION").to_string(),
     );
+    meta.insert("log_version".to_string(), LOG_VERSION.to_string());
     meta.insert("cell".to_string(), cell.name.clone());
     meta.insert("cycle_ns".to_string(), cell.cycle_ns.to_string());
     meta.insert("workcell_file".to_string(), cell.file.display().to_string());
@@ -352,6 +372,7 @@ impl McapLog {
             file,
             every: options.every.max(1),
             boundary: 0,
+            parts: Vec::new(),
         })
     }
 
@@ -376,29 +397,25 @@ impl McapLog {
     /// Logs an event (and, for `log`, `warning` and `error`, a Foxglove log message); on
     /// `collision_start`/`collision_end` the two bodies change colour.
     pub(crate) fn event(&mut self, cell: &Cell, e: &TraceEvent) -> Result<(), LogError> {
-        let robot = e.robot.map(|r| cell.robots[r].name.clone());
-        let file = e.file(cell);
-        let (line, col) = e.pos.map_or((0, 0), |p| (p.line, p.col));
-        let details = e.details(cell);
-        let v = serde_json::json!({"time_ns": e.time, "robot": robot, "kind": e.kind, "details": details, "file": file, "line": line, "col": col});
-        self.write(EVENTS, e.time, &v)?;
+        let ev = e.resolve(cell);
+        self.write(EVENTS, e.time, &ev.to_json())?;
         let level = match e.kind {
-            "log" => Some(2),
-            "warning" => Some(3),
-            "error" => Some(4),
+            Kind::Log => Some(2),
+            Kind::Warning => Some(3),
+            Kind::Error => Some(4),
             _ => None,
         };
         if let Some(level) = level {
-            let v = serde_json::json!({"timestamp": scene::ts(e.time), "level": level, "message": details.trim_matches('"'), "name": robot.unwrap_or_else(|| "cell".into()), "file": file.unwrap_or_default(), "line": line});
+            let message = match &ev.data {
+                Data::Text { text } => text.as_str(),
+                Data::Issue { message, .. } => message.as_str(),
+                _ => ev.details.as_str(),
+            };
+            let v = serde_json::json!({"timestamp": scene::ts(e.time), "level": level, "message": message, "name": ev.robot.as_deref().unwrap_or("cell"), "file": ev.file.as_deref().unwrap_or_default(), "line": ev.line});
             self.write(LOG, e.time, &v)?;
         }
-        if matches!(e.kind, "collision_start" | "collision_end") {
-            let mut names = details.split(' ');
-            let (a, b) = (
-                names.next().unwrap_or_default(),
-                names.next().unwrap_or_default(),
-            );
-            let on = e.kind == "collision_start";
+        if let Data::Collision { a, b, .. } = &ev.data {
+            let on = e.kind == Kind::CollisionStart;
             self.sink
                 .colour(e.time.max(0) as u64, on, a, b)
                 .map_err(|reason| self.failed(reason))?;
@@ -438,12 +455,64 @@ impl McapLog {
             .map_err(|reason| self.failed(reason))
     }
 
+    /// Records how the run ended ([`RESULT_METADATA`]).
+    fn result(&mut self, end: &RunEnd<'_>) -> Result<(), LogError> {
+        let ended: Vec<String> = end
+            .robots
+            .iter()
+            .map(|r| format!("{}={}", r.name, r.ended.name()))
+            .collect();
+        let map = BTreeMap::from([
+            ("outcome".to_string(), end.outcome.name().to_string()),
+            ("end_time_ns".to_string(), end.end_time_ns.to_string()),
+            ("ended".to_string(), ended.join(",")),
+        ]);
+        self.sink
+            .metadata(RESULT_METADATA, &map)
+            .map_err(|reason| self.failed(reason))
+    }
+
     /// Finishes the file: summary, indexes, CRCs. Returns the counts per topic.
     pub fn finish(mut self) -> Result<BTreeMap<&'static str, u64>, LogError> {
         let counts = self.sink.finish().map_err(|reason| LogError::Io {
             file: self.file.clone(),
             reason,
         })?;
+        Ok(TOPICS.iter().copied().zip(counts).collect())
+    }
+}
+
+impl RunSink for McapLog {
+    fn event(&mut self, cell: &Cell, e: &TraceEvent) -> Result<(), String> {
+        McapLog::event(self, cell, e).map_err(|e| e.to_string())
+    }
+
+    fn cycle(&mut self, cell: &Cell, t: i64, world: &World) -> Result<(), String> {
+        if !self.logs_next_boundary() {
+            self.skip_boundary();
+            return Ok(());
+        }
+        let mut parts = std::mem::take(&mut self.parts);
+        world.part_poses_into(cell, &mut parts);
+        let done = McapLog::cycle(self, cell, t, world.joints(), world.frames(), &parts);
+        self.parts = parts;
+        done.map_err(|e| e.to_string())
+    }
+
+    fn records_cycles(&self) -> bool {
+        true
+    }
+
+    fn finish(&mut self, end: &RunEnd<'_>) -> Result<BTreeMap<&'static str, u64>, String> {
+        let recorded = self.result(end);
+        let counts = self.sink.finish().map_err(|reason| {
+            LogError::Io {
+                file: self.file.clone(),
+                reason,
+            }
+            .to_string()
+        })?;
+        recorded.map_err(|e| e.to_string())?;
         Ok(TOPICS.iter().copied().zip(counts).collect())
     }
 }

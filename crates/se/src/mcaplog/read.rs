@@ -1,58 +1,11 @@
-//! Reading a log back: its topics, message counts and simulated span, and its events as
-//! trace lines. A log cut short (the run was killed) is read up to the damage, and the
+//! Reading a log back: its topics, message counts and simulated span, its metadata and
+//! its events, decoded into the run's typed events ([`crate::trace::Event`]). A log cut short (the run was killed) is read up to the damage, and the
 //! damage is reported beside what was read.
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use super::LogError;
-
-/// An event as logged on `/events`.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct LoggedEvent {
-    /// Simulated time (ns).
-    pub time_ns: i64,
-    /// The robot, if the event belongs to one.
-    pub robot: Option<String>,
-    /// Kind, e.g. `motion_start`.
-    pub kind: String,
-    /// Details (may be empty).
-    pub details: String,
-    /// The WSL source file, if known.
-    pub file: Option<String>,
-    /// Line and column (0 if unknown).
-    pub line: u32,
-    /// Column (0 if unknown).
-    pub col: u32,
-}
-
-impl LoggedEvent {
-    /// `file:line:col` with the file's name only, if the event has a source position.
-    pub fn position(&self) -> Option<String> {
-        let f = self.file.as_ref()?;
-        let name = Path::new(f)
-            .file_name()
-            .map_or(f.clone(), |n| n.to_string_lossy().into_owned());
-        Some(format!("{name}:{}:{}", self.line, self.col))
-    }
-
-    /// The event as a trace line, `time_ns robot kind details file:line:col` with `-` for
-    /// an empty field and the file's name only: the golden traces' format.
-    pub fn line(&self) -> String {
-        let details = if self.details.is_empty() {
-            "-"
-        } else {
-            &self.details
-        };
-        let pos = self.position().unwrap_or_else(|| "-".into());
-        format!(
-            "{} {} {} {details} {pos}",
-            self.time_ns,
-            self.robot.as_deref().unwrap_or("-"),
-            self.kind
-        )
-    }
-}
+use super::{LogError, LoggedEvent, RESULT_METADATA};
 
 /// What a log holds.
 #[derive(Clone, Debug, Default)]
@@ -69,6 +22,10 @@ pub struct LogContents {
     /// The `vworks` metadata record: the version, the cell's name, its robots (comma
     /// separated), the cycle, the workcell file (empty if the record was not found).
     pub metadata: BTreeMap<String, String>,
+    /// The `vworks_result` metadata record ([`RESULT_METADATA`]): the outcome, the end
+    /// time and each robot's ending (empty if the run did not finish the log, or for
+    /// logs of version 1).
+    pub result: BTreeMap<String, String>,
 }
 
 /// Reads the log at `path`.
@@ -165,10 +122,12 @@ fn scan(
             }
             // The run's metadata (its lengths fit: safe to parse).
             op::METADATA => {
-                if let Ok(mcap::records::Record::Metadata(m)) = mcap::parse_record(opcode, data)
-                    && m.name == "vworks"
-                {
-                    out.metadata = m.metadata;
+                if let Ok(mcap::records::Record::Metadata(m)) = mcap::parse_record(opcode, data) {
+                    if m.name == "vworks" {
+                        out.metadata = m.metadata;
+                    } else if m.name == RESULT_METADATA {
+                        out.result = m.metadata;
+                    }
                 }
             }
             // Message: channel id u16, sequence u32, log time u64, publish time u64, data.
@@ -189,18 +148,13 @@ fn scan(
                     let payload = data.get(22..).unwrap_or_default();
                     let v: serde_json::Value = serde_json::from_slice(payload)
                         .map_err(|e| invalid(format!("an event is not JSON: {e}")))?;
-                    let text = |k: &str| v[k].as_str().map(str::to_string);
-                    let int =
-                        |k: &str| u32::try_from(v[k].as_u64().unwrap_or(0)).unwrap_or(u32::MAX);
-                    out.events.push(LoggedEvent {
-                        time_ns: v["time_ns"].as_i64().unwrap_or(0),
-                        robot: text("robot"),
-                        kind: text("kind").unwrap_or_else(|| "?".into()),
-                        details: text("details").unwrap_or_default(),
-                        file: text("file"),
-                        line: int("line"),
-                        col: int("col"),
-                    });
+                    let event = LoggedEvent::from_json(&v).map_err(|why| {
+                        invalid(format!(
+                            "event {}: {why}; was it written by a newer vworks?",
+                            out.events.len()
+                        ))
+                    })?;
+                    out.events.push(event);
                 }
             }
             _ => {}

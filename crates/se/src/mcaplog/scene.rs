@@ -7,7 +7,7 @@ use vworks_model::math::Iso;
 use vworks_model::model::Geometry;
 
 use super::proto;
-use crate::workcell::Cell;
+use vworks_cell::Cell;
 
 /// A body of the scene: its frame and primitives.
 pub(crate) struct SceneBody {

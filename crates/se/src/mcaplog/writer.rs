@@ -11,7 +11,9 @@
 //!   ([`super::cycles::append_cycle`]), from which the thread's [`CycleEncoder`] builds
 //!   `/state` and `/tf`;
 //! - [`COLOUR`]: on (u8), the lengths (u16) of two frame names and the names: a collision
-//!   started or ended, and the thread publishes the two bodies' new colour on `/scene`.
+//!   started or ended, and the thread publishes the two bodies' new colour on `/scene`;
+//! - [`METADATA`]: the length (u32) and a JSON object `{"name": …, "metadata": {…}}`,
+//!   written as an MCAP metadata record (the run's result, at its end).
 //!
 //! All integers little-endian. A bounded channel carries full batches to the thread
 //! (back-pressure: the simulation waits when the writer is [`QUEUED_BATCHES`] behind) and a
@@ -44,6 +46,8 @@ const MESSAGE: u8 = 0;
 const CYCLE: u8 = 1;
 /// Record tag: two bodies change colour.
 const COLOUR: u8 = 2;
+/// Record tag: a metadata record.
+const METADATA: u8 = 3;
 
 /// Messages written per topic, indexed like [`TOPICS`].
 pub(crate) type Counts = [u64; TOPICS.len()];
@@ -162,6 +166,21 @@ impl Sink {
             .extend_from_slice(&(b.len() as u16).to_le_bytes());
         self.batch.extend_from_slice(a);
         self.batch.extend_from_slice(b);
+        self.ship_if_full()
+    }
+
+    /// Appends a metadata record `name` holding `map`.
+    pub(crate) fn metadata(
+        &mut self,
+        name: &str,
+        map: &std::collections::BTreeMap<String, String>,
+    ) -> Result<(), String> {
+        let json = serde_json::json!({"name": name, "metadata": map}).to_string();
+        let len = u32::try_from(json.len()).map_err(|_| "the run's metadata is too large")?;
+        self.batch.push(METADATA);
+        self.batch.extend_from_slice(&0u64.to_le_bytes());
+        self.batch.extend_from_slice(&len.to_le_bytes());
+        self.batch.extend_from_slice(json.as_bytes());
         self.ship_if_full()
     }
 
@@ -295,6 +314,24 @@ fn write_batches<W: Write + Seek>(
                     scene.colour(&a, &b, on);
                     out.scene(&scene, time, Some(&[a.as_str(), b.as_str()]))?;
                 }
+                METADATA => {
+                    let head = take(&mut rest, 4)?;
+                    let len = u32::from_le_bytes([head[0], head[1], head[2], head[3]]) as usize;
+                    let v: serde_json::Value = serde_json::from_slice(take(&mut rest, len)?)
+                        .map_err(|e| format!("internal error: metadata: {e}"))?;
+                    let metadata = v["metadata"]
+                        .as_object()
+                        .map(|m| {
+                            m.iter()
+                                .map(|(k, v)| (k.clone(), v.as_str().unwrap_or("").to_string()))
+                                .collect()
+                        })
+                        .unwrap_or_default();
+                    let name = v["name"].as_str().unwrap_or("vworks_result").to_string();
+                    out.mcap
+                        .write_metadata(&mcap::records::Metadata { name, metadata })
+                        .map_err(|e| super::error_chain(&e))?;
+                }
                 _ => {
                     let head = take(&mut rest, 5)?;
                     let topic = usize::from(head[0]);
@@ -391,7 +428,7 @@ mod tests {
 
     #[test]
     fn a_write_error_in_the_thread_reaches_the_simulation() {
-        let cell = crate::workcell::load(
+        let cell = vworks_cell::load(
             &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
                 .join("../../workcells/handoff/cell.toml"),
         )
@@ -436,7 +473,7 @@ mod tests {
 
     #[test]
     fn records_come_out_in_order_with_their_counts() {
-        let cell = crate::workcell::load(
+        let cell = vworks_cell::load(
             &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
                 .join("../../workcells/track/cell.toml"),
         )

@@ -253,24 +253,9 @@ impl Ctx<'_> {
         match v {
             toml::Value::Integer(i) => Ok(*i as f64),
             toml::Value::Float(x) if x.is_finite() => Ok(*x),
-            toml::Value::String(s) => {
-                let mut diags = Vec::new();
-                let toks = vworks_wslc::lexer::lex(s.trim(), &mut diags);
-                use vworks_wslc::lexer::TokKind;
-                let kinds: Vec<&TokKind> = toks
-                    .iter()
-                    .map(|t| &t.kind)
-                    .filter(|k| **k != TokKind::Eof)
-                    .collect();
-                let (neg, kinds) = match kinds.as_slice() {
-                    [TokKind::P(vworks_wslc::lexer::Punct::Minus), rest @ ..] => {
-                        (-1.0, rest.to_vec())
-                    }
-                    other => (1.0, other.to_vec()),
-                };
-                match (diags.is_empty(), kinds.as_slice()) {
-                    (true, [TokKind::Quantity(x, d)]) if *d == dim => Ok(neg * x),
-                    (true, [TokKind::Quantity(_, d)]) => Err(self.bad(
+            toml::Value::String(s) => match vworks_wslc::units::parse_quantity(s) {
+                Some(q) => q.si(dim).map_err(|d| {
+                    self.bad(
                         key,
                         format!(
                             "`{s}` is {}, but {key} is {}; write {}",
@@ -278,15 +263,13 @@ impl Ctx<'_> {
                             dim.described(),
                             unit_hint()
                         ),
-                    )),
-                    (true, [TokKind::Int(i)]) => Ok(neg * *i as f64),
-                    (true, [TokKind::Num(x)]) => Ok(neg * x),
-                    _ => Err(self.bad(
-                        key,
-                        format!("`{s}` is not a quantity; write {}", unit_hint()),
-                    )),
-                }
-            }
+                    )
+                }),
+                None => Err(self.bad(
+                    key,
+                    format!("`{s}` is not a quantity; write {}", unit_hint()),
+                )),
+            },
             other => Err(self.bad(
                 key,
                 format!("expected {}, found {}", unit_hint(), other.type_str()),

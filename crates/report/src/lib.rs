@@ -1,79 +1,72 @@
 //! The run report: one self-contained HTML file (no network, no external files) made from
 //! a run's MCAP log — what `vworks report run.mcap -o report.html` writes.
 //!
-//! - a Gantt chart per robot over simulated time: moving, waiting, in a handler, idle
-//!   (the rest), with collisions (red lines across every row) and signals (ticks on the
-//!   sender's row) marked, as an inline SVG;
-//! - the cycle time of each robot (its `end` event) and its time moving, waiting, idle and
-//!   in handlers;
+//! - a Gantt chart per robot over simulated time: moving, waiting, idle (the rest), with
+//!   collisions (red lines across every row) and signals (ticks on the sender's row)
+//!   marked, as an inline SVG;
+//! - the cycle time of each robot and its time moving, waiting and idle — the same fold
+//!   over the same typed events as `vworks run` ([`vworks_se::stats`]), so the numbers
+//!   agree;
 //! - the collisions and the warnings and errors;
 //! - the event table, filterable by text, robot and kind (a few lines of inline
 //!   JavaScript; without it the whole table shows).
 //!
-//! Everything is derived from the `/events` topic, so a log thinned with `--log-every`
-//! gives the same report.
+//! Everything is derived from the `/events` topic and the log's metadata, so a log thinned
+//! with `--log-every` gives the same report.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
-use crate::mcaplog::{LogContents, LoggedEvent};
+use vworks_se::mcaplog::{LogContents, LoggedEvent};
+use vworks_se::stats::{Ending, Fold, RobotStats};
+use vworks_se::trace::{Data, Kind};
+
+pub use vworks_se::stats::Activity;
 
 /// Events in the table at most (the rest are counted; `vworks log events` lists them).
 pub const TABLE_LIMIT: usize = 20_000;
 
-/// What a robot does over an interval, as the chart colours it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Activity {
-    /// A motion (`motion_start` to `motion_end`).
-    Moving,
-    /// A `wait_until`, `wait_signal` or `join` (to its `wait_end`).
-    Waiting,
-    /// A `when` handler runs (`when_fire` to `when_end`).
-    Handler,
-}
-
-impl Activity {
-    fn name(self) -> &'static str {
-        match self {
-            Activity::Moving => "moving",
-            Activity::Waiting => "waiting",
-            Activity::Handler => "in handler",
-        }
-    }
-
-    fn colour(self) -> &'static str {
-        match self {
-            Activity::Moving => "#2f6fdf",
-            Activity::Waiting => "#f0a030",
-            Activity::Handler => "#9b59b6",
-        }
+fn colour(a: Activity) -> &'static str {
+    match a {
+        Activity::Moving => "#2f6fdf",
+        Activity::Waiting => "#f0a030",
     }
 }
 
 /// One robot's timeline, derived from its events.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Timeline {
-    /// The robot's name.
-    pub robot: String,
+    /// Time moving, waiting and idle, the cycle time and how the robot ended, exactly as
+    /// the run reported them.
+    pub stats: RobotStats,
     /// (activity, start ns, end ns), in order of start.
     pub intervals: Vec<(Activity, i64, i64)>,
-    /// When its program ended (its `end` event), if it did.
+    /// When its program ended (its last `end` or `remote_end`), if it did.
     pub ended_ns: Option<i64>,
     /// Signals it sent: (time ns, `receiver.name`).
     pub signals: Vec<(i64, String)>,
-    /// Number of motions.
-    pub motions: u64,
 }
 
 impl Timeline {
-    /// Total time in `activity` (ns).
-    pub fn total(&self, activity: Activity) -> i64 {
-        self.intervals
-            .iter()
-            .filter(|(a, ..)| *a == activity)
-            .map(|(_, s, e)| e - s)
-            .sum()
+    /// The robot's name.
+    pub fn robot(&self) -> &str {
+        &self.stats.name
     }
+}
+
+/// A collision in the report.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Collision {
+    /// When it started (ns).
+    pub start_ns: i64,
+    /// When it ended, if it did (ns).
+    pub end_ns: Option<i64>,
+    /// The two bodies.
+    pub a: String,
+    /// The second body.
+    pub b: String,
+    /// The start event's details text (depth and point).
+    pub details: String,
 }
 
 /// Everything the report shows, derived from a log.
@@ -81,14 +74,16 @@ impl Timeline {
 pub struct Report {
     /// The cell's name (from the log's metadata; `?` if it has none).
     pub cell: String,
-    /// The simulated span: the last event's time (ns).
+    /// The run's outcome, if the log recorded it (`completed`, `deadlock`, …).
+    pub outcome: Option<String>,
+    /// The simulated span: the run's end time as recorded, else the last event's time (ns).
     pub end_ns: i64,
     /// Per robot, in the workcell's order (the metadata's), else in order of appearance.
     pub timelines: Vec<Timeline>,
-    /// Collisions: (start ns, end ns if it ended, `body body`, details).
-    pub collisions: Vec<(i64, Option<i64>, String, String)>,
+    /// Collisions, in order of start.
+    pub collisions: Vec<Collision>,
     /// Warnings and errors: (time ns, `warning`/`error`, robot, message).
-    pub issues: Vec<(i64, String, Option<String>, String)>,
+    pub issues: Vec<(i64, Kind, Option<String>, String)>,
 }
 
 impl Report {
@@ -116,100 +111,88 @@ impl Report {
             .enumerate()
             .map(|(i, r)| (r.as_str(), i))
             .collect();
-        let mut timelines: Vec<Timeline> = order
-            .iter()
-            .map(|r| Timeline {
-                robot: r.clone(),
-                ..Timeline::default()
+        let last_event = log.events.iter().map(|e| e.time_ns).max().unwrap_or(0);
+        let end_ns = log
+            .result
+            .get("end_time_ns")
+            .and_then(|t| t.parse().ok())
+            .unwrap_or(last_event);
+        // Each robot's ending as the run recorded it (a log of version 1 has none: the
+        // events decide).
+        let recorded: BTreeMap<&str, Ending> = log
+            .result
+            .get("ended")
+            .map(|list| {
+                list.split(',')
+                    .filter_map(|kv| kv.split_once('='))
+                    .filter_map(|(r, e)| Some((r, Ending::from_name(e)?)))
+                    .collect()
             })
-            .collect();
-        // Open intervals per robot and activity.
-        let mut open: Vec<[Option<i64>; 3]> = vec![[None; 3]; order.len()];
-        let slot = |a: Activity| match a {
-            Activity::Moving => 0,
-            Activity::Waiting => 1,
-            Activity::Handler => 2,
-        };
-        let end_ns = log.events.iter().map(|e| e.time_ns).max().unwrap_or(0);
-        let mut collisions = Vec::new();
-        let mut open_collisions: BTreeMap<String, usize> = BTreeMap::new();
+            .unwrap_or_default();
+        let mut fold = Fold::new(order.clone(), true);
+        let mut ended_ns = vec![None; order.len()];
+        let mut signals = vec![Vec::new(); order.len()];
+        let mut collisions: Vec<Collision> = Vec::new();
+        let mut open_collisions: BTreeMap<(String, String), usize> = BTreeMap::new();
         let mut issues = Vec::new();
         for e in &log.events {
             let r = e.robot.as_deref().and_then(|r| index.get(r)).copied();
-            let start = |a: Activity| (a, true);
-            let stop = |a: Activity| (a, false);
-            let change = match e.kind.as_str() {
-                "motion_start" => Some(start(Activity::Moving)),
-                "motion_end" => Some(stop(Activity::Moving)),
-                "wait_until" | "wait_signal" | "join" => Some(start(Activity::Waiting)),
-                "wait_end" => Some(stop(Activity::Waiting)),
-                "when_fire" => Some(start(Activity::Handler)),
-                "when_end" => Some(stop(Activity::Handler)),
-                _ => None,
-            };
-            if let (Some(r), Some((activity, begins))) = (r, change) {
-                let o = &mut open[r][slot(activity)];
-                if begins {
-                    o.get_or_insert(e.time_ns);
-                    if activity == Activity::Moving {
-                        timelines[r].motions += 1;
-                    }
-                } else if let Some(s) = o.take() {
-                    timelines[r].intervals.push((activity, s, e.time_ns));
+            fold.event(e.time_ns, r, e.kind);
+            match (e.kind, r, &e.data) {
+                (Kind::End | Kind::RemoteEnd, Some(r), _) => ended_ns[r] = Some(e.time_ns),
+                (Kind::Signal, Some(r), _) => signals[r].push((e.time_ns, e.details.clone())),
+                (Kind::CollisionStart, _, Data::Collision { a, b, .. }) => {
+                    open_collisions.insert((a.clone(), b.clone()), collisions.len());
+                    collisions.push(Collision {
+                        start_ns: e.time_ns,
+                        end_ns: None,
+                        a: a.clone(),
+                        b: b.clone(),
+                        details: e.details.clone(),
+                    });
                 }
-            }
-            match (e.kind.as_str(), r) {
-                ("end", Some(r)) => timelines[r].ended_ns = Some(e.time_ns),
-                ("signal", Some(r)) => timelines[r].signals.push((e.time_ns, e.details.clone())),
-                ("collision_start", _) => {
-                    let pair = pair_of(&e.details);
-                    open_collisions.insert(pair.clone(), collisions.len());
-                    collisions.push((e.time_ns, None, pair, e.details.clone()));
-                }
-                ("collision_end", _) => {
-                    if let Some(i) = open_collisions.remove(&pair_of(&e.details)) {
-                        collisions[i].1 = Some(e.time_ns);
+                (Kind::CollisionEnd, _, Data::Collision { a, b, .. }) => {
+                    if let Some(i) = open_collisions.remove(&(a.clone(), b.clone())) {
+                        collisions[i].end_ns = Some(e.time_ns);
                     }
                 }
-                ("warning" | "error", _) => issues.push((
-                    e.time_ns,
-                    e.kind.clone(),
-                    e.robot.clone(),
-                    e.details.trim_matches('"').to_string(),
-                )),
+                (Kind::Warning | Kind::Error, _, data) => {
+                    let message = match data {
+                        Data::Issue { message, .. } => message.clone(),
+                        _ => e.details.clone(),
+                    };
+                    issues.push((e.time_ns, e.kind, e.robot.clone(), message));
+                }
                 _ => {}
             }
         }
-        // What is still open runs to the end of the log.
-        for (r, o) in open.iter().enumerate() {
-            for activity in [Activity::Moving, Activity::Waiting, Activity::Handler] {
-                if let Some(s) = o[slot(activity)] {
-                    timelines[r].intervals.push((activity, s, end_ns));
-                }
-            }
-            timelines[r]
-                .intervals
-                .sort_by_key(|(a, s, _)| (*s, slot(*a)));
-        }
+        let (stats, intervals) = fold.finish(end_ns, &|r| {
+            order.get(r).and_then(|n| recorded.get(n.as_str())).copied()
+        });
+        let timelines = stats
+            .into_iter()
+            .zip(intervals)
+            .zip(ended_ns.into_iter().zip(signals))
+            .map(|((stats, intervals), (ended_ns, signals))| Timeline {
+                ended_ns: ended_ns.filter(|_| stats.ended == Ending::Ended),
+                stats,
+                intervals,
+                signals,
+            })
+            .collect();
         Report {
             cell: log
                 .metadata
                 .get("cell")
                 .cloned()
                 .unwrap_or_else(|| "?".into()),
+            outcome: log.result.get("outcome").cloned(),
             end_ns,
             timelines,
             collisions,
             issues,
         }
     }
-}
-
-/// The two bodies of a collision event's details (`a b depth=… point=…` or `a b`).
-fn pair_of(details: &str) -> String {
-    let mut words = details.split(' ');
-    let (a, b) = (words.next().unwrap_or(""), words.next().unwrap_or(""));
-    format!("{a} {b}")
 }
 
 /// Escapes text for HTML.
@@ -284,26 +267,22 @@ fn gantt(report: &Report) -> String {
         let _ = write!(
             s,
             r##"<g class="row" data-robot="{name}"><text x="{tx}" y="{ty:.1}" font-size="13" text-anchor="end" fill="#222">{name}</text><rect class="idle" x="{LEFT}" y="{yb:.1}" width="{wi:.1}" height="22" fill="#e8e8e8"><title>{name}: idle</title></rect>"##,
-            name = esc(&tl.robot),
+            name = esc(tl.robot()),
             tx = LEFT - 8.0,
             ty = y + 20.0,
             yb = y + 4.0,
             wi = x(tl.ended_ns.unwrap_or(report.end_ns)) - LEFT,
         );
         for (activity, start, end) in &tl.intervals {
-            let (yb, h) = if *activity == Activity::Handler {
-                (y + 4.0, 7.0) // a thin band over the main thread's activity
-            } else {
-                (y + 4.0, 22.0)
-            };
             let _ = write!(
                 s,
-                r#"<rect class="{cls}" x="{x0:.2}" y="{yb:.1}" width="{w:.2}" height="{h}" fill="{fill}"><title>{name}: {what} {a} – {b}</title></rect>"#,
-                cls = activity.name().replace(' ', "-"),
+                r#"<rect class="{cls}" x="{x0:.2}" y="{yb:.1}" width="{w:.2}" height="22" fill="{fill}"><title>{name}: {what} {a} – {b}</title></rect>"#,
+                cls = activity.name(),
                 x0 = x(*start),
+                yb = y + 4.0,
                 w = (x(*end) - x(*start)).max(0.5),
-                fill = activity.colour(),
-                name = esc(&tl.robot),
+                fill = colour(*activity),
+                name = esc(tl.robot()),
                 what = activity.name(),
                 a = secs(*start),
                 b = secs(*end),
@@ -315,7 +294,7 @@ fn gantt(report: &Report) -> String {
                 s,
                 r##"<path class="signal" d="M{xs:.1} {y0:.1} l-4 -6 h8 z" fill="#1a9e55"><title>{name} signals {to} at {at}</title></path>"##,
                 y0 = y + 4.0,
-                name = esc(&tl.robot),
+                name = esc(tl.robot()),
                 to = esc(to),
                 at = secs(*t),
             );
@@ -327,20 +306,24 @@ fn gantt(report: &Report) -> String {
                 xe = x(end),
                 y0 = y + 2.0,
                 y1 = y + 28.0,
-                name = esc(&tl.robot),
+                name = esc(tl.robot()),
                 at = secs(end),
             );
         }
         s.push_str("</g>");
     }
-    for (start, _, pair, details) in &report.collisions {
-        let xc = x(*start);
+    for c in &report.collisions {
+        let xc = x(c.start_ns);
         let _ = write!(
             s,
             r##"<line class="collision" x1="{xc:.1}" y1="{TOP}" x2="{xc:.1}" y2="{y1:.1}" stroke="#d62728" stroke-width="2"><title>collision at {at}: {d}</title></line>"##,
             y1 = TOP + rows * ROW,
-            at = secs(*start),
-            d = esc(if details.is_empty() { pair } else { details }),
+            at = secs(c.start_ns),
+            d = esc(&if c.details.is_empty() {
+                format!("{} {}", c.a, c.b)
+            } else {
+                c.details.clone()
+            }),
         );
     }
     s.push_str("</svg>");
@@ -406,42 +389,43 @@ th {{ background: #f6f6f6; position: sticky; top: 0; }} td.num, th.num {{ text-a
 #events {{ font-family: ui-monospace, monospace; font-size: 12px; }} .none {{ color: #888; }}
 </style></head><body>
 <h1>{t}</h1>
-<div class="sub">{src} · simulated span {span} · {n} events</div>
+<div class="sub">{src} · {outcome}simulated span {span} · {n} events</div>
 "#,
         t = esc(&title),
         src = esc(source),
         span = secs(report.end_ns),
+        outcome = report
+            .outcome
+            .as_ref()
+            .map_or(String::new(), |o| format!("{} · ", esc(o))),
         n = events.len()
     );
     // Cycle times.
-    s.push_str("<h2>Cycle time per robot</h2>\n<table id=\"cycle-times\"><tr><th>robot</th><th class=\"num\">cycle time</th><th class=\"num\">moving</th><th class=\"num\">waiting</th><th class=\"num\">in handlers</th><th class=\"num\">idle</th><th class=\"num\">motions</th></tr>\n");
+    s.push_str("<h2>Cycle time per robot</h2>\n<table id=\"cycle-times\"><tr><th>robot</th><th class=\"num\">cycle time</th><th class=\"num\">moving</th><th class=\"num\">waiting</th><th class=\"num\">idle</th><th class=\"num\">motions</th></tr>\n");
     for tl in &report.timelines {
-        let end = tl.ended_ns.unwrap_or(report.end_ns);
-        let (moving, waiting) = (tl.total(Activity::Moving), tl.total(Activity::Waiting));
-        let idle = (end - moving - waiting).max(0);
+        let st = &tl.stats;
         let _ = writeln!(
             s,
-            "<tr><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td></tr>",
-            esc(&tl.robot),
-            match tl.ended_ns {
-                Some(e) => secs(e),
-                None => format!("did not end ({})", secs(report.end_ns)),
+            "<tr><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td></tr>",
+            esc(&st.name),
+            match st.ended {
+                Ending::Ended => secs(st.end_time_ns),
+                other => format!("did not end: {} ({})", other.name(), secs(st.end_time_ns)),
             },
-            secs(moving),
-            secs(waiting),
-            secs(tl.total(Activity::Handler)),
-            secs(idle),
-            tl.motions
+            secs(st.moving_ns),
+            secs(st.waiting_ns),
+            secs(st.idle_ns),
+            st.motions
         );
     }
     s.push_str("</table>\n");
     // Gantt.
     s.push_str("<h2>Timeline</h2>\n<div class=\"legend\">");
-    for a in [Activity::Moving, Activity::Waiting, Activity::Handler] {
+    for a in [Activity::Moving, Activity::Waiting] {
         let _ = write!(
             s,
             "<span><i style=\"background:{}\"></i>{}</span>",
-            a.colour(),
+            colour(a),
             a.name()
         );
     }
@@ -449,12 +433,12 @@ th {{ background: #f6f6f6; position: sticky; top: 0; }} td.num, th.num {{ text-a
     s.push_str(&gantt(report));
     s.push('\n');
     // Collisions and issues.
-    let collisions = report.collisions.iter().map(|(start, end, pair, details)| {
+    let collisions = report.collisions.iter().map(|c| {
         vec![
-            secs(*start),
-            end.map_or("–".into(), secs),
-            esc(pair),
-            esc(details),
+            secs(c.start_ns),
+            c.end_ns.map_or("–".into(), secs),
+            esc(&format!("{} {}", c.a, c.b)),
+            esc(&c.details),
         ]
     });
     list(
@@ -471,7 +455,7 @@ th {{ background: #f6f6f6; position: sticky; top: 0; }} td.num, th.num {{ text-a
     let issues = report.issues.iter().map(|(t, kind, robot, message)| {
         vec![
             secs(*t),
-            esc(kind),
+            esc(kind.name()),
             esc(robot.as_deref().unwrap_or("–")),
             esc(message),
         ]
@@ -488,8 +472,8 @@ th {{ background: #f6f6f6; position: sticky; top: 0; }} td.num, th.num {{ text-a
         issues,
     );
     // Events.
-    let robots: Vec<&str> = report.timelines.iter().map(|t| t.robot.as_str()).collect();
-    let mut kinds: Vec<&str> = events.iter().map(|e| e.kind.as_str()).collect();
+    let robots: Vec<&str> = report.timelines.iter().map(|t| t.robot()).collect();
+    let mut kinds: Vec<&str> = events.iter().map(|e| e.kind.name()).collect();
     kinds.sort_unstable();
     kinds.dedup();
     s.push_str("<h2>Events</h2>\n<div id=\"filters\"><input id=\"text\" type=\"search\" placeholder=\"filter: any text\" aria-label=\"filter events by text\">");
@@ -515,7 +499,7 @@ th {{ background: #f6f6f6; position: sticky; top: 0; }} td.num, th.num {{ text-a
             s,
             "<tr data-robot=\"{r}\" data-kind=\"{k}\"><td class=\"num\">{t:.6}</td><td>{r}</td><td>{k}</td><td>{d}</td><td>{p}</td></tr>",
             r = esc(robot),
-            k = esc(&e.kind),
+            k = e.kind.name(),
             t = e.time_ns as f64 / 1e9,
             d = esc(&e.details),
             p = esc(&pos)
@@ -559,41 +543,53 @@ th {{ background: #f6f6f6; position: sticky; top: 0; }} td.num, th.num {{ text-a
 mod tests {
     use super::*;
 
-    fn ev(t: i64, robot: Option<&str>, kind: &str, details: &str) -> LoggedEvent {
+    fn ev(t: i64, robot: Option<&str>, kind: Kind, data: Data) -> LoggedEvent {
         LoggedEvent {
             time_ns: t,
             robot: robot.map(str::to_string),
-            kind: kind.into(),
-            details: details.into(),
+            kind,
+            details: String::new(),
+            data,
             file: None,
             line: 0,
             col: 0,
         }
     }
 
+    /// Times by hand from docs/engine.md: a moves 0–5, waits 5–8, fires a handler at 9
+    /// (no time) and ends at 10; b sends a signal at 7 and waits from 7 to the end at 12;
+    /// idle is the rest of the 12 ns run.
     #[test]
-    fn intervals_come_from_start_and_end_events() {
+    fn intervals_and_totals_come_from_the_shared_fold() {
+        let pair = |contact| Data::Collision {
+            a: "a.link_1".into(),
+            b: "b.link_2".into(),
+            contact,
+        };
+        let mut signal = ev(7, Some("b"), Kind::Signal, Data::None);
+        signal.details = "a.go".into();
         let log = LogContents {
             events: vec![
-                ev(0, Some("a"), "motion_start", "move_j duration=5"),
-                ev(5, Some("a"), "motion_end", ""),
-                ev(5, Some("a"), "wait_until", "condition(g)"),
-                ev(7, Some("b"), "signal", "a.go"),
-                ev(8, Some("a"), "wait_end", "released"),
-                ev(
-                    8,
-                    None,
-                    "collision_start",
-                    "a.link_1 b.link_2 depth=0mm point=(0, 0, 0)",
-                ),
-                ev(9, None, "collision_end", "a.link_1 b.link_2"),
-                ev(9, Some("a"), "when_fire", "h"),
-                ev(10, Some("a"), "end", ""),
+                ev(0, Some("a"), Kind::MotionStart, Data::None),
+                ev(5, Some("a"), Kind::MotionEnd, Data::None),
+                ev(5, Some("a"), Kind::WaitUntil, Data::None),
+                signal,
+                ev(7, Some("b"), Kind::WaitUntil, Data::None),
+                ev(8, Some("a"), Kind::WaitEnd, Data::None),
+                ev(8, None, Kind::CollisionStart, pair(Some((0.0, [0.0; 3])))),
+                ev(9, None, Kind::CollisionEnd, pair(None)),
+                ev(9, Some("a"), Kind::WhenFire, Data::None),
+                ev(9, Some("a"), Kind::WhenEnd, Data::None),
+                ev(10, Some("a"), Kind::End, Data::None),
                 ev(
                     12,
                     None,
-                    "warning",
-                    "\"near miss: x and y come within 1mm\"",
+                    Kind::Warning,
+                    Data::Issue {
+                        kind: "near_miss".into(),
+                        message: "near miss: x and y come within 1mm".into(),
+                        distance_m: Some(1e-3),
+                    },
                 ),
             ],
             ..LogContents::default()
@@ -603,21 +599,47 @@ mod tests {
         let a = &r.timelines[0];
         assert_eq!(
             a.intervals,
-            vec![
-                (Activity::Moving, 0, 5),
-                (Activity::Waiting, 5, 8),
-                (Activity::Handler, 9, 12)
-            ]
+            vec![(Activity::Moving, 0, 5), (Activity::Waiting, 5, 8)]
         );
-        assert_eq!((a.ended_ns, a.motions), (Some(10), 1));
-        assert_eq!(r.timelines[1].signals, vec![(7, "a.go".to_string())]);
-        assert_eq!(r.collisions[0].0..r.collisions[0].1.unwrap(), 8..9);
+        assert_eq!((a.ended_ns, a.stats.motions), (Some(10), 1));
+        assert_eq!(
+            (a.stats.moving_ns, a.stats.waiting_ns, a.stats.idle_ns),
+            (5, 3, 4)
+        );
+        let b = &r.timelines[1];
+        assert_eq!(b.signals, vec![(7, "a.go".to_string())]);
+        assert_eq!((b.stats.waiting_ns, b.stats.idle_ns), (5, 7));
+        assert_eq!((b.stats.ended, b.stats.end_time_ns), (Ending::Waiting, 12));
+        assert_eq!(
+            r.collisions[0].start_ns..r.collisions[0].end_ns.unwrap(),
+            8..9
+        );
         assert_eq!(r.issues[0].3, "near miss: x and y come within 1mm");
         let page = html(&r, &log.events, "x.mcap");
         assert!(page.contains("<svg id=\"gantt\""));
         assert!(page.contains("class=\"collision\""));
+        assert!(!page.contains("handler"));
         // Self-contained: nothing loaded from elsewhere.
         assert!(!page.contains(" src=") && !page.contains("<link"));
+    }
+
+    /// The run's own end time and endings, when the log records them, win over what the
+    /// events alone suggest.
+    #[test]
+    fn the_recorded_result_sets_the_span_and_endings() {
+        let log = LogContents {
+            events: vec![ev(0, Some("a"), Kind::WaitUntil, Data::None)],
+            result: BTreeMap::from([
+                ("end_time_ns".to_string(), "20".to_string()),
+                ("ended".to_string(), "a=running".to_string()),
+                ("outcome".to_string(), "until".to_string()),
+            ]),
+            ..LogContents::default()
+        };
+        let r = Report::from_log(&log);
+        assert_eq!((r.end_ns, r.outcome.as_deref()), (20, Some("until")));
+        let a = &r.timelines[0].stats;
+        assert_eq!((a.waiting_ns, a.ended), (20, Ending::Running));
     }
 
     #[test]

@@ -1,0 +1,968 @@
+//! The run's event vocabulary: one typed event for everything a run reports, from the
+//! engine's queue to the log file, the report, the CLI and Python.
+//!
+//! - [`Kind`]: what happened (`motion_start`, `set`, `collision_start`, `warning`, …).
+//! - [`TraceEvent`]: an event as the engine records it — indices into the cell and the
+//!   robot's module, nothing formatted, so that recording a VM event allocates nothing.
+//! - [`Event`]: the same event resolved with the cell's names ([`TraceEvent::resolve`]), or
+//!   read back from a log (`mcaplog::read_log`): names instead of indices, the typed
+//!   [`Data`] and the details text of a trace line. This is what leaves the engine.
+//!
+//! The trace line `time_ns robot kind details file:line:col` (the golden files, `vworks
+//! log events`) is rendered from these types ([`TraceEvent::line`], [`Event::line`]); no
+//! consumer parses it back.
+
+use std::path::Path;
+
+use serde_json::{Value as Json, json};
+use vworks_cell::Cell;
+use vworks_vm::Type;
+use vworks_vm::bytecode::{Module, SrcPos};
+use vworks_vm::machine::EventKind;
+use vworks_vm::types::fmt_quantity;
+
+use crate::collide::Contact;
+
+/// What an event is: its kind, as trace lines and the log name it ([`Kind::name`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[non_exhaustive]
+pub enum Kind {
+    /// A motion begins.
+    MotionStart,
+    /// A motion reached its target.
+    MotionEnd,
+    /// A `delay` begins.
+    Delay,
+    /// A `delay` is over.
+    DelayEnd,
+    /// A global is assigned.
+    Set,
+    /// A `wait_until` begins (a condition or a signal).
+    WaitUntil,
+    /// A wait is over (released or timed out).
+    WaitEnd,
+    /// A signal is sent.
+    Signal,
+    /// A part is gripped.
+    Grip,
+    /// A part is released.
+    Release,
+    /// A `log` statement.
+    Log,
+    /// A runtime error, `fail`, or an error the engine finds (deadlock, livelock).
+    Error,
+    /// A `when` handler is enabled.
+    EnableWhen,
+    /// Handlers are disabled.
+    DisableWhen,
+    /// A handler fires.
+    WhenFire,
+    /// A handler finished.
+    WhenEnd,
+    /// A remote request is made.
+    RemoteCall,
+    /// The robot waits for its `parallel` block's remote work.
+    Join,
+    /// The robot starts serving a remote request.
+    RemoteStart,
+    /// The robot finished serving a remote request.
+    RemoteEnd,
+    /// The robot's program ended.
+    End,
+    /// The engine re-tests a robot's wait condition after a set.
+    CheckWait,
+    /// The engine re-tests a robot's condition handlers after a set.
+    CheckWhen,
+    /// Two bodies started touching.
+    CollisionStart,
+    /// Two bodies stopped touching.
+    CollisionEnd,
+    /// A warning of the run (race, near miss, slowdown, …).
+    Warning,
+}
+
+impl Kind {
+    /// Every kind, in declaration order.
+    pub const ALL: [Kind; 26] = [
+        Kind::MotionStart,
+        Kind::MotionEnd,
+        Kind::Delay,
+        Kind::DelayEnd,
+        Kind::Set,
+        Kind::WaitUntil,
+        Kind::WaitEnd,
+        Kind::Signal,
+        Kind::Grip,
+        Kind::Release,
+        Kind::Log,
+        Kind::Error,
+        Kind::EnableWhen,
+        Kind::DisableWhen,
+        Kind::WhenFire,
+        Kind::WhenEnd,
+        Kind::RemoteCall,
+        Kind::Join,
+        Kind::RemoteStart,
+        Kind::RemoteEnd,
+        Kind::End,
+        Kind::CheckWait,
+        Kind::CheckWhen,
+        Kind::CollisionStart,
+        Kind::CollisionEnd,
+        Kind::Warning,
+    ];
+
+    /// The kind's name in trace lines and logs.
+    pub fn name(self) -> &'static str {
+        match self {
+            Kind::MotionStart => "motion_start",
+            Kind::MotionEnd => "motion_end",
+            Kind::Delay => "delay",
+            Kind::DelayEnd => "delay_end",
+            Kind::Set => "set",
+            Kind::WaitUntil => "wait_until",
+            Kind::WaitEnd => "wait_end",
+            Kind::Signal => "signal",
+            Kind::Grip => "grip",
+            Kind::Release => "release",
+            Kind::Log => "log",
+            Kind::Error => "error",
+            Kind::EnableWhen => "enable_when",
+            Kind::DisableWhen => "disable_when",
+            Kind::WhenFire => "when_fire",
+            Kind::WhenEnd => "when_end",
+            Kind::RemoteCall => "remote_call",
+            Kind::Join => "join",
+            Kind::RemoteStart => "remote_start",
+            Kind::RemoteEnd => "remote_end",
+            Kind::End => "end",
+            Kind::CheckWait => "check_wait",
+            Kind::CheckWhen => "check_when",
+            Kind::CollisionStart => "collision_start",
+            Kind::CollisionEnd => "collision_end",
+            Kind::Warning => "warning",
+        }
+    }
+
+    /// The kind named `name` ([`Kind::name`]), if there is one.
+    pub fn from_name(name: &str) -> Option<Kind> {
+        Kind::ALL.into_iter().find(|k| k.name() == name)
+    }
+
+    /// The kind of a VM event.
+    pub fn of(kind: &EventKind) -> Kind {
+        match kind {
+            EventKind::MotionStart { .. } => Kind::MotionStart,
+            EventKind::MotionEnd => Kind::MotionEnd,
+            EventKind::Delay { .. } => Kind::Delay,
+            EventKind::DelayEnd => Kind::DelayEnd,
+            EventKind::Set { .. } => Kind::Set,
+            EventKind::WaitUntil { .. } | EventKind::WaitSignal { .. } => Kind::WaitUntil,
+            EventKind::WaitEnd { .. } => Kind::WaitEnd,
+            EventKind::Signal { .. } => Kind::Signal,
+            EventKind::Grip { .. } => Kind::Grip,
+            EventKind::Release { .. } => Kind::Release,
+            EventKind::Log { .. } => Kind::Log,
+            EventKind::Error { .. } => Kind::Error,
+            EventKind::EnableWhen { .. } => Kind::EnableWhen,
+            EventKind::DisableWhen { .. } => Kind::DisableWhen,
+            EventKind::WhenFire { .. } => Kind::WhenFire,
+            EventKind::WhenEnd { .. } => Kind::WhenEnd,
+            EventKind::RemoteCall { .. } => Kind::RemoteCall,
+            EventKind::Join => Kind::Join,
+            EventKind::RemoteStart { .. } => Kind::RemoteStart,
+            EventKind::RemoteEnd { .. } => Kind::RemoteEnd,
+            EventKind::End => Kind::End,
+        }
+    }
+}
+
+impl std::fmt::Display for Kind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The value of a global.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum Value {
+    /// A `bool` global.
+    Bool(bool),
+    /// An `int` global.
+    Int(i64),
+    /// A `num` global, in SI units (m, rad, s, …).
+    Num(f64),
+}
+
+impl Value {
+    /// A global's value from its slot bits and type (globals are scalars).
+    pub fn of(bits: u64, ty: Type) -> Value {
+        match ty {
+            Type::Bool => Value::Bool(bits != 0),
+            Type::Int => Value::Int(bits as i64),
+            _ => Value::Num(f64::from_bits(bits)),
+        }
+    }
+
+    /// As JSON: `true`/`false`, an integer, or a number in SI units (`null` if not finite,
+    /// which a global never is).
+    pub fn to_json(self) -> Json {
+        match self {
+            Value::Bool(b) => Json::Bool(b),
+            Value::Int(i) => Json::from(i),
+            Value::Num(x) => serde_json::Number::from_f64(x).map_or(Json::Null, Json::Number),
+        }
+    }
+
+    /// From JSON as [`Value::to_json`] writes it.
+    pub fn from_json(v: &Json) -> Option<Value> {
+        match v {
+            Json::Bool(b) => Some(Value::Bool(*b)),
+            Json::Number(n) if n.is_i64() => n.as_i64().map(Value::Int),
+            Json::Number(n) => n.as_f64().map(Value::Num),
+            _ => None,
+        }
+    }
+}
+
+/// A global's value as trace lines and `run` print it: numbers in display units
+/// (`250mm`, `90deg`, `2s`).
+pub fn format_value(bits: u64, ty: Type) -> String {
+    match ty {
+        Type::Bool => (bits != 0).to_string(),
+        Type::Int => (bits as i64).to_string(),
+        Type::Num(d) => fmt_quantity(f64::from_bits(bits), d),
+        _ => format!("{bits:#x}"),
+    }
+}
+
+/// A warning or error of the run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Issue {
+    /// `race`, `near_miss`, `slowdown`, `runtime`, `deadlock`, or a compiler warning's
+    /// code (`W0001`).
+    pub kind: String,
+    /// The message.
+    pub message: String,
+    /// The robot, if one.
+    pub robot: Option<String>,
+    /// Source position, if known.
+    pub file: Option<String>,
+    /// Line (0 if unknown).
+    pub line: u32,
+    /// Column (0 if unknown).
+    pub col: u32,
+    /// For a near miss, how close the bodies came (m), exactly; the message rounds it.
+    pub distance_m: Option<f64>,
+}
+
+/// One event as the engine records it. Recording one allocates nothing for a VM event:
+/// its details are kept as indices ([`Detail`]) and resolved with the cell's names on
+/// demand ([`TraceEvent::resolve`], [`TraceEvent::line`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TraceEvent {
+    /// Time (ns).
+    pub time: i64,
+    /// Robot index, if the event belongs to one.
+    pub robot: Option<usize>,
+    /// What happened.
+    pub kind: Kind,
+    /// What the event says beyond its kind.
+    pub detail: Detail,
+    /// Source position in the robot's program (see [`TraceEvent::file`]).
+    pub pos: Option<SrcPos>,
+}
+
+/// The details of a recorded event: indices into the cell and the robot's module.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum Detail {
+    /// No details.
+    None,
+    /// An event of the robot's VM (module indices).
+    Vm(EventKind),
+    /// A set of cell global `global`: its value bits before and after (its type is the
+    /// cell global's).
+    Set {
+        /// Cell global index.
+        global: u32,
+        /// The value before.
+        old: u64,
+        /// The value set.
+        new: u64,
+    },
+    /// `check_wait` / `check_when`: the cell global whose change caused it.
+    Global(u32),
+    /// A collision started.
+    Collision(Box<Contact>),
+    /// A collision ended: the two bodies.
+    CollisionEnd(Box<(String, String)>),
+    /// A warning or an error the engine found.
+    Issue(Box<Issue>),
+}
+
+/// An event's typed details, with names: what `/events` carries in its `data` field and
+/// what programs should read instead of the details text.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum Data {
+    /// No details (`motion_end`, `delay_end`, `join`, `end`), or a log written before
+    /// events carried typed details.
+    None,
+    /// `motion_start`: the command (`move_j`, `move_l`, `move_c`) and its exact duration.
+    Motion {
+        /// `move_j`, `move_l` or `move_c`.
+        command: String,
+        /// Duration (ns).
+        duration_ns: i64,
+    },
+    /// `delay`: its duration.
+    Delay {
+        /// Duration (ns).
+        duration_ns: i64,
+    },
+    /// `set`: the global, its value before and the value set.
+    Set {
+        /// The global's name.
+        global: String,
+        /// The value before.
+        old: Value,
+        /// The value set.
+        new: Value,
+    },
+    /// `wait_until` on a condition: the globals it reads, and the deadline if any.
+    WaitCondition {
+        /// The globals the condition reads.
+        globals: Vec<String>,
+        /// Absolute deadline (ns), with a timeout.
+        deadline_ns: Option<i64>,
+    },
+    /// `wait_until` on a signal: its name, and the deadline if any.
+    WaitSignal {
+        /// The signal's name.
+        signal: String,
+        /// Absolute deadline (ns), with a timeout.
+        deadline_ns: Option<i64>,
+    },
+    /// `wait_end`: whether the wait timed out.
+    WaitEnd {
+        /// It ended by timeout.
+        timed_out: bool,
+    },
+    /// `signal`: the receiving robot and the signal's name.
+    Signal {
+        /// The receiver.
+        robot: String,
+        /// The signal.
+        signal: String,
+    },
+    /// `grip` / `release`: the part.
+    Part {
+        /// The part's name.
+        part: String,
+    },
+    /// `log`: the text.
+    Text {
+        /// The text logged.
+        text: String,
+    },
+    /// `enable_when`, `disable_when`, `when_fire`, `when_end`, `remote_start`,
+    /// `remote_end`: the procedure.
+    Procedure {
+        /// The procedure's name.
+        procedure: String,
+    },
+    /// `remote_call`: the robot asked and the procedure.
+    Remote {
+        /// The robot that serves the request.
+        robot: String,
+        /// The procedure.
+        procedure: String,
+    },
+    /// `check_wait` / `check_when`: the global whose set caused it.
+    Global {
+        /// The global's name.
+        global: String,
+    },
+    /// `collision_start` / `collision_end`: the two bodies; for a start, the depth and a
+    /// contact point.
+    Collision {
+        /// First body (`r1.link_4`, `table`, `part1`).
+        a: String,
+        /// Second body.
+        b: String,
+        /// For a start: penetration depth (m) and a contact point in the cell (m).
+        contact: Option<(f64, [f64; 3])>,
+    },
+    /// `warning` / `error`: its kind (`race`, `near_miss`, `runtime`, `deadlock`, a
+    /// compiler code), message, and for a near miss the distance (m).
+    Issue {
+        /// `race`, `near_miss`, `slowdown`, `runtime`, `deadlock`, …
+        kind: String,
+        /// The message.
+        message: String,
+        /// For a near miss, how close the bodies came (m).
+        distance_m: Option<f64>,
+    },
+}
+
+/// An event with the cell's names: what a run hands out and a log holds.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Event {
+    /// Simulated time (ns).
+    pub time_ns: i64,
+    /// The robot, if the event belongs to one.
+    pub robot: Option<String>,
+    /// What happened.
+    pub kind: Kind,
+    /// The details as the trace line shows them (may be empty).
+    pub details: String,
+    /// The details, typed.
+    pub data: Data,
+    /// The WSL source file, if known.
+    pub file: Option<String>,
+    /// Line (0 if unknown).
+    pub line: u32,
+    /// Column (0 if unknown).
+    pub col: u32,
+}
+
+/// `path`'s file name (the whole text if it has none).
+fn file_name(path: &str) -> String {
+    Path::new(path)
+        .file_name()
+        .map_or(path.to_string(), |n| n.to_string_lossy().into_owned())
+}
+
+impl Event {
+    /// `file:line:col` with the file's name only, if the event has a source position.
+    pub fn position(&self) -> Option<String> {
+        let f = self.file.as_ref()?;
+        Some(format!("{}:{}:{}", file_name(f), self.line, self.col))
+    }
+
+    /// The trace line `time_ns robot kind details file:line:col`, `-` for an empty field
+    /// and the file's name only: the golden traces' format.
+    pub fn line(&self) -> String {
+        let details = if self.details.is_empty() {
+            "-"
+        } else {
+            &self.details
+        };
+        let pos = self.position().unwrap_or_else(|| "-".into());
+        format!(
+            "{} {} {} {details} {pos}",
+            self.time_ns,
+            self.robot.as_deref().unwrap_or("-"),
+            self.kind
+        )
+    }
+
+    /// The event as the JSON object of the log's `/events` topic (schema in
+    /// `docs/log.md`).
+    pub fn to_json(&self) -> Json {
+        json!({
+            "time_ns": self.time_ns,
+            "robot": self.robot,
+            "kind": self.kind.name(),
+            "details": self.details,
+            "file": self.file,
+            "line": self.line,
+            "col": self.col,
+            "data": self.data.to_json(),
+        })
+    }
+
+    /// An event from the JSON object [`Event::to_json`] writes. An object without
+    /// `data` (a log of vworks before log version 2) gives [`Data::None`].
+    pub fn from_json(v: &Json) -> Result<Event, String> {
+        let text = |k: &str| v[k].as_str().map(str::to_string);
+        let int = |k: &str| u32::try_from(v[k].as_u64().unwrap_or(0)).unwrap_or(u32::MAX);
+        let name = v["kind"].as_str().unwrap_or("");
+        let kind = Kind::from_name(name)
+            .ok_or_else(|| format!("an event has the unknown kind `{name}`"))?;
+        let data = match v.get("data") {
+            None | Some(Json::Null) => Data::None,
+            Some(d) => Data::from_json(kind, d)
+                .ok_or_else(|| format!("a `{name}` event's data does not fit its kind: {d}"))?,
+        };
+        Ok(Event {
+            time_ns: v["time_ns"].as_i64().unwrap_or(0),
+            robot: text("robot"),
+            kind,
+            details: text("details").unwrap_or_default(),
+            data,
+            file: text("file"),
+            line: int("line"),
+            col: int("col"),
+        })
+    }
+}
+
+impl Data {
+    /// The `data` object of a `/events` message (`null` for [`Data::None`]).
+    pub fn to_json(&self) -> Json {
+        match self {
+            Data::None => Json::Null,
+            Data::Motion {
+                command,
+                duration_ns,
+            } => json!({"command": command, "duration_ns": duration_ns}),
+            Data::Delay { duration_ns } => json!({"duration_ns": duration_ns}),
+            Data::Set { global, old, new } => {
+                json!({"global": global, "old": old.to_json(), "new": new.to_json()})
+            }
+            Data::WaitCondition {
+                globals,
+                deadline_ns,
+            } => json!({"globals": globals, "deadline_ns": deadline_ns}),
+            Data::WaitSignal {
+                signal,
+                deadline_ns,
+            } => json!({"signal": signal, "deadline_ns": deadline_ns}),
+            Data::WaitEnd { timed_out } => json!({"timed_out": timed_out}),
+            Data::Signal { robot, signal } => json!({"robot": robot, "signal": signal}),
+            Data::Part { part } => json!({"part": part}),
+            Data::Text { text } => json!({"text": text}),
+            Data::Procedure { procedure } => json!({"procedure": procedure}),
+            Data::Remote { robot, procedure } => json!({"robot": robot, "procedure": procedure}),
+            Data::Global { global } => json!({"global": global}),
+            Data::Collision { a, b, contact } => match contact {
+                Some((depth, point)) => json!({"a": a, "b": b, "depth_m": depth, "point_m": point}),
+                None => json!({"a": a, "b": b}),
+            },
+            Data::Issue {
+                kind,
+                message,
+                distance_m,
+            } => json!({"kind": kind, "message": message, "distance_m": distance_m}),
+        }
+    }
+
+    /// The data of a `kind` event from its `data` object; `None` if it does not fit.
+    pub fn from_json(kind: Kind, d: &Json) -> Option<Data> {
+        let s = |k: &str| d.get(k)?.as_str().map(str::to_string);
+        let i = |k: &str| d.get(k)?.as_i64();
+        let opt_i = |k: &str| match d.get(k) {
+            None | Some(Json::Null) => Some(None),
+            Some(v) => v.as_i64().map(Some),
+        };
+        let f = |k: &str| d.get(k)?.as_f64();
+        Some(match kind {
+            Kind::MotionStart => Data::Motion {
+                command: s("command")?,
+                duration_ns: i("duration_ns")?,
+            },
+            Kind::Delay => Data::Delay {
+                duration_ns: i("duration_ns")?,
+            },
+            Kind::Set => Data::Set {
+                global: s("global")?,
+                old: Value::from_json(d.get("old")?)?,
+                new: Value::from_json(d.get("new")?)?,
+            },
+            Kind::WaitUntil if d.get("signal").is_some() => Data::WaitSignal {
+                signal: s("signal")?,
+                deadline_ns: opt_i("deadline_ns")?,
+            },
+            Kind::WaitUntil => Data::WaitCondition {
+                globals: d
+                    .get("globals")?
+                    .as_array()?
+                    .iter()
+                    .map(|g| g.as_str().map(str::to_string))
+                    .collect::<Option<_>>()?,
+                deadline_ns: opt_i("deadline_ns")?,
+            },
+            Kind::WaitEnd => Data::WaitEnd {
+                timed_out: d.get("timed_out")?.as_bool()?,
+            },
+            Kind::Signal => Data::Signal {
+                robot: s("robot")?,
+                signal: s("signal")?,
+            },
+            Kind::Grip | Kind::Release => Data::Part { part: s("part")? },
+            Kind::Log => Data::Text { text: s("text")? },
+            Kind::EnableWhen
+            | Kind::DisableWhen
+            | Kind::WhenFire
+            | Kind::WhenEnd
+            | Kind::RemoteStart
+            | Kind::RemoteEnd => Data::Procedure {
+                procedure: s("procedure")?,
+            },
+            Kind::RemoteCall => Data::Remote {
+                robot: s("robot")?,
+                procedure: s("procedure")?,
+            },
+            Kind::CheckWait | Kind::CheckWhen => Data::Global {
+                global: s("global")?,
+            },
+            Kind::CollisionStart | Kind::CollisionEnd => Data::Collision {
+                a: s("a")?,
+                b: s("b")?,
+                contact: match (f("depth_m"), d.get("point_m")) {
+                    (Some(depth), Some(p)) => {
+                        let p = p.as_array()?;
+                        let c = |k: usize| p.get(k)?.as_f64();
+                        Some((depth, [c(0)?, c(1)?, c(2)?]))
+                    }
+                    _ => None,
+                },
+            },
+            Kind::Warning | Kind::Error => Data::Issue {
+                kind: s("kind")?,
+                message: s("message")?,
+                distance_m: f("distance_m"),
+            },
+            Kind::MotionEnd | Kind::DelayEnd | Kind::Join | Kind::End => Data::None,
+        })
+    }
+}
+
+impl TraceEvent {
+    /// The program file the source position refers to (the robot's program).
+    pub fn file<'c>(&self, cell: &'c Cell) -> Option<&'c str> {
+        self.pos?;
+        self.robot
+            .and_then(|r| cell.robots.get(r))
+            .map(|r| r.program.as_str())
+    }
+
+    /// The details as trace lines show them (empty when there are none).
+    pub fn details(&self, cell: &Cell) -> String {
+        match &self.detail {
+            Detail::None => String::new(),
+            Detail::Vm(kind) => self
+                .robot
+                .and_then(|r| cell.robots.get(r))
+                .map_or_else(String::new, |robot| vm_details(kind, &robot.module)),
+            Detail::Set { global, new, .. } => cell
+                .linked
+                .globals
+                .get(*global as usize)
+                .map_or_else(String::new, |g| {
+                    format!("{}={}", g.name, format_value(*new, g.ty))
+                }),
+            Detail::Global(g) => cell
+                .linked
+                .globals
+                .get(*g as usize)
+                .map_or_else(String::new, |g| g.name.clone()),
+            Detail::Collision(c) => format!(
+                "{} {} depth={} point=({:.4}, {:.4}, {:.4})",
+                c.a,
+                c.b,
+                fmt_quantity(c.depth, vworks_vm::Dim::LENGTH),
+                c.point[0],
+                c.point[1],
+                c.point[2]
+            ),
+            Detail::CollisionEnd(pair) => format!("{} {}", pair.0, pair.1),
+            Detail::Issue(issue) => format!("{:?}", issue.message),
+        }
+    }
+
+    /// The typed details with the cell's names.
+    pub fn data(&self, cell: &Cell) -> Data {
+        let module = self
+            .robot
+            .and_then(|r| cell.robots.get(r))
+            .map(|r| &*r.module);
+        match (&self.detail, module) {
+            (Detail::None, _) => Data::None,
+            (Detail::Vm(kind), Some(m)) => vm_data(kind, m),
+            (Detail::Vm(_), None) => Data::None,
+            (Detail::Set { global, old, new }, _) => {
+                match cell.linked.globals.get(*global as usize) {
+                    Some(g) => Data::Set {
+                        global: g.name.clone(),
+                        old: Value::of(*old, g.ty),
+                        new: Value::of(*new, g.ty),
+                    },
+                    None => Data::None,
+                }
+            }
+            (Detail::Global(g), _) => {
+                cell.linked
+                    .globals
+                    .get(*g as usize)
+                    .map_or(Data::None, |g| Data::Global {
+                        global: g.name.clone(),
+                    })
+            }
+            (Detail::Collision(c), _) => Data::Collision {
+                a: c.a.clone(),
+                b: c.b.clone(),
+                contact: Some((c.depth, c.point)),
+            },
+            (Detail::CollisionEnd(pair), _) => Data::Collision {
+                a: pair.0.clone(),
+                b: pair.1.clone(),
+                contact: None,
+            },
+            (Detail::Issue(issue), _) => Data::Issue {
+                kind: issue.kind.clone(),
+                message: issue.message.clone(),
+                distance_m: issue.distance_m,
+            },
+        }
+    }
+
+    /// The event with the cell's names.
+    pub fn resolve(&self, cell: &Cell) -> Event {
+        let (line, col) = self.pos.map_or((0, 0), |p| (p.line, p.col));
+        Event {
+            time_ns: self.time,
+            robot: self
+                .robot
+                .and_then(|r| cell.robots.get(r))
+                .map(|r| r.name.clone()),
+            kind: self.kind,
+            details: self.details(cell),
+            data: self.data(cell),
+            file: self.file(cell).map(str::to_string),
+            line,
+            col,
+        }
+    }
+
+    /// The trace line: `time_ns robot kind details file:line:col`, `-` for empty fields.
+    pub fn line(&self, cell: &Cell) -> String {
+        let robot = self
+            .robot
+            .and_then(|r| cell.robots.get(r))
+            .map_or("-", |r| r.name.as_str());
+        let mut details = self.details(cell);
+        if details.is_empty() {
+            details.push('-');
+        }
+        let pos = match (self.file(cell), self.pos) {
+            (Some(f), Some(p)) => format!("{}:{}:{}", file_name(f), p.line, p.col),
+            _ => "-".to_string(),
+        };
+        format!("{} {robot} {} {details} {pos}", self.time, self.kind)
+    }
+}
+
+/// The names a module's conditions read.
+fn cond_globals(m: &Module, cond: u32) -> Vec<String> {
+    m.conds[cond as usize]
+        .globals
+        .iter()
+        .map(|g| m.str(m.globals[*g as usize].name).to_string())
+        .collect()
+}
+
+/// A VM event's typed details, with the names of module `m`.
+fn vm_data(kind: &EventKind, m: &Module) -> Data {
+    let procedure = |p: u32| Data::Procedure {
+        procedure: m.str(m.procs[p as usize].name).to_string(),
+    };
+    let handler = |h: u32| procedure(m.handlers[h as usize].target);
+    match kind {
+        EventKind::MotionStart {
+            command,
+            duration_ns,
+        } => Data::Motion {
+            command: (*command).to_string(),
+            duration_ns: *duration_ns,
+        },
+        EventKind::Delay { duration_ns } => Data::Delay {
+            duration_ns: *duration_ns,
+        },
+        // The engine records sets as `Detail::Set` (cell globals, old and new values).
+        EventKind::Set { global, value, ty } => Data::Set {
+            global: m.str(m.globals[*global as usize].name).to_string(),
+            old: Value::of(*value, *ty),
+            new: Value::of(*value, *ty),
+        },
+        EventKind::WaitUntil { cond, deadline } => Data::WaitCondition {
+            globals: cond_globals(m, *cond),
+            deadline_ns: *deadline,
+        },
+        EventKind::WaitSignal { name, deadline } => Data::WaitSignal {
+            signal: m.str(*name).to_string(),
+            deadline_ns: *deadline,
+        },
+        EventKind::WaitEnd { timed_out } => Data::WaitEnd {
+            timed_out: *timed_out,
+        },
+        EventKind::Signal { site } => {
+            let s = &m.signals_sent[*site as usize];
+            Data::Signal {
+                robot: m.str(s.robot).to_string(),
+                signal: m.str(s.name).to_string(),
+            }
+        }
+        EventKind::Grip { site } | EventKind::Release { site } => Data::Part {
+            part: m.str(m.parts[*site as usize].part).to_string(),
+        },
+        EventKind::Log { text } => Data::Text { text: text.clone() },
+        EventKind::Error { message } => Data::Issue {
+            kind: "runtime".into(),
+            message: message.clone(),
+            distance_m: None,
+        },
+        EventKind::EnableWhen { handler: h }
+        | EventKind::WhenFire { handler: h }
+        | EventKind::WhenEnd { handler: h } => handler(*h),
+        EventKind::DisableWhen { proc } => procedure(*proc),
+        EventKind::RemoteCall { site, .. } => {
+            let s = &m.remotes[*site as usize];
+            Data::Remote {
+                robot: m.str(s.robot).to_string(),
+                procedure: m.str(s.proc).to_string(),
+            }
+        }
+        EventKind::RemoteStart { proc } | EventKind::RemoteEnd { proc } => procedure(*proc),
+        EventKind::MotionEnd | EventKind::DelayEnd | EventKind::Join | EventKind::End => Data::None,
+    }
+}
+
+/// A VM event's details as trace lines show them, with the names of module `m`.
+fn vm_details(kind: &EventKind, m: &Module) -> String {
+    match kind {
+        EventKind::MotionStart {
+            command,
+            duration_ns,
+        } => format!("{command} duration={duration_ns}"),
+        EventKind::Delay { duration_ns } => format!("duration={duration_ns}"),
+        EventKind::Set { global, value, ty } => format!(
+            "{}={}",
+            m.str(m.globals[*global as usize].name),
+            format_value(*value, *ty)
+        ),
+        EventKind::WaitUntil { cond, deadline } => format!(
+            "condition({}){}",
+            cond_globals(m, *cond).join(","),
+            deadline.map_or(String::new(), |d| format!(" deadline={d}"))
+        ),
+        EventKind::WaitSignal { name, deadline } => format!(
+            "signal={}{}",
+            m.str(*name),
+            deadline.map_or(String::new(), |d| format!(" deadline={d}"))
+        ),
+        EventKind::WaitEnd { timed_out } => {
+            (if *timed_out { "timeout" } else { "released" }).into()
+        }
+        EventKind::Log { text } => format!("{text:?}"),
+        EventKind::Error { message } => format!("{message:?}"),
+        _ => match vm_data(kind, m) {
+            Data::Signal { robot, signal } => format!("{robot}.{signal}"),
+            Data::Remote { robot, procedure } => format!("{robot}.{procedure}"),
+            Data::Part { part } => part,
+            Data::Procedure { procedure } => procedure,
+            _ => String::new(),
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kinds_have_distinct_names_and_come_back_from_them() {
+        for k in Kind::ALL {
+            assert_eq!(Kind::from_name(k.name()), Some(k));
+        }
+        let mut names: Vec<_> = Kind::ALL.iter().map(|k| k.name()).collect();
+        names.sort_unstable();
+        names.dedup();
+        assert_eq!(names.len(), Kind::ALL.len());
+        assert_eq!(Kind::from_name("wait_signal"), None);
+    }
+
+    #[test]
+    fn data_round_trips_through_json() {
+        let cases = [
+            (
+                Kind::MotionStart,
+                Data::Motion {
+                    command: "move_l".into(),
+                    duration_ns: 1_500_000_000,
+                },
+            ),
+            (
+                Kind::Set,
+                Data::Set {
+                    global: "parts".into(),
+                    old: Value::Int(2),
+                    new: Value::Int(3),
+                },
+            ),
+            (
+                Kind::Set,
+                Data::Set {
+                    global: "gap".into(),
+                    old: Value::Num(0.25),
+                    new: Value::Num(-1e-3),
+                },
+            ),
+            (
+                Kind::WaitUntil,
+                Data::WaitCondition {
+                    globals: vec!["a".into(), "b".into()],
+                    deadline_ns: Some(7),
+                },
+            ),
+            (
+                Kind::WaitUntil,
+                Data::WaitSignal {
+                    signal: "go".into(),
+                    deadline_ns: None,
+                },
+            ),
+            (
+                Kind::CollisionStart,
+                Data::Collision {
+                    a: "r1.link_4".into(),
+                    b: "table".into(),
+                    contact: Some((0.002, [0.1, -0.2, 0.3])),
+                },
+            ),
+            (
+                Kind::CollisionEnd,
+                Data::Collision {
+                    a: "r1.link_4".into(),
+                    b: "table".into(),
+                    contact: None,
+                },
+            ),
+            (
+                Kind::Warning,
+                Data::Issue {
+                    kind: "near_miss".into(),
+                    message: "near miss".into(),
+                    distance_m: Some(0.00245),
+                },
+            ),
+            (Kind::End, Data::None),
+        ];
+        for (kind, data) in cases {
+            let e = Event {
+                time_ns: 42,
+                robot: Some("r1".into()),
+                kind,
+                details: "d".into(),
+                data,
+                file: Some("/x/r1.wsl".into()),
+                line: 3,
+                col: 5,
+            };
+            assert_eq!(Event::from_json(&e.to_json()), Ok(e.clone()), "{kind}");
+        }
+    }
+
+    #[test]
+    fn unknown_kinds_and_misfitting_data_are_errors() {
+        let e = json!({"time_ns": 0, "kind": "teleport", "details": ""});
+        assert!(Event::from_json(&e).unwrap_err().contains("`teleport`"));
+        let e = json!({"time_ns": 0, "kind": "set", "data": {"global": 3}});
+        assert!(Event::from_json(&e).is_err());
+        let e = json!({"time_ns": 0, "kind": "end", "details": ""});
+        assert_eq!(Event::from_json(&e).map(|e| e.data), Ok(Data::None));
+    }
+}

@@ -1,0 +1,68 @@
+//! The cell's kinematic state at a cycle boundary: every robot's joints and link frames,
+//! which robot holds which part, and where the parts are. The collider brings it up to
+//! date at each boundary it checks ([`crate::collide::Collider::check`]); sinks such as
+//! the log read it there ([`crate::sink::RunSink::cycle`]).
+
+use vworks_cell::Cell;
+use vworks_model::math::Iso;
+use vworks_vm::MAX_AXES;
+
+/// The state of a cell's robots and parts as of the last boundary checked.
+#[derive(Clone, Debug)]
+pub struct World {
+    /// Per robot: the joints `frames` are the forward kinematics of (`MAX_AXES` slots, the
+    /// robot's axes first; NaN before the first check).
+    pub(crate) joints: Vec<[f64; MAX_AXES]>,
+    /// Per robot: every link's frame in the cell.
+    pub(crate) frames: Vec<Vec<Iso>>,
+    /// Per part: the robot holding it and the part's pose in that robot's tool-link frame.
+    pub(crate) held: Vec<Option<(usize, Iso)>>,
+    /// Per part: its pose in the cell when not held.
+    pub(crate) part_pose: Vec<Iso>,
+}
+
+impl World {
+    /// The cell before its first boundary: parts where the workcell puts them, no frames
+    /// computed yet.
+    pub fn new(cell: &Cell) -> World {
+        World {
+            joints: vec![[f64::NAN; MAX_AXES]; cell.robots.len()],
+            frames: cell
+                .robots
+                .iter()
+                .map(|r| r.model.frames_buffer())
+                .collect(),
+            held: vec![None; cell.parts.len()],
+            part_pose: cell.parts.iter().map(|p| p.pose).collect(),
+        }
+    }
+
+    /// Every robot's joints (`MAX_AXES` slots, the robot's axes first).
+    pub fn joints(&self) -> &[[f64; MAX_AXES]] {
+        &self.joints
+    }
+
+    /// Every robot's link frames in the cell.
+    pub fn frames(&self) -> &[Vec<Iso>] {
+        &self.frames
+    }
+
+    /// The robot holding part `p`, if one does.
+    pub fn holder(&self, p: usize) -> Option<usize> {
+        self.held.get(p).copied().flatten().map(|(r, _)| r)
+    }
+
+    /// Part `p`'s pose in the cell (identity if there is no part `p`).
+    pub fn part_pose(&self, cell: &Cell, p: usize) -> Iso {
+        match self.held.get(p).copied().flatten() {
+            Some((r, offset)) => self.frames[r][cell.robots[r].model.tool_link].mul(&offset),
+            None => self.part_pose.get(p).copied().unwrap_or(Iso::IDENTITY),
+        }
+    }
+
+    /// Every part's pose in the cell, into `out` (reused).
+    pub fn part_poses_into(&self, cell: &Cell, out: &mut Vec<Iso>) {
+        out.clear();
+        out.extend((0..cell.parts.len()).map(|p| self.part_pose(cell, p)));
+    }
+}
