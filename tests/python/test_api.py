@@ -135,7 +135,7 @@ def test_result_fields():
     assert (r1.name, r2.name) == ("r1", "r2")
     assert r1.end_time == pytest.approx(63.417729589) and r1.ended == "ended"
     assert r1.moving + r1.waiting + r1.idle == pytest.approx(r.end_time, abs=1e-6)
-    assert r1.motions == 41 and r1.handler == 0
+    assert r1.motions == 41 and not hasattr(r1, "handler")
     assert r.globals == {"handed": 3}
     assert r.collisions == [] and r.errors == []
     assert isinstance(r.warnings, list)
@@ -170,6 +170,19 @@ def test_run_until_and_a_log(tmp_path):
     assert r.log_counts["/state"] == -(-r.cycles // 10)
     read = vworks.read_log(log)
     assert [e.trace_line() for e in read] == [e.trace_line() for e in r.events]
+    # The typed details come back from the log as the run gave them.
+    assert [e.data for e in read] == [e.data for e in r.events]
+
+
+def test_events_carry_typed_data():
+    r = vworks.load_cell(HANDOFF).run()
+    sets = [e.data for e in r.events if e.kind == "set"]
+    # handoff's r1 counts three parts handed over: 0 → 1 → 2 → 3, as ints.
+    assert sets == [{"global": "handed", "old": n, "new": n + 1} for n in range(3)]
+    motion = next(e for e in r.events if e.kind == "motion_start")
+    assert motion.data["command"] in ("move_j", "move_l", "move_c")
+    assert motion.data["duration_ns"] == int(motion.details.split("duration=")[1])
+    assert next(e for e in r.events if e.kind == "end").data is None
     # A cell runs again from the start, the same way.
     again = cell.run(until=5)
     assert [e.trace_line() for e in again.events] == [e.trace_line() for e in r.events]

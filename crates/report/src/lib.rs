@@ -23,6 +23,13 @@ use vworks_se::trace::{Data, Kind};
 
 pub use vworks_se::stats::Activity;
 
+/// The README's Rust example, compiled by `cargo test --doc` so that it stays true (this
+/// crate sits at the end of the run's data flow, so it can see every crate the example
+/// uses).
+#[cfg(doctest)]
+#[doc = include_str!("../../../README.md")]
+pub struct ReadmeExamples;
+
 /// Events in the table at most (the rest are counted; `vworks log events` lists them).
 pub const TABLE_LIMIT: usize = 20_000;
 

@@ -26,8 +26,3 @@ pub mod sink;
 pub mod stats;
 pub mod trace;
 pub mod world;
-
-/// The README's Rust example, compiled by `cargo test --doc` so that it stays true.
-#[cfg(doctest)]
-#[doc = include_str!("../../../README.md")]
-pub struct ReadmeExamples;

@@ -93,6 +93,9 @@ pub struct RobotStats {
     pub ended: Ending,
 }
 
+/// One robot's closed intervals: (activity, start ns, end ns).
+pub type Intervals = Vec<(Activity, i64, i64)>;
+
 /// The fold: feed every event in order ([`Fold::event`]), then [`Fold::finish`].
 /// Allocates nothing per event unless intervals are kept.
 #[derive(Clone, Debug)]
@@ -106,7 +109,7 @@ pub struct Fold {
     /// Per robot: how it stands by its events alone (a log has nothing else).
     state: Vec<Ending>,
     /// Per robot, if kept: (activity, start, end) in the order they closed.
-    intervals: Option<Vec<Vec<(Activity, i64, i64)>>>,
+    intervals: Option<Vec<Intervals>>,
 }
 
 impl Fold {
@@ -182,7 +185,7 @@ impl Fold {
         mut self,
         end_ns: i64,
         ended: &dyn Fn(usize) -> Option<Ending>,
-    ) -> (Vec<RobotStats>, Vec<Vec<(Activity, i64, i64)>>) {
+    ) -> (Vec<RobotStats>, Vec<Intervals>) {
         let mut out = Vec::with_capacity(self.names.len());
         for r in 0..self.names.len() {
             self.close(r, Activity::Moving, end_ns);
