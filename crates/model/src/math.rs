@@ -141,6 +141,18 @@ pub fn sub(a: V3, b: V3) -> V3 {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
+/// `a · b`.
+#[inline]
+pub fn dot(a: V3, b: V3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// `s·x + y`.
+#[inline]
+pub fn axpy(s: f64, x: V3, y: V3) -> V3 {
+    [s * x[0] + y[0], s * x[1] + y[1], s * x[2] + y[2]]
+}
+
 /// `a × b`.
 #[inline]
 pub fn cross(a: V3, b: V3) -> V3 {

@@ -299,12 +299,12 @@ impl Thread {
                 Instr::CmpI(c) => {
                     let y = self.pop() as i64;
                     let x = self.pop() as i64;
-                    self.stack.push(u64::from(cmp(c, x.cmp(&y))));
+                    self.stack.push(u64::from(c.holds(x.cmp(&y))));
                 }
                 Instr::CmpF(c) => {
                     let y = f(self.pop());
                     let x = f(self.pop());
-                    let v = x.partial_cmp(&y).is_some_and(|o| cmp(c, o));
+                    let v = x.partial_cmp(&y).is_some_and(|o| c.holds(o));
                     self.stack.push(u64::from(v));
                 }
                 Instr::CmpB(c) => {
@@ -483,17 +483,5 @@ impl Thread {
             ));
         }
         Ok(i as usize)
-    }
-}
-
-fn cmp(c: Cmp, o: std::cmp::Ordering) -> bool {
-    use std::cmp::Ordering::*;
-    match c {
-        Cmp::Eq => o == Equal,
-        Cmp::Ne => o != Equal,
-        Cmp::Lt => o == Less,
-        Cmp::Le => o != Greater,
-        Cmp::Gt => o == Greater,
-        Cmp::Ge => o != Less,
     }
 }

@@ -6,16 +6,10 @@
 /// A pose as stored in six slots: x, y, z (m), rx, ry, rz (rad).
 pub type Pose6 = [f64; 6];
 
-/// The rotation matrix (row-major) of fixed-axis roll-pitch-yaw angles.
+/// The rotation matrix (row-major) of fixed-axis roll-pitch-yaw angles: the robot
+/// models' own ([`vworks_model::math::rpy_matrix`]), so poses mean the same in both.
 pub fn rpy_to_matrix(rx: f64, ry: f64, rz: f64) -> [[f64; 3]; 3] {
-    let (sr, cr) = rx.sin_cos();
-    let (sp, cp) = ry.sin_cos();
-    let (sy, cy) = rz.sin_cos();
-    [
-        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-        [-sp, cp * sr, cp * cr],
-    ]
+    vworks_model::math::rpy_matrix([rx, ry, rz])
 }
 
 /// `offset(p, dx, dy, dz)`: translates the pose along the base frame's axes.

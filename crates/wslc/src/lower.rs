@@ -2568,14 +2568,7 @@ impl Compiler<'_> {
             _ => (lt, rt, lo.k.clone(), ro.k.clone()),
         };
         let bare = lo.bare && ro.bare;
-        let cmp = |op: BinOp| match op {
-            Eq => Cmp::Eq,
-            Ne => Cmp::Ne,
-            Lt => Cmp::Lt,
-            Le => Cmp::Le,
-            Gt => Cmp::Gt,
-            _ => Cmp::Ge,
-        };
+        let cmp = cmp_of;
         match (op, lt, rt) {
             (Add | Sub | Mul | Div | Mod, Ty::Int, Ty::Int) => {
                 self.emit(
@@ -2672,7 +2665,7 @@ impl Compiler<'_> {
                 self.emit(Instr::CmpI(cmp(op)), sp);
                 let k = match (lk, rk) {
                     (Some(ConstValue::Int(a)), Some(ConstValue::Int(b))) => {
-                        Some(ConstValue::Bool(compare(op, a.cmp(&b))))
+                        Some(ConstValue::Bool(cmp_of(op).holds(a.cmp(&b))))
                     }
                     _ => None,
                 };
@@ -2693,9 +2686,9 @@ impl Compiler<'_> {
                 }
                 self.emit(Instr::CmpF(cmp(op)), sp);
                 let k = match (lk, rk) {
-                    (Some(ConstValue::Num(x)), Some(ConstValue::Num(y))) => {
-                        x.partial_cmp(&y).map(|o| ConstValue::Bool(compare(op, o)))
-                    }
+                    (Some(ConstValue::Num(x)), Some(ConstValue::Num(y))) => x
+                        .partial_cmp(&y)
+                        .map(|o| ConstValue::Bool(cmp_of(op).holds(o))),
                     _ => None,
                 };
                 Out {
@@ -3311,14 +3304,14 @@ fn num2(
     }
 }
 
-fn compare(op: BinOp, o: std::cmp::Ordering) -> bool {
-    use std::cmp::Ordering::*;
+/// The comparison instruction's operator for a comparison `op`.
+fn cmp_of(op: BinOp) -> Cmp {
     match op {
-        BinOp::Eq => o == Equal,
-        BinOp::Ne => o != Equal,
-        BinOp::Lt => o == Less,
-        BinOp::Le => o != Greater,
-        BinOp::Gt => o == Greater,
-        _ => o != Less,
+        BinOp::Eq => Cmp::Eq,
+        BinOp::Ne => Cmp::Ne,
+        BinOp::Lt => Cmp::Lt,
+        BinOp::Le => Cmp::Le,
+        BinOp::Gt => Cmp::Gt,
+        _ => Cmp::Ge,
     }
 }

@@ -68,28 +68,7 @@ pub(super) fn trust(a: &dyn parry3d::shape::Shape, b: &dyn parry3d::shape::Shape
     }
 }
 
-/// A vector in the cell frame (m).
-pub(super) type V3 = [f64; 3];
-
-pub(super) fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-pub(super) fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-pub(super) fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-pub(super) fn axpy(s: f64, x: V3, y: V3) -> V3 {
-    [s * x[0] + y[0], s * x[1] + y[1], s * x[2] + y[2]]
-}
+pub(super) use vworks_model::math::{V3, axpy, cross, dot, sub};
 
 /// Point `p` (in the shape's frame) placed by `pose`, in f64.
 pub(super) fn place(pose: &Pose, p: parry3d::math::Vector) -> V3 {

@@ -27,6 +27,20 @@ pub enum Cmp {
 }
 
 impl Cmp {
+    /// Whether the comparison holds for two operands ordered `o` (the interpreter and the
+    /// compiler's constant folding both ask this).
+    pub fn holds(self, o: std::cmp::Ordering) -> bool {
+        use std::cmp::Ordering::*;
+        match self {
+            Cmp::Eq => o == Equal,
+            Cmp::Ne => o != Equal,
+            Cmp::Lt => o == Less,
+            Cmp::Le => o != Greater,
+            Cmp::Gt => o == Greater,
+            Cmp::Ge => o != Less,
+        }
+    }
+
     /// The operator as written in WSL.
     pub fn symbol(self) -> &'static str {
         match self {
@@ -446,6 +460,26 @@ impl Instr {
                 | Instr::Log(_)
                 | Instr::Fail(_)
                 | Instr::Stop
+        )
+    }
+
+    /// True for the instructions that may let simulated time pass (a motion, a delay, a
+    /// wait, a grip or release, remote work and its join): `when` handlers, which run in
+    /// zero time, may not execute them.
+    pub fn takes_time(&self) -> bool {
+        matches!(
+            self,
+            Instr::MoveJ(_)
+                | Instr::MoveL(_)
+                | Instr::MoveC(_)
+                | Instr::Delay
+                | Instr::WaitUntil(..)
+                | Instr::WaitSignal(..)
+                | Instr::Grip(_)
+                | Instr::Release(_)
+                | Instr::Remote(_)
+                | Instr::ParBegin
+                | Instr::ParJoin
         )
     }
 

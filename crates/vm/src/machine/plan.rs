@@ -1,0 +1,359 @@
+//! Motion planning and sampling: a motion's operands, inverse kinematics of its target,
+//! its trajectory and exact duration (`plan`), and the joints and TCP at any time inside
+//! it (`joints_at`, `tcp_at`, the speed bounds the collider's sweep uses).
+
+use super::*;
+
+impl Vm {
+    /// The joints at time `t` (inside or after the current motion).
+    pub fn joints_at(&self, t: i64) -> [f64; MAX_AXES] {
+        let Some((start, traj)) = &self.motion else {
+            return self.rest;
+        };
+        let dt = (t - start) as f64 / NS;
+        match traj {
+            Trajectory::Joint {
+                from,
+                delta,
+                profile,
+            } => {
+                let s = if profile.dist > 0.0 {
+                    profile.at(dt) / profile.dist
+                } else {
+                    1.0
+                };
+                let mut q = *from;
+                for (qi, d) in q.iter_mut().zip(delta) {
+                    *qi += d * s;
+                }
+                q
+            }
+            Trajectory::Cartesian {
+                path,
+                from,
+                to,
+                profile,
+                end_joints,
+                branch,
+                ..
+            } => {
+                if dt >= profile.t_total {
+                    return *end_joints;
+                }
+                let s = if profile.dist > 0.0 {
+                    profile.at(dt) / profile.dist
+                } else {
+                    1.0
+                };
+                let tcp = cartesian_at(path, from, to, s);
+                let flange = tcp.mul(&self.cfg.tool.inverse());
+                let mut q = [0.0; MAX_AXES];
+                // On the motion's branch (one analytic solution), or seeded from the start
+                // joints (numeric IK) — either way the configuration the move started in.
+                let n = self.model.dof();
+                let solved = match branch {
+                    Some(b) => self
+                        .model
+                        .ik_in_branch(&flange, &self.rest[..n], *b, &mut q[..n]),
+                    None => self.model.ik(&flange, &self.rest[..n], &mut q[..n]),
+                };
+                if solved.is_err() {
+                    return self.rest;
+                }
+                q
+            }
+        }
+    }
+
+    /// Per axis, a bound on its speed during the current motion (rad/s or m/s; 0 when
+    /// not moving): for a joint motion exact; for a Cartesian one the largest speed at the
+    /// 64 samples its axis speeds were checked at (between samples it can be somewhat
+    /// higher; the collision sweep adds a margin).
+    pub fn axis_rate_bounds(&self) -> [f64; MAX_AXES] {
+        let mut out = [0.0; MAX_AXES];
+        match &self.motion {
+            Some((_, Trajectory::Joint { delta, profile, .. })) if profile.dist > 0.0 => {
+                for (o, d) in out.iter_mut().zip(delta) {
+                    *o = d.abs() * profile.v / profile.dist;
+                }
+            }
+            Some((_, Trajectory::Cartesian { rates, .. })) => out = *rates,
+            _ => {}
+        }
+        out
+    }
+
+    /// The TCP pose at time `t`.
+    pub fn tcp_at(&self, t: i64) -> Iso {
+        if let Some((
+            start,
+            Trajectory::Cartesian {
+                path,
+                from,
+                to,
+                profile,
+                ..
+            },
+        )) = &self.motion
+        {
+            let dt = (t - start) as f64 / NS;
+            let s = if profile.dist > 0.0 {
+                (profile.at(dt) / profile.dist).min(1.0)
+            } else {
+                1.0
+            };
+            return cartesian_at(path, from, to, s);
+        }
+        let q = self.joints_at(t);
+        self.model.tcp(&q[..self.model.dof()], &self.cfg.tool)
+    }
+
+    /// The operands of a motion instruction, read (not popped) from the stack.
+    pub(super) fn motion_operands(&self, ins: Instr) -> MotionOperands {
+        let f = match ins {
+            Instr::MoveJ(f) | Instr::MoveL(f) | Instr::MoveC(f) => f,
+            _ => MoveFlags(0),
+        };
+        let s = &self.main.stack;
+        let mut k = 0;
+        let accel = f.has(MoveFlags::ACCEL).then(|| {
+            k += 1;
+            f64::from_bits(s[s.len() - k])
+        });
+        let speed = f.has(MoveFlags::SPEED).then(|| {
+            k += 1;
+            f64::from_bits(s[s.len() - k])
+        });
+        let tw = if f.has(MoveFlags::TARGET_JOINTS) {
+            MAX_AXES
+        } else {
+            6
+        };
+        let target = Slots::read(s, s.len() - k - tw, tw);
+        k += tw;
+        let via = matches!(ins, Instr::MoveC(_)).then(|| {
+            let vw = if f.has(MoveFlags::VIA_JOINTS) {
+                MAX_AXES
+            } else {
+                6
+            };
+            let v = Slots::read(s, s.len() - k - vw, vw);
+            k += vw;
+            v
+        });
+        MotionOperands {
+            target,
+            via,
+            speed,
+            accel,
+            width: k,
+        }
+    }
+
+    /// A pose operand (6 slots) or a joints operand (12 slots) as a TCP pose.
+    pub(super) fn operand_pose(&self, slots: &[u64]) -> Iso {
+        if slots.len() == 6 {
+            return to_iso(slots);
+        }
+        let q: Vec<f64> = slots
+            .iter()
+            .take(self.model.dof())
+            .map(|x| f64::from_bits(*x))
+            .collect();
+        self.model.tcp(&q, &self.cfg.tool)
+    }
+
+    pub(super) fn ik_tcp(&self, tcp: &Iso, near: &[f64]) -> Result<[f64; MAX_AXES], String> {
+        let n = self.model.dof();
+        let mut q = [0.0; MAX_AXES];
+        let flange = tcp.mul(&self.cfg.tool.inverse());
+        self.model
+            .ik(&flange, &near[..n], &mut q[..n])
+            // In the TCP's terms, as the program wrote the target.
+            .map_err(|e: IkError| format!("unreachable pose: {}", e.at_position(tcp.t)))?;
+        Ok(q)
+    }
+
+    /// Plans the motion of `ins` from the robot's state now; returns it and its duration.
+    pub(super) fn plan(&mut self, ins: Instr) -> Result<(Trajectory, i64), String> {
+        let MotionOperands {
+            target: target_slots,
+            via,
+            speed,
+            accel,
+            ..
+        } = self.motion_operands(ins);
+        let target = target_slots.get();
+        let n = self.model.dof();
+        let from = self.rest;
+        if let Instr::MoveJ(_) = ins {
+            let goal = if target.len() == MAX_AXES {
+                let mut q = [0.0; MAX_AXES];
+                for (i, v) in q.iter_mut().enumerate().take(n) {
+                    *v = f64::from_bits(target[i]);
+                }
+                q
+            } else {
+                self.ik_tcp(&to_iso(target), &from)?
+            };
+            for (i, g) in goal.iter().enumerate().take(n) {
+                let j = self.model.axis(i);
+                if *g < j.lower - 1e-9 || *g > j.upper + 1e-9 {
+                    return Err(format!(
+                        "joint limit exceeded: axis {} `{}` would go to {}, outside its range {} to {}; choose a target within the range{}",
+                        i + 1,
+                        j.name,
+                        j.display(*g),
+                        j.display(j.lower),
+                        j.display(j.upper),
+                        if target.len() == MAX_AXES {
+                            ""
+                        } else {
+                            " (this pose needs it: try another wrist configuration or approach)"
+                        }
+                    ));
+                }
+            }
+            let ratio = speed.unwrap_or(1.0);
+            let aratio = accel.unwrap_or(1.0);
+            if !(ratio > 0.0 && ratio <= 1.0 && aratio > 0.0 && aratio <= 1.0) {
+                return Err(format!(
+                    "speed and acceleration of move_j must be more than 0% and at most 100% (got {}%, {}%)",
+                    ratio * 100.0,
+                    aratio * 100.0
+                ));
+            }
+            // One normalised profile s(t) ∈ [0, 1] within every axis's limits.
+            let (mut vs, mut as_) = (f64::INFINITY, f64::INFINITY);
+            let mut delta = [0.0; MAX_AXES];
+            for i in 0..n {
+                delta[i] = goal[i] - from[i];
+                let d = delta[i].abs();
+                if d > 0.0 {
+                    let j = self.model.axis(i);
+                    vs = vs.min(ratio * j.max_velocity / d);
+                    as_ = as_.min(aratio * j.max_accel / d);
+                }
+            }
+            let profile = if vs.is_finite() {
+                Profile::new(1.0, vs, as_)
+            } else {
+                Profile::new(0.0, 1.0, 1.0)
+            };
+            let dur = profile.duration_ns();
+            return Ok((
+                Trajectory::Joint {
+                    from,
+                    delta,
+                    profile,
+                },
+                dur,
+            ));
+        }
+        // Cartesian: line or arc, orientation by slerp.
+        let start = self.tcp_at(self.time);
+        let goal = self.operand_pose(target);
+        let path = match &via {
+            None => Path::Line {
+                from: start.t,
+                to: goal.t,
+            },
+            Some(v) => {
+                let via_pose = self.operand_pose(v.get());
+                Path::arc(start.t, via_pose.t, goal.t).ok_or_else(|| "move_c: the via point lies on the line from start to target; give a point off that line".to_string())?
+            }
+        };
+        let v = speed.unwrap_or(self.cfg.default_speed);
+        if v.is_nan() || v <= 0.0 {
+            return Err(format!(
+                "the speed must be greater than zero (got {})",
+                fmt_quantity(v, Dim::SPEED)
+            ));
+        }
+        let a = accel.unwrap_or(v / vworks_model::model::DEFAULT_ACCEL_TIME);
+        let len = path.length();
+        let angle = vworks_model::math::norm(vworks_model::math::rotation_vector(
+            &vworks_model::math::mat_mul(&vworks_model::math::transpose(&start.r), &goal.r),
+        ));
+        // Orientation moves at most 180°/s (with the same ramp time).
+        let w = std::f64::consts::PI;
+        let mut vs = f64::INFINITY;
+        let mut as_ = f64::INFINITY;
+        // Below 0.1 µm and 0.1 µrad a move is a rounding error, not a motion.
+        if len > 1e-7 {
+            vs = vs.min(v / len);
+            as_ = as_.min(a / len);
+        }
+        if angle > 1e-7 {
+            vs = vs.min(w / angle);
+            as_ = as_.min(w / vworks_model::model::DEFAULT_ACCEL_TIME / angle);
+        }
+        if !vs.is_finite() {
+            let traj = Trajectory::Cartesian {
+                path,
+                from: start,
+                to: goal,
+                profile: Profile::new(0.0, 1.0, 1.0),
+                end_joints: from,
+                branch: None,
+                rates: [0.0; MAX_AXES],
+            };
+            return Ok((traj, 0));
+        }
+        // Joints along the path: reachable, and within every axis's speed at this speed.
+        const SAMPLES: usize = 64;
+        let mut prev = from;
+        let mut worst = 1.0f64;
+        let mut worst_axis = 0;
+        let mut rates = [0.0f64; MAX_AXES];
+        for k in 1..=SAMPLES {
+            let s = k as f64 / SAMPLES as f64;
+            let pose = cartesian_at(&path, &start, &goal, s);
+            let q = self
+                .ik_tcp(&pose, &prev)
+                .map_err(|e| format!("{e} (at {:.0}% of the path)", s * 100.0))?;
+            for i in 0..n {
+                // ds/dt at most vs: axis speed ≈ |Δq/Δs|·vs.
+                let rate = (q[i] - prev[i]).abs() * SAMPLES as f64 * vs;
+                rates[i] = rates[i].max(rate);
+                let j = self.model.axis(i);
+                if rate > j.max_velocity && j.max_velocity / rate < worst {
+                    worst = j.max_velocity / rate;
+                    worst_axis = i;
+                }
+            }
+            prev = q;
+        }
+        if worst < 1.0 {
+            vs *= worst;
+            as_ *= worst;
+            for r in &mut rates {
+                *r *= worst;
+            }
+            let pos = self.m.pos_of(self.main.pc);
+            let j = self.model.axis(worst_axis);
+            self.warnings.push((
+                self.time,
+                pos,
+                format!("the motion is slowed to {:.0}% of its speed: axis {} `{}` would exceed its speed limit", worst * 100.0, worst_axis + 1, j.name),
+            ));
+        }
+        let profile = Profile::new(1.0, vs, as_);
+        let dur = profile.duration_ns();
+        let branch = self
+            .model
+            .ik_branch(&start.mul(&self.cfg.tool.inverse()), &from[..n]);
+        Ok((
+            Trajectory::Cartesian {
+                path,
+                from: start,
+                to: goal,
+                profile,
+                end_joints: prev,
+                branch,
+                rates,
+            },
+            dur,
+        ))
+    }
+}
