@@ -28,6 +28,14 @@ pub mod syntax;
 pub mod units;
 
 pub use diag::{Code, Diagnostic, Severity, Sources, render};
+
+/// Every built-in function as (name, signature, result), in the order of
+/// docs/language.md's table: for editors, completions and documentation tools.
+pub fn builtin_functions() -> impl Iterator<Item = (&'static str, &'static str, &'static str)> {
+    lower::BUILTINS
+        .iter()
+        .map(|b| (b.name, b.signature, b.returns))
+}
 pub use vworks_vm::Module;
 
 /// A successful compilation.

@@ -1,0 +1,484 @@
+//! Checking and code generation in one walk over the syntax tree, split by what is being
+//! compiled:
+//!
+//! - this file: the driver ([`lower`]), the checking types (`Ty`, `Out`), the per-procedure
+//!   context and the emitter (instructions, constants, line table);
+//! - `decls`: module-level declarations and the symbol table (name resolution);
+//! - `stmt`: statements, with the zero-time and function rules where each is compiled;
+//! - `expr`: expressions, types and units, constant folding, calls, unknown names;
+//! - `rules`: conditions and handlers, and the checks closed over the call graph;
+//! - `builtins`: the built-in function table and its type rules.
+//!
+//! Declarations are collected first (procedure signatures, then globals, constants and
+//! module variables in order, each initializer evaluated at compile time); then every body
+//! is type- and unit-checked while its bytecode is emitted. Each expression yields its
+//! [`Ty`] and, when it is constant, its value: the code emitted for a constant
+//! subexpression is replaced by one push, which is both constant folding and the
+//! evaluator for module-level initializers.
+//!
+//! `wait_until` and `when` conditions, and the argument lists of `when` handlers, are
+//! compiled into synthetic procedures whose parameters are the locals they *capture* (by
+//! value, when the wait starts or the handler is enabled). Facts gathered per procedure —
+//! does it take time, which globals does it read, does it read clock or robot state, whom
+//! does it call — are closed over the call graph at the end to enforce the zero-time rule
+//! of handlers and to give every condition the exact set of globals it depends on.
+
+use std::collections::{BTreeSet, HashMap};
+
+use vworks_vm::bytecode::{
+    Capture, Cmp, CondInfo, ConstInfo, GlobalInfo, HandlerInfo, Instr, JointsSite, LineEntry,
+    LogFormat, LogPart, MoveFlags, ParamInfo, PartSite, ProcInfo, ProcKind, RemoteSite, SignalSite,
+    SrcPos, Trigger, VarInfo,
+};
+use vworks_vm::math;
+use vworks_vm::{ConstValue, Dim, MAX_AXES, Module, Type};
+
+use crate::diag::{Code, Diagnostic, LineIndex};
+use crate::syntax::*;
+
+mod builtins;
+mod decls;
+mod expr;
+mod rules;
+mod stmt;
+
+pub(crate) use builtins::BUILTINS;
+use builtins::builtin_named;
+
+/// A type during checking: the run-time types plus text, "no value" and "already wrong".
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Ty {
+    Bool,
+    Int,
+    Num(Dim),
+    Joints,
+    Pose,
+    Void,
+    Error,
+}
+
+impl Ty {
+    fn vm(self) -> Option<Type> {
+        Some(match self {
+            Ty::Bool => Type::Bool,
+            Ty::Int => Type::Int,
+            Ty::Num(d) => Type::Num(d),
+            Ty::Joints => Type::Joints,
+            Ty::Pose => Type::Pose,
+            _ => return None,
+        })
+    }
+    fn width(self) -> u8 {
+        self.vm().map_or(0, Type::width)
+    }
+    /// How a value of this type is described in messages: "an int", "a length", "a pose".
+    fn described(self) -> String {
+        match self {
+            Ty::Bool => "a bool".into(),
+            Ty::Int => "an int".into(),
+            Ty::Num(d) => d.described(),
+            Ty::Joints => "a joints value".into(),
+            Ty::Pose => "a pose".into(),
+            Ty::Void => "no value".into(),
+            Ty::Error => "an invalid value".into(),
+        }
+    }
+    fn is_err(self) -> bool {
+        self == Ty::Error
+    }
+}
+
+/// The unit a bare number most likely meant, for "write 2s".
+fn default_unit(d: Dim) -> Option<&'static str> {
+    Some(match d {
+        Dim::LENGTH => "mm",
+        Dim::ANGLE => "deg",
+        Dim::TIME => "s",
+        Dim::SPEED => "mm/s",
+        Dim::ANGSPEED => "deg/s",
+        Dim::ACCEL => "mm/s2",
+        Dim::ANGACCEL => "deg/s2",
+        _ => return None,
+    })
+}
+
+/// The result of checking an expression.
+#[derive(Clone, Debug)]
+struct Out {
+    ty: Ty,
+    /// The value, if known at compile time.
+    k: Option<ConstValue>,
+    /// A number literal written without unit (for "write 2s" help).
+    bare: bool,
+}
+
+impl Out {
+    fn err() -> Out {
+        Out {
+            ty: Ty::Error,
+            k: None,
+            bare: false,
+        }
+    }
+    fn of(ty: Ty) -> Out {
+        Out {
+            ty,
+            k: None,
+            bare: false,
+        }
+    }
+    fn is_zero_literal(&self) -> bool {
+        self.bare && matches!(self.k, Some(ConstValue::Int(0) | ConstValue::Num(0.0)))
+    }
+}
+
+#[derive(Clone, Debug)]
+enum Sym {
+    Global(u32, Ty),
+    Const(Ty, ConstValue),
+    Var(u32, Ty),
+    Proc(u32),
+}
+
+#[derive(Clone, Debug)]
+struct Sig {
+    name: String,
+    is_func: bool,
+    params: Vec<(String, Ty)>,
+    ret: Ty,
+    span: Span,
+}
+
+/// Per-procedure facts, closed over the call graph at the end.
+#[derive(Clone, Debug, Default)]
+struct Facts {
+    /// The first statement that takes time: what it is and where.
+    time: Option<(String, Span)>,
+    /// Calls to user procedures/functions.
+    calls: Vec<(u32, Span)>,
+    /// Globals read.
+    globals: BTreeSet<u32>,
+    /// The first read of clock, robot state or a module variable.
+    impure: Option<(String, Span)>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum FnKind {
+    Proc,
+    Func,
+    Cond,
+    Handler,
+    /// A module-level initializer: constants only.
+    Init,
+}
+
+#[derive(Clone, Debug)]
+struct Local {
+    name: String,
+    slot: u32,
+    ty: Ty,
+    mutable: bool,
+}
+
+#[derive(Debug, Default)]
+struct Loop {
+    breaks: Vec<usize>,
+    continues: Vec<usize>,
+}
+
+#[derive(Debug)]
+struct FnCtx {
+    index: u32,
+    kind: FnKind,
+    ret: Ty,
+    code: Vec<Instr>,
+    lines: Vec<(u32, SrcPos)>,
+    scopes: Vec<Vec<Local>>,
+    next_slot: u32,
+    loops: Vec<Loop>,
+    /// Captured locals of the enclosing procedure: name, its slot there, width, type.
+    captures: Vec<(String, u32, u8, Ty)>,
+    /// Inside a `parallel` block's local branch: `Some(loops)`, the loops open around
+    /// the block (a `break` or `continue` to one of them, or a `return`, would leave the
+    /// block before its join: E0063).
+    in_parallel: Option<usize>,
+}
+
+impl FnCtx {
+    fn new(index: u32, kind: FnKind, ret: Ty) -> FnCtx {
+        FnCtx {
+            index,
+            kind,
+            ret,
+            code: Vec::new(),
+            lines: Vec::new(),
+            scopes: vec![Vec::new()],
+            next_slot: 0,
+            loops: Vec::new(),
+            captures: Vec::new(),
+            in_parallel: None,
+        }
+    }
+}
+
+struct PendingCond {
+    cond: u32,
+    span: Span,
+}
+
+struct PendingHandler {
+    target: u32,
+    span: Span,
+}
+
+/// Compiles a parsed module. Diagnostics get spans; the caller resolves positions.
+pub(crate) fn lower(
+    path: &str,
+    src: &str,
+    ast: &SourceModule,
+    diags: &mut Vec<Diagnostic>,
+) -> Module {
+    let mut c = Compiler {
+        index: LineIndex::new(src),
+        diags,
+        m: Module {
+            source_path: path.to_string(),
+            ..Module::default()
+        },
+        strings: HashMap::new(),
+        symbols: HashMap::new(),
+        sigs: Vec::new(),
+        facts: Vec::new(),
+        proc_code: Vec::new(),
+        fns: Vec::new(),
+        pending_conds: Vec::new(),
+        pending_handlers: Vec::new(),
+        disabled: Vec::new(),
+        scratch_facts: Facts::default(),
+    };
+    c.module(ast);
+    c.m
+}
+
+/// A finished procedure's instructions and its (pc, position) rows.
+type ProcCode = (Vec<Instr>, Vec<(u32, SrcPos)>);
+
+struct Compiler<'d> {
+    index: LineIndex,
+    diags: &'d mut Vec<Diagnostic>,
+    m: Module,
+    strings: HashMap<String, u32>,
+    symbols: HashMap<String, (Sym, Span)>,
+    sigs: Vec<Sig>,
+    facts: Vec<Facts>,
+    /// Code and line rows (procedure-relative) of each procedure, by index.
+    proc_code: Vec<ProcCode>,
+    fns: Vec<FnCtx>,
+    pending_conds: Vec<PendingCond>,
+    pending_handlers: Vec<PendingHandler>,
+    disabled: Vec<(u32, Span)>,
+    /// Facts of module-level initializers, which are discarded.
+    scratch_facts: Facts,
+}
+
+const TYPE_NAMES: &str =
+    "bool, int, num, length, angle, time, speed, angspeed, accel, angaccel, joints, pose";
+
+pub(crate) fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut cur = vec![i + 1];
+        for (j, cb) in b.iter().enumerate() {
+            let sub = prev[j] + usize::from(ca != *cb);
+            cur.push(sub.min(prev[j + 1] + 1).min(cur[j] + 1));
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+impl Compiler<'_> {
+    // ---- infrastructure ------------------------------------------------------------------
+
+    fn err(&mut self, d: Diagnostic) {
+        self.diags.push(d);
+    }
+
+    fn str(&mut self, s: &str) -> u32 {
+        if let Some(&i) = self.strings.get(s) {
+            return i;
+        }
+        let i = self.m.strings.len() as u32;
+        self.m.strings.push(s.to_string());
+        self.strings.insert(s.to_string(), i);
+        i
+    }
+
+    fn pos(&self, span: Span) -> SrcPos {
+        let (line, col) = self.index.line_col(span.start as usize);
+        SrcPos { line, col }
+    }
+
+    fn f(&mut self) -> &mut FnCtx {
+        let n = self.fns.len();
+        &mut self.fns[n - 1]
+    }
+
+    fn fk(&self) -> FnKind {
+        self.fns.last().map_or(FnKind::Init, |f| f.kind)
+    }
+
+    fn facts(&mut self) -> &mut Facts {
+        match self.fns.last() {
+            Some(f) if f.kind != FnKind::Init && (f.index as usize) < self.facts.len() => {
+                &mut self.facts[f.index as usize]
+            }
+            _ => &mut self.scratch_facts,
+        }
+    }
+
+    fn emit(&mut self, ins: Instr, span: Span) -> usize {
+        let pos = self.pos(span);
+        let f = self.f();
+        let pc = f.code.len() as u32;
+        if f.lines.last().is_none_or(|(_, p)| *p != pos) {
+            f.lines.push((pc, pos));
+        }
+        f.code.push(ins);
+        pc as usize
+    }
+
+    fn here(&mut self) -> usize {
+        self.f().code.len()
+    }
+
+    fn patch(&mut self, at: usize, target: usize) {
+        let t = target as u32;
+        let f = self.f();
+        f.code[at] = match f.code[at] {
+            Instr::Jump(_) => Instr::Jump(t),
+            Instr::JumpIfFalse(_) => Instr::JumpIfFalse(t),
+            Instr::JumpIfTrue(_) => Instr::JumpIfTrue(t),
+            other => other,
+        };
+    }
+
+    /// Drops the code emitted since `start` (used when a subexpression folded to a constant).
+    fn truncate(&mut self, start: usize) {
+        let f = self.f();
+        f.code.truncate(start);
+        while f.lines.last().is_some_and(|(pc, _)| *pc as usize >= start) {
+            f.lines.pop();
+        }
+    }
+
+    fn push_const(&mut self, v: &ConstValue, ty: Ty, span: Span) {
+        match v {
+            ConstValue::Bool(b) => {
+                self.emit(Instr::PushBool(*b), span);
+            }
+            ConstValue::Int(i) => {
+                self.emit(Instr::PushInt(*i), span);
+            }
+            ConstValue::Num(x) => {
+                self.emit(Instr::PushNum(*x), span);
+            }
+            ConstValue::Joints(_) | ConstValue::Pose(_) => {
+                let k = self.pool(v, ty, span);
+                self.emit(Instr::PushConst(k), span);
+            }
+        }
+    }
+
+    fn pool(&mut self, v: &ConstValue, ty: Ty, span: Span) -> u32 {
+        let vty = ty.vm().unwrap_or(Type::Pose);
+        if let Some(i) = self
+            .m
+            .consts
+            .iter()
+            .position(|c| c.ty == vty && &c.value == v)
+        {
+            return i as u32;
+        }
+        let pos = self.pos(span);
+        self.m.consts.push(ConstInfo {
+            name: None,
+            ty: vty,
+            value: v.clone(),
+            pos,
+        });
+        (self.m.consts.len() - 1) as u32
+    }
+
+    fn new_proc(&mut self, name: &str, kind: ProcKind, span: Span) -> u32 {
+        let name = self.str(name);
+        let pos = self.pos(span);
+        self.m.procs.push(ProcInfo {
+            name,
+            kind,
+            params: Vec::new(),
+            ret: None,
+            frame_slots: 0,
+            code_start: 0,
+            code_len: 0,
+            pos,
+            max_stack: 0,
+        });
+        self.facts.push(Facts::default());
+        self.proc_code.push((Vec::new(), Vec::new()));
+        (self.m.procs.len() - 1) as u32
+    }
+
+    fn finish_fn(&mut self) -> FnCtx {
+        let f = self
+            .fns
+            .pop()
+            .unwrap_or_else(|| FnCtx::new(0, FnKind::Init, Ty::Void));
+        if f.kind != FnKind::Init
+            && let Some(p) = self.m.procs.get_mut(f.index as usize)
+        {
+            p.frame_slots = f.next_slot;
+            self.proc_code[f.index as usize] = (f.code.clone(), f.lines.clone());
+        }
+        f
+    }
+
+    // ---- module ----------------------------------------------------------------------------
+
+    // ---- statements --------------------------------------------------------------------
+
+    // ---- whole-module rules --------------------------------------------------------------
+
+    // ---- expressions -------------------------------------------------------------------
+}
+
+fn to_num(k: &Option<ConstValue>) -> Option<ConstValue> {
+    match k {
+        Some(ConstValue::Int(i)) => Some(ConstValue::Num(*i as f64)),
+        other => other.clone(),
+    }
+}
+
+fn num2(
+    a: &Option<ConstValue>,
+    b: &Option<ConstValue>,
+    f: impl Fn(f64, f64) -> f64,
+) -> Option<ConstValue> {
+    match (a, b) {
+        (Some(ConstValue::Num(x)), Some(ConstValue::Num(y))) => Some(ConstValue::Num(f(*x, *y))),
+        _ => None,
+    }
+}
+
+/// The comparison instruction's operator for a comparison `op`.
+fn cmp_of(op: BinOp) -> Cmp {
+    match op {
+        BinOp::Eq => Cmp::Eq,
+        BinOp::Ne => Cmp::Ne,
+        BinOp::Lt => Cmp::Lt,
+        BinOp::Le => Cmp::Le,
+        BinOp::Gt => Cmp::Gt,
+        _ => Cmp::Ge,
+    }
+}
