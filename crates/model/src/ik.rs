@@ -17,6 +17,7 @@
 use std::f64::consts::PI;
 
 use crate::math::{Iso, M3, V3, cross, mat_mul, mat_vec, norm, rotation_vector, sub, transpose};
+pub use crate::model::SphericalWrist;
 use crate::model::{AxisDir, JointKind, RobotModel};
 
 /// Levenberg–Marquardt iterations per start.
@@ -97,27 +98,6 @@ impl IkError {
         }
         self
     }
-}
-
-/// The geometry of a spherical-wrist arm, read from its model.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SphericalWrist {
-    /// Root frame to axis 1's joint frame (fixed joints before it and its origin).
-    pre: Iso,
-    /// Inverse of `pre`.
-    pre_inv: Iso,
-    /// Axis 6's frame to the tool link (fixed joints after it), inverted.
-    post_inv: Iso,
-    /// Sign of each axis (+1 or −1) relative to z, y, y, x, y, x.
-    sign: [f64; 6],
-    /// Axis 2's position in axis 1's frame (x, z).
-    shoulder: [f64; 2],
-    /// Axis 2 → axis 3 (x, z).
-    upper: [f64; 2],
-    /// Axis 3 → wrist centre (x, z).
-    fore: [f64; 2],
-    /// Wrist centre → axis 6 frame, along x.
-    hand: f64,
 }
 
 fn is_identity(r: &M3) -> bool {

@@ -206,7 +206,7 @@ pub struct RobotModel {
     /// The tool (flange) link.
     pub tool_link: usize,
     /// The analytic IK geometry, when the robot is a spherical-wrist 6-axis arm.
-    pub wrist: Option<crate::ik::SphericalWrist>,
+    pub wrist: Option<SphericalWrist>,
     /// The joints from the root to the tool link, in order.
     pub(crate) chain_cache: Vec<usize>,
 }
@@ -375,4 +375,26 @@ impl Iso {
             parry3d::math::Rot3::from_mat3(&m),
         )
     }
+}
+
+/// The geometry of a spherical-wrist arm, read from its model by
+/// [`crate::ik::SphericalWrist::detect`] (kept here, with the model it belongs to).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SphericalWrist {
+    /// Root frame to axis 1's joint frame (fixed joints before it and its origin).
+    pub(crate) pre: Iso,
+    /// Inverse of `pre`.
+    pub(crate) pre_inv: Iso,
+    /// Axis 6's frame to the tool link (fixed joints after it), inverted.
+    pub(crate) post_inv: Iso,
+    /// Sign of each axis (+1 or −1) relative to z, y, y, x, y, x.
+    pub(crate) sign: [f64; 6],
+    /// Axis 2's position in axis 1's frame (x, z).
+    pub(crate) shoulder: [f64; 2],
+    /// Axis 2 → axis 3 (x, z).
+    pub(crate) upper: [f64; 2],
+    /// Axis 3 → wrist centre (x, z).
+    pub(crate) fore: [f64; 2],
+    /// Wrist centre → axis 6 frame, along x.
+    pub(crate) hand: f64,
 }

@@ -1,5 +1,5 @@
 //! Consumers of a run: the MCAP log today, a live stream or a progress display later. A
-//! sink is attached to a [`crate::engine::Simulation`] with `with_sink` and sees every
+//! sink is attached to a `Simulation` (`engine`) with `with_sink` and sees every
 //! event as it is recorded and the cell's state at cycle boundaries, without the engine
 //! knowing what it does with them.
 
@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 
 use vworks_cell::Cell;
 
-use crate::engine::Outcome;
+use crate::result::Outcome;
 use crate::stats::RobotStats;
 use crate::trace::TraceEvent;
 use crate::world::World;
