@@ -5,8 +5,11 @@ Built into the test virtualenv by scripts/test (`maturin develop`); the stub che
 """
 
 import inspect
+import json
 import math
+import os
 import pathlib
+import subprocess
 import tempfile
 import threading
 import time
@@ -172,6 +175,22 @@ def test_run_until_and_a_log(tmp_path):
     assert [e.trace_line() for e in read] == [e.trace_line() for e in r.events]
     # The typed details come back from the log as the run gave them.
     assert [e.data for e in read] == [e.data for e in r.events]
+
+
+def test_to_dict_is_the_run_json():
+    r = vworks.load_cell(HANDOFF).run(until=5)
+    d = r.to_dict()
+    # The same object `vworks run --json` prints (one RunResult::to_json in Rust).
+    assert d["outcome"] == "until" and d["end_time_ns"] == 5_000_000_000
+    assert d["globals"] == r.globals and d["events"] == len(r.events)
+    assert [x["name"] for x in d["robots"]] == [s.name for s in r.robots]
+    assert [x["idle_ns"] / 1e9 for x in d["robots"]] == pytest.approx([s.idle for s in r.robots])
+    assert d["log"] is None
+    exe = os.environ.get("VWORKS")
+    if exe:  # scripts/test sets it to the binary it just built
+        out = subprocess.run([exe, "run", str(HANDOFF), "--until", "5s", "--json"],
+                             capture_output=True, text=True, check=True).stdout
+        assert json.loads(out) == d
 
 
 def test_events_carry_typed_data():

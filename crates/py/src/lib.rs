@@ -325,7 +325,8 @@ impl Cell {
             sim = sim.with_log(l);
         }
         let r = py.detach(|| sim.run(until));
-        let report = RunReport::new(&self.cell, r);
+        let log_file = log.as_ref().map(|p| p.display().to_string());
+        let report = RunReport::new(&self.cell, r, log_file.as_deref());
         if check && report.outcome == Outcome::Error.name() {
             return Err(report.simulation_error(py));
         }
@@ -631,11 +632,14 @@ struct RunReport {
     cycles: u64,
     log_counts: Vec<(String, u64)>,
     log_error: Option<String>,
+    /// The result as `vworks run --json` prints it.
+    json: String,
 }
 
 impl RunReport {
-    fn new(cell: &vworks_cell::Cell, r: RunResult) -> RunReport {
+    fn new(cell: &vworks_cell::Cell, r: RunResult, log_file: Option<&str>) -> RunReport {
         RunReport {
+            json: r.to_json(&cell.name, log_file).to_string(),
             outcome: r.outcome.name().to_string(),
             end_time_ns: r.end_time_ns,
             robots: r
@@ -758,6 +762,14 @@ impl RunReport {
     #[getter]
     fn errors(&self) -> Vec<PyIssue> {
         self.errors.clone()
+    }
+
+    /// The result as a dict, exactly as `vworks run --json` prints it (times in ns,
+    /// globals as values of their type).
+    fn to_dict(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        py.import("json")?
+            .call_method1("loads", (self.json.as_str(),))
+            .map(Bound::unbind)
     }
 
     /// Final values of the globals by name (bool, int, or float in SI units).
@@ -913,7 +925,7 @@ impl Simulation {
             .take()
             .ok_or_else(|| Error::new_err("this simulation has no result"))?;
         let r = py.detach(|| sim.into_result());
-        let report = Py::new(py, RunReport::new(&self.cell, r))?;
+        let report = Py::new(py, RunReport::new(&self.cell, r, None))?;
         self.result = Some(report.clone_ref(py));
         Ok(report)
     }
