@@ -175,6 +175,9 @@ def test_run_until_and_a_log(tmp_path):
     assert [e.trace_line() for e in read] == [e.trace_line() for e in r.events]
     # The typed details come back from the log as the run gave them.
     assert [e.data for e in read] == [e.data for e in r.events]
+    # A cell runs again from the start, the same way.
+    again = cell.run(until=5)
+    assert [e.trace_line() for e in again.events] == [e.trace_line() for e in r.events]
 
 
 def test_to_dict_is_the_run_json():
@@ -202,9 +205,6 @@ def test_events_carry_typed_data():
     assert motion.data["command"] in ("move_j", "move_l", "move_c")
     assert motion.data["duration_ns"] == int(motion.details.split("duration=")[1])
     assert next(e for e in r.events if e.kind == "end").data is None
-    # A cell runs again from the start, the same way.
-    again = cell.run(until=5)
-    assert [e.trace_line() for e in again.events] == [e.trace_line() for e in r.events]
 
 
 def test_collision_and_deadlock_are_results_not_exceptions():
