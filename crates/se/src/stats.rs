@@ -101,15 +101,24 @@ pub type Intervals = Vec<(Activity, i64, i64)>;
 #[derive(Clone, Debug)]
 pub struct Fold {
     names: Vec<String>,
-    /// Per robot: open motion and wait (start times), totals, motions, last end.
-    open: Vec<[Option<i64>; 2]>,
-    total: Vec<[i64; 2]>,
-    motions: Vec<u32>,
-    ended_at: Vec<Option<i64>>,
-    /// Per robot: how it stands by its events alone (a log has nothing else).
-    state: Vec<Ending>,
+    /// Per robot, in one place (one bounds check per event).
+    robots: Vec<Robot>,
     /// Per robot, if kept: (activity, start, end) in the order they closed.
     intervals: Option<Vec<Intervals>>,
+}
+
+/// One robot's running totals.
+#[derive(Clone, Copy, Debug)]
+struct Robot {
+    /// Open motion and wait: their start times.
+    open: [Option<i64>; 2],
+    /// Time moving and waiting so far.
+    total: [i64; 2],
+    motions: u32,
+    /// Its last `end`, `remote_end` or `error`.
+    ended_at: Option<i64>,
+    /// How it stands by its events alone (a log has nothing else).
+    state: Ending,
 }
 
 impl Fold {
@@ -117,20 +126,24 @@ impl Fold {
     /// `keep_intervals`, every closed interval is kept for a timeline.
     pub fn new(names: Vec<String>, keep_intervals: bool) -> Fold {
         let n = names.len();
+        let robot = Robot {
+            open: [None; 2],
+            total: [0; 2],
+            motions: 0,
+            ended_at: None,
+            state: Ending::Running,
+        };
         Fold {
             names,
-            open: vec![[None; 2]; n],
-            total: vec![[0; 2]; n],
-            motions: vec![0; n],
-            ended_at: vec![None; n],
-            state: vec![Ending::Running; n],
+            robots: vec![robot; n],
             intervals: keep_intervals.then(|| vec![Vec::new(); n]),
         }
     }
 
     fn close(&mut self, r: usize, a: Activity, t: i64) {
-        if let Some(s) = self.open[r][a as usize].take() {
-            self.total[r][a as usize] += t - s;
+        let robot = &mut self.robots[r];
+        if let Some(s) = robot.open[a as usize].take() {
+            robot.total[a as usize] += t - s;
             if let Some(iv) = &mut self.intervals {
                 iv[r].push((a, s, t));
             }
@@ -141,41 +154,44 @@ impl Fold {
     /// out of range, change nothing).
     #[inline]
     pub fn event(&mut self, t: i64, robot: Option<usize>, kind: Kind) {
-        let Some(r) = robot.filter(|r| *r < self.names.len()) else {
+        let Some(r) = robot else { return };
+        let Some(st) = self.robots.get_mut(r) else {
             return;
         };
         match kind {
             Kind::MotionStart => {
-                self.motions[r] += 1;
-                self.open[r][Activity::Moving as usize].get_or_insert(t);
+                st.motions += 1;
+                st.open[Activity::Moving as usize].get_or_insert(t);
             }
             Kind::MotionEnd => self.close(r, Activity::Moving, t),
             Kind::WaitUntil | Kind::Join => {
-                self.state[r] = Ending::Waiting;
-                self.open[r][Activity::Waiting as usize].get_or_insert(t);
+                st.state = Ending::Waiting;
+                st.open[Activity::Waiting as usize].get_or_insert(t);
             }
             Kind::WaitEnd => {
-                self.state[r] = Ending::Running;
+                st.state = Ending::Running;
                 self.close(r, Activity::Waiting, t);
             }
             Kind::End | Kind::RemoteEnd | Kind::Error => {
-                self.state[r] = if kind == Kind::Error {
+                st.state = if kind == Kind::Error {
                     Ending::Error
                 } else {
                     Ending::Ended
                 };
-                self.ended_at[r] = Some(t);
+                st.ended_at = Some(t);
                 self.close(r, Activity::Moving, t);
                 self.close(r, Activity::Waiting, t);
             }
-            Kind::RemoteStart => self.state[r] = Ending::Running,
+            Kind::RemoteStart => st.state = Ending::Running,
             _ => {}
         }
     }
 
     /// Whether robot `r` has an open wait (its events say it waits).
     pub fn waiting(&self, r: usize) -> bool {
-        self.open.get(r).is_some_and(|o| o[1].is_some())
+        self.robots
+            .get(r)
+            .is_some_and(|o| o.open[Activity::Waiting as usize].is_some())
     }
 
     /// The statistics at the run's end `end_ns`; `ended` gives each robot's ending where
@@ -190,15 +206,16 @@ impl Fold {
         for r in 0..self.names.len() {
             self.close(r, Activity::Moving, end_ns);
             self.close(r, Activity::Waiting, end_ns);
-            let ending = ended(r).unwrap_or(self.state[r]);
-            let [moving_ns, waiting_ns] = self.total[r];
+            let st = self.robots[r];
+            let ending = ended(r).unwrap_or(st.state);
+            let [moving_ns, waiting_ns] = st.total;
             out.push(RobotStats {
                 name: std::mem::take(&mut self.names[r]),
                 moving_ns,
                 waiting_ns,
                 idle_ns: (end_ns - moving_ns - waiting_ns).max(0),
-                motions: self.motions[r],
-                end_time_ns: match (ending, self.ended_at[r]) {
+                motions: st.motions,
+                end_time_ns: match (ending, st.ended_at) {
                     (Ending::Ended, Some(t)) => t,
                     _ => end_ns,
                 },

@@ -432,7 +432,6 @@ impl Simulation {
             (Some(_), Some(p)) if p.line > 0 => Some(p),
             _ => None,
         };
-        self.fold.event(time, robot, kind);
         self.trace.push(TraceEvent {
             time,
             robot,
@@ -685,6 +684,10 @@ impl Simulation {
     }
 
     fn account(&mut self, r: usize, e: &Event) {
+        // Time per robot: the fold sees every event that can count — the robots' own (here)
+        // and the errors the engine finds in them (`error`); check_wait, check_when,
+        // collisions and warnings never change it.
+        self.fold.event(e.time, Some(r), Kind::of(&e.kind));
         if let EventKind::MotionStart { .. } = e.kind {
             // Speed bounds behind skipped collision queries change with the motion.
             self.collider.motion_started(r);
@@ -722,6 +725,7 @@ impl Simulation {
     ) {
         let issue = self.issue(kind, message, robot, pos);
         self.errors.push(issue.clone());
+        self.fold.event(t, robot, Kind::Error);
         self.record(t, robot, Kind::Error, Detail::Issue(Box::new(issue)), pos);
     }
 
