@@ -23,7 +23,7 @@ pub enum Outcome {
     Error,
     /// The `until` time was reached.
     Until,
-    /// Stopped from outside (Ctrl-C) through [`Simulation::with_stop`].
+    /// Stopped from outside (Ctrl-C) through `Simulation::with_stop` ([`crate::engine::Simulation`]).
     Interrupted,
 }
 

@@ -1,4 +1,4 @@
-//! Module-level declarations: type names, the symbol table, procedure signatures,
+//! Name resolution: type names, the symbol table, procedure signatures,
 //! globals, constants and module variables (their initializers evaluated at compile time),
 //! and each procedure body's frame.
 
