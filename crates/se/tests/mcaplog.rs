@@ -715,3 +715,21 @@ fn a_field_longer_than_its_record_is_damage_not_a_huge_allocation() {
         Err(e) => assert!(e.to_string().contains("damaged.mcap"), "{e}"),
     }
 }
+
+/// Found by the `log` fuzz target: a record inside an uncompressed chunk claimed more
+/// bytes than the chunk has, and the mcap crate's reader underflowed its count (a panic
+/// with overflow checks, a misread without). Such a chunk is damage; the reader stops
+/// before it and names its byte offset.
+#[test]
+fn a_record_longer_than_its_chunk_is_damage() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/log-record-longer-than-its-chunk.mcap");
+    let bytes = std::fs::read(&path).unwrap();
+    let contents = vworks_se::mcaplog::read_log_bytes("damaged.mcap", &bytes).unwrap();
+    let (read, why) = contents.damage.expect("reported as damaged");
+    assert_eq!(read, 0);
+    assert!(
+        why.contains("the chunk at byte 41 holds a record longer than the chunk"),
+        "{why}"
+    );
+}

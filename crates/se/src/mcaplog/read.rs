@@ -57,7 +57,16 @@ pub fn read_log_bytes(file: &str, bytes: &[u8]) -> Result<LogContents, LogError>
     // log is read with its sans-io reader and a record size limit, every length checked
     // before a record is parsed, and messages taken from their records here.
     let mut out = LogContents::default();
-    let damage = scan(bytes, &mut out, &invalid)?;
+    // The reader trusts the records inside an uncompressed chunk to fit in it (a longer one
+    // underflows its count: found by fuzzing). Such a chunk is the damage: everything
+    // before it is read (the reader then finds the file cut short there).
+    let damage = match uncompressed_chunks_fit(bytes) {
+        Ok(()) => scan(bytes, &mut out, &invalid)?,
+        Err((at, why)) => {
+            scan(&bytes[..at], &mut out, &invalid)?;
+            Some(why)
+        }
+    };
     if let Some(why) = damage {
         let read = out.counts.values().sum();
         out.damage = Some((read, why));
@@ -161,6 +170,68 @@ fn scan(
         }
     }
     Ok(None)
+}
+
+/// Checks every uncompressed chunk of the file: each record inside it must fit in the
+/// chunk's records. Returns where the first chunk that breaks this starts, and why.
+/// Records are walked as the file lays them out (opcode u8, length u64); what cannot be
+/// walked further is left to the reader, which reports it.
+fn uncompressed_chunks_fit(bytes: &[u8]) -> Result<(), (usize, String)> {
+    const CHUNK: u8 = 0x06;
+    let u64_at = |at: usize| {
+        bytes
+            .get(at..at.checked_add(8)?)
+            .and_then(|b| b.try_into().ok())
+            .map(u64::from_le_bytes)
+    };
+    let mut at = mcap::MAGIC.len();
+    while let (Some(&opcode), Some(len)) = (bytes.get(at), u64_at(at + 1)) {
+        let body = at + 9;
+        // A record may claim more than the file holds (a file cut short): the reader
+        // streams what there is, so a chunk is checked up to the file's end.
+        let claimed = usize::try_from(len).ok().and_then(|l| body.checked_add(l));
+        let end = claimed.map_or(bytes.len(), |e| e.min(bytes.len()));
+        if opcode == CHUNK {
+            // start u64, end u64, uncompressed size u64, crc u32, compression (u32 length
+            // and text), records length u64, records.
+            let comp_len = bytes
+                .get(body + 28..body + 32)
+                .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize);
+            if let Some(comp_len) = comp_len
+                && comp_len == 0
+                && let Some(records_len) = u64_at(body + 32)
+            {
+                let start = body + 40;
+                let records_end = usize::try_from(records_len)
+                    .ok()
+                    .and_then(|l| start.checked_add(l))
+                    .filter(|e| *e <= end)
+                    .unwrap_or(end);
+                let mut r = start;
+                while r < records_end {
+                    let inner = u64_at(r + 1)
+                        .and_then(|l| usize::try_from(l).ok())
+                        .and_then(|l| (r + 9).checked_add(l));
+                    match inner {
+                        Some(next) if next <= records_end => r = next,
+                        _ => {
+                            return Err((
+                                at,
+                                format!(
+                                    "the chunk at byte {at} holds a record longer than the chunk: the file is damaged there"
+                                ),
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+        match claimed {
+            Some(e) if e <= bytes.len() => at = e,
+            _ => return Ok(()),
+        }
+    }
+    Ok(())
 }
 
 /// Whether every length-prefixed field of a record fits in the record: the mcap crate
