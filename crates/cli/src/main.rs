@@ -16,6 +16,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use vworks_se::result::issue_json as json_issue;
 use vworks_vm::Module;
 use vworks_vm::bytecode::disassemble;
 use vworks_wslc::{Sources, compile, render};
@@ -420,9 +421,6 @@ fn simulate(
     }
     sim.into_result()
 }
-
-/// A warning or error as `run --json` lists them.
-use vworks_se::result::issue_json as json_issue;
 
 /// How `vworks run` was asked to run a cell.
 struct RunOptions<'a> {

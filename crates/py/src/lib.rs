@@ -361,47 +361,70 @@ impl Cell {
 #[pyclass(frozen, module = "vworks")]
 #[derive(Clone)]
 struct Event {
-    /// Simulated time (s).
-    #[pyo3(get)]
-    time: f64,
-    /// Simulated time (ns).
-    #[pyo3(get)]
-    time_ns: i64,
-    /// The robot, or `None` for cell events (a collision, a deadlock).
-    #[pyo3(get)]
-    robot: Option<String>,
-    /// Kind, e.g. `motion_start`, `set`, `wait_until`, `collision_start`, `end`.
-    #[pyo3(get)]
-    kind: &'static str,
-    /// What the trace line shows between kind and position (may be empty).
-    #[pyo3(get)]
-    details: String,
-    /// The WSL file, if the event has a source position.
-    #[pyo3(get)]
-    file: Option<String>,
-    /// Its line (0 if none).
-    #[pyo3(get)]
-    line: u32,
-    /// Its column (0 if none).
-    #[pyo3(get)]
-    col: u32,
-    /// The whole typed event.
-    typed: LoggedEvent,
+    e: LoggedEvent,
 }
 
 #[pymethods]
 impl Event {
+    /// Simulated time (s).
+    #[getter]
+    fn time(&self) -> f64 {
+        secs(self.e.time_ns)
+    }
+
+    /// Simulated time (ns).
+    #[getter]
+    fn time_ns(&self) -> i64 {
+        self.e.time_ns
+    }
+
+    /// The robot, or `None` for cell events (a collision, a deadlock).
+    #[getter]
+    fn robot(&self) -> Option<&str> {
+        self.e.robot.as_deref()
+    }
+
+    /// Kind, e.g. `motion_start`, `set`, `wait_until`, `collision_start`, `end`.
+    #[getter]
+    fn kind(&self) -> &'static str {
+        self.e.kind.name()
+    }
+
+    /// What the trace line shows between kind and position (may be empty).
+    #[getter]
+    fn details(&self) -> &str {
+        &self.e.details
+    }
+
+    /// The WSL file, if the event has a source position.
+    #[getter]
+    fn file(&self) -> Option<&str> {
+        self.e.file.as_deref()
+    }
+
+    /// Its line (0 if none).
+    #[getter]
+    fn line(&self) -> u32 {
+        self.e.line
+    }
+
+    /// Its column (0 if none).
+    #[getter]
+    fn col(&self) -> u32 {
+        self.e.col
+    }
+
     /// The event as a trace line: `time_ns robot kind details file:line:col`, `-` for an
     /// empty field (the golden traces' and `vworks log events`' format).
     fn trace_line(&self) -> String {
-        self.typed.line()
+        self.e.line()
     }
 
     /// The typed details as a dict (keys by kind, as in the log's `/events` `data`:
     /// docs/log.md), or `None` for events without details.
     #[getter]
     fn data(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
-        json_object(py, &self.typed.data.to_json())
+        json_object(py, &self.e.data.to_json().to_string())
     }
 
     fn __repr__(&self) -> String {
@@ -409,30 +432,13 @@ impl Event {
     }
 }
 
-/// A JSON value as the Python object `json.loads` gives.
-fn json_object(py: Python<'_>, v: &serde_json::Value) -> PyResult<Py<PyAny>> {
-    Ok(py
-        .import("json")?
-        .call_method1("loads", (v.to_string(),))?
-        .unbind())
+/// JSON text as the Python object `json.loads` gives.
+fn json_object(py: Python<'_>, json: &str) -> PyResult<Py<PyAny>> {
+    Ok(py.import("json")?.call_method1("loads", (json,))?.unbind())
 }
 
 fn event(cell: &vworks_cell::Cell, e: &TraceEvent) -> Event {
-    logged_event(e.resolve(cell))
-}
-
-fn logged_event(e: LoggedEvent) -> Event {
-    Event {
-        time: secs(e.time_ns),
-        time_ns: e.time_ns,
-        robot: e.robot.clone(),
-        kind: e.kind.name(),
-        details: e.details.clone(),
-        file: e.file.clone(),
-        line: e.line,
-        col: e.col,
-        typed: e,
-    }
+    Event { e: e.resolve(cell) }
 }
 
 /// A sequence of `Event`s (indexable, sliceable, iterable), with `to_pandas()`.
@@ -486,14 +492,17 @@ impl EventList {
             )
         })?;
         let columns = PyDict::new(py);
-        let e = &self.events;
-        columns.set_item("time", e.iter().map(|e| e.time).collect::<Vec<_>>())?;
+        let e: Vec<&LoggedEvent> = self.events.iter().map(|e| &e.e).collect();
+        columns.set_item(
+            "time",
+            e.iter().map(|e| secs(e.time_ns)).collect::<Vec<_>>(),
+        )?;
         columns.set_item("time_ns", e.iter().map(|e| e.time_ns).collect::<Vec<_>>())?;
         columns.set_item(
             "robot",
             e.iter().map(|e| e.robot.clone()).collect::<Vec<_>>(),
         )?;
-        columns.set_item("kind", e.iter().map(|e| e.kind).collect::<Vec<_>>())?;
+        columns.set_item("kind", e.iter().map(|e| e.kind.name()).collect::<Vec<_>>())?;
         columns.set_item(
             "details",
             e.iter().map(|e| e.details.clone()).collect::<Vec<_>>(),
@@ -767,9 +776,7 @@ impl RunReport {
     /// The result as a dict, exactly as `vworks run --json` prints it (times in ns,
     /// globals as values of their type).
     fn to_dict(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
-        py.import("json")?
-            .call_method1("loads", (self.json.as_str(),))
-            .map(Bound::unbind)
+        json_object(py, &self.json)
     }
 
     /// Final values of the globals by name (bool, int, or float in SI units).
@@ -1075,7 +1082,7 @@ fn read_log(py: Python<'_>, path: PathBuf) -> PyResult<EventList> {
         )?;
     }
     Ok(EventList {
-        events: log.events.into_iter().map(logged_event).collect(),
+        events: log.events.into_iter().map(|e| Event { e }).collect(),
     })
 }
 

@@ -48,8 +48,6 @@ pub struct Timeline {
     pub stats: RobotStats,
     /// (activity, start ns, end ns), in order of start.
     pub intervals: Vec<(Activity, i64, i64)>,
-    /// When its program ended (its last `end` or `remote_end`), if it did.
-    pub ended_ns: Option<i64>,
     /// Signals it sent: (time ns, `receiver.name`).
     pub signals: Vec<(i64, String)>,
 }
@@ -58,6 +56,11 @@ impl Timeline {
     /// The robot's name.
     pub fn robot(&self) -> &str {
         &self.stats.name
+    }
+
+    /// When its program ended (its cycle time), if it did.
+    pub fn ended_ns(&self) -> Option<i64> {
+        (self.stats.ended == Ending::Ended).then_some(self.stats.end_time_ns)
     }
 }
 
@@ -137,7 +140,6 @@ impl Report {
             })
             .unwrap_or_default();
         let mut fold = Fold::new(order.clone(), true);
-        let mut ended_ns = vec![None; order.len()];
         let mut signals = vec![Vec::new(); order.len()];
         let mut collisions: Vec<Collision> = Vec::new();
         let mut open_collisions: BTreeMap<(String, String), usize> = BTreeMap::new();
@@ -146,7 +148,6 @@ impl Report {
             let r = e.robot.as_deref().and_then(|r| index.get(r)).copied();
             fold.event(e.time_ns, r, e.kind);
             match (e.kind, r, &e.data) {
-                (Kind::End | Kind::RemoteEnd, Some(r), _) => ended_ns[r] = Some(e.time_ns),
                 (Kind::Signal, Some(r), _) => signals[r].push((e.time_ns, e.details.clone())),
                 (Kind::CollisionStart, _, Data::Collision { a, b, .. }) => {
                     open_collisions.insert((a.clone(), b.clone()), collisions.len());
@@ -179,9 +180,8 @@ impl Report {
         let timelines = stats
             .into_iter()
             .zip(intervals)
-            .zip(ended_ns.into_iter().zip(signals))
-            .map(|((stats, intervals), (ended_ns, signals))| Timeline {
-                ended_ns: ended_ns.filter(|_| stats.ended == Ending::Ended),
+            .zip(signals)
+            .map(|((stats, intervals), signals)| Timeline {
                 stats,
                 intervals,
                 signals,
@@ -278,7 +278,7 @@ fn gantt(report: &Report) -> String {
             tx = LEFT - 8.0,
             ty = y + 20.0,
             yb = y + 4.0,
-            wi = x(tl.ended_ns.unwrap_or(report.end_ns)) - LEFT,
+            wi = x(tl.ended_ns().unwrap_or(report.end_ns)) - LEFT,
         );
         for (activity, start, end) in &tl.intervals {
             let _ = write!(
@@ -306,7 +306,7 @@ fn gantt(report: &Report) -> String {
                 at = secs(*t),
             );
         }
-        if let Some(end) = tl.ended_ns {
+        if let Some(end) = tl.ended_ns() {
             let _ = write!(
                 s,
                 r##"<line class="end" x1="{xe:.1}" y1="{y0:.1}" x2="{xe:.1}" y2="{y1:.1}" stroke="#222" stroke-width="2"><title>{name} ends at {at}</title></line>"##,
@@ -608,7 +608,7 @@ mod tests {
             a.intervals,
             vec![(Activity::Moving, 0, 5), (Activity::Waiting, 5, 8)]
         );
-        assert_eq!((a.ended_ns, a.stats.motions), (Some(10), 1));
+        assert_eq!((a.ended_ns(), a.stats.motions), (Some(10), 1));
         assert_eq!(
             (a.stats.moving_ns, a.stats.waiting_ns, a.stats.idle_ns),
             (5, 3, 4)

@@ -501,6 +501,51 @@ impl Event {
 }
 
 impl Data {
+    /// The details as a trace line shows them (empty for [`Data::None`]). A set's value is
+    /// written in SI units here; [`TraceEvent::details`] writes it in display units.
+    pub fn text(&self) -> String {
+        let deadline = |d: &Option<i64>| d.map_or(String::new(), |d| format!(" deadline={d}"));
+        match self {
+            Data::None => String::new(),
+            Data::Motion {
+                command,
+                duration_ns,
+            } => format!("{command} duration={duration_ns}"),
+            Data::Delay { duration_ns } => format!("duration={duration_ns}"),
+            Data::Set { global, new, .. } => match new {
+                Value::Bool(b) => format!("{global}={b}"),
+                Value::Int(i) => format!("{global}={i}"),
+                Value::Num(x) => format!("{global}={x}"),
+            },
+            Data::WaitCondition {
+                globals,
+                deadline_ns,
+            } => format!("condition({}){}", globals.join(","), deadline(deadline_ns)),
+            Data::WaitSignal {
+                signal,
+                deadline_ns,
+            } => format!("signal={signal}{}", deadline(deadline_ns)),
+            Data::WaitEnd { timed_out } => (if *timed_out { "timeout" } else { "released" }).into(),
+            Data::Signal { robot, signal } => format!("{robot}.{signal}"),
+            Data::Remote { robot, procedure } => format!("{robot}.{procedure}"),
+            Data::Part { part } => part.clone(),
+            Data::Procedure { procedure } => procedure.clone(),
+            Data::Global { global } => global.clone(),
+            Data::Text { text } => format!("{text:?}"),
+            Data::Issue { message, .. } => format!("{message:?}"),
+            Data::Collision { a, b, contact } => match contact {
+                Some((depth, p)) => format!(
+                    "{a} {b} depth={} point=({:.4}, {:.4}, {:.4})",
+                    fmt_quantity(*depth, vworks_vm::Dim::LENGTH),
+                    p[0],
+                    p[1],
+                    p[2]
+                ),
+                None => format!("{a} {b}"),
+            },
+        }
+    }
+
     /// The `data` object of a `/events` message (`null` for [`Data::None`]).
     pub fn to_json(&self) -> Json {
         match self {
@@ -632,35 +677,18 @@ impl TraceEvent {
 
     /// The details as trace lines show them (empty when there are none).
     pub fn details(&self, cell: &Cell) -> String {
-        match &self.detail {
-            Detail::None => String::new(),
-            Detail::Vm(kind) => self
-                .robot
-                .and_then(|r| cell.robots.get(r))
-                .map_or_else(String::new, |robot| vm_details(kind, &robot.module)),
-            Detail::Set { global, new, .. } => cell
-                .linked
-                .globals
-                .get(*global as usize)
-                .map_or_else(String::new, |g| {
-                    format!("{}={}", g.name, format_value(*new, g.ty))
-                }),
-            Detail::Global(g) => cell
-                .linked
-                .globals
-                .get(*g as usize)
-                .map_or_else(String::new, |g| g.name.clone()),
-            Detail::Collision(c) => format!(
-                "{} {} depth={} point=({:.4}, {:.4}, {:.4})",
-                c.a,
-                c.b,
-                fmt_quantity(c.depth, vworks_vm::Dim::LENGTH),
-                c.point[0],
-                c.point[1],
-                c.point[2]
-            ),
-            Detail::CollisionEnd(pair) => format!("{} {}", pair.0, pair.1),
-            Detail::Issue(issue) => format!("{:?}", issue.message),
+        self.details_of(cell, &self.data(cell))
+    }
+
+    /// The details text from the event's typed `data`: the text of [`Data`], except that a
+    /// set's value is shown in display units (`250mm`), which needs the global's type.
+    fn details_of(&self, cell: &Cell, data: &Data) -> String {
+        match (&self.detail, data) {
+            (Detail::Set { global, new, .. }, Data::Set { global: name, .. }) => {
+                let ty = cell.linked.globals[*global as usize].ty;
+                format!("{name}={}", format_value(*new, ty))
+            }
+            _ => data.text(),
         }
     }
 
@@ -713,6 +741,7 @@ impl TraceEvent {
     /// The event with the cell's names.
     pub fn resolve(&self, cell: &Cell) -> Event {
         let (line, col) = self.pos.map_or((0, 0), |p| (p.line, p.col));
+        let data = self.data(cell);
         Event {
             time_ns: self.time,
             robot: self
@@ -720,8 +749,8 @@ impl TraceEvent {
                 .and_then(|r| cell.robots.get(r))
                 .map(|r| r.name.clone()),
             kind: self.kind,
-            details: self.details(cell),
-            data: self.data(cell),
+            details: self.details_of(cell, &data),
+            data,
             file: self.file(cell).map(str::to_string),
             line,
             col,
@@ -772,12 +801,9 @@ fn vm_data(kind: &EventKind, m: &Module) -> Data {
         EventKind::Delay { duration_ns } => Data::Delay {
             duration_ns: *duration_ns,
         },
-        // The engine records sets as `Detail::Set` (cell globals, old and new values).
-        EventKind::Set { global, value, ty } => Data::Set {
-            global: m.str(m.globals[*global as usize].name).to_string(),
-            old: Value::of(*value, *ty),
-            new: Value::of(*value, *ty),
-        },
+        // The engine records a set as `Detail::Set` (the cell's global and the value it
+        // replaces), never as a VM event.
+        EventKind::Set { .. } => Data::None,
         EventKind::WaitUntil { cond, deadline } => Data::WaitCondition {
             globals: cond_globals(m, *cond),
             deadline_ns: *deadline,
@@ -818,44 +844,6 @@ fn vm_data(kind: &EventKind, m: &Module) -> Data {
         }
         EventKind::RemoteStart { proc } | EventKind::RemoteEnd { proc } => procedure(*proc),
         EventKind::MotionEnd | EventKind::DelayEnd | EventKind::Join | EventKind::End => Data::None,
-    }
-}
-
-/// A VM event's details as trace lines show them, with the names of module `m`.
-fn vm_details(kind: &EventKind, m: &Module) -> String {
-    match kind {
-        EventKind::MotionStart {
-            command,
-            duration_ns,
-        } => format!("{command} duration={duration_ns}"),
-        EventKind::Delay { duration_ns } => format!("duration={duration_ns}"),
-        EventKind::Set { global, value, ty } => format!(
-            "{}={}",
-            m.str(m.globals[*global as usize].name),
-            format_value(*value, *ty)
-        ),
-        EventKind::WaitUntil { cond, deadline } => format!(
-            "condition({}){}",
-            cond_globals(m, *cond).join(","),
-            deadline.map_or(String::new(), |d| format!(" deadline={d}"))
-        ),
-        EventKind::WaitSignal { name, deadline } => format!(
-            "signal={}{}",
-            m.str(*name),
-            deadline.map_or(String::new(), |d| format!(" deadline={d}"))
-        ),
-        EventKind::WaitEnd { timed_out } => {
-            (if *timed_out { "timeout" } else { "released" }).into()
-        }
-        EventKind::Log { text } => format!("{text:?}"),
-        EventKind::Error { message } => format!("{message:?}"),
-        _ => match vm_data(kind, m) {
-            Data::Signal { robot, signal } => format!("{robot}.{signal}"),
-            Data::Remote { robot, procedure } => format!("{robot}.{procedure}"),
-            Data::Part { part } => part,
-            Data::Procedure { procedure } => procedure,
-            _ => String::new(),
-        },
     }
 }
 

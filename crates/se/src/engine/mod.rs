@@ -651,7 +651,7 @@ impl Simulation {
                         );
                         let mut issue = self.issue("near_miss", m, None, None);
                         issue.distance_m = Some(dist);
-                        self.add_warning(b, None, None, issue);
+                        self.add_issue(b, None, None, Kind::Warning, issue);
                     }
                 }
             }
@@ -673,8 +673,9 @@ impl Simulation {
             return;
         };
         self.vms[r].perform();
-        self.account(r, &e);
-        self.route(r, &e);
+        let kind = Kind::of(&e.kind);
+        self.account(r, &e, kind);
+        self.route(r, &e, kind);
         for (t, pos, m) in self.vms[r].take_warnings() {
             self.warning(t, Some(r), Some(pos), "slowdown", m);
         }
@@ -683,11 +684,11 @@ impl Simulation {
         }
     }
 
-    fn account(&mut self, r: usize, e: &Event) {
+    fn account(&mut self, r: usize, e: &Event, kind: Kind) {
         // Time per robot: the fold sees every event that can count — the robots' own (here)
         // and the errors the engine finds in them (`error`); check_wait, check_when,
         // collisions and warnings never change it.
-        self.fold.event(e.time, Some(r), Kind::of(&e.kind));
+        self.fold.event(e.time, Some(r), kind);
         if let EventKind::MotionStart { .. } = e.kind {
             // Speed bounds behind skipped collision queries change with the motion.
             self.collider.motion_started(r);
@@ -704,13 +705,26 @@ impl Simulation {
         message: String,
     ) {
         let issue = self.issue(kind, message, robot, pos);
-        self.add_warning(t, robot, pos, issue);
+        self.add_issue(t, robot, pos, Kind::Warning, issue);
     }
 
-    /// A `warning` trace event and the run's warning `issue`.
-    fn add_warning(&mut self, t: i64, robot: Option<usize>, pos: Option<SrcPos>, issue: Issue) {
-        self.warnings.push(issue.clone());
-        self.record(t, robot, Kind::Warning, Detail::Issue(Box::new(issue)), pos);
+    /// A `warning` or `error` trace event (`severity`) and the run's warning or error
+    /// `issue`. An error counts in its robot's statistics (it ends the robot).
+    fn add_issue(
+        &mut self,
+        t: i64,
+        robot: Option<usize>,
+        pos: Option<SrcPos>,
+        severity: Kind,
+        issue: Issue,
+    ) {
+        if severity == Kind::Error {
+            self.errors.push(issue.clone());
+            self.fold.event(t, robot, Kind::Error);
+        } else {
+            self.warnings.push(issue.clone());
+        }
+        self.record(t, robot, severity, Detail::Issue(Box::new(issue)), pos);
     }
 
     /// An `error` trace event (the message quoted) and the run's error of `kind`. The
@@ -724,9 +738,7 @@ impl Simulation {
         message: String,
     ) {
         let issue = self.issue(kind, message, robot, pos);
-        self.errors.push(issue.clone());
-        self.fold.event(t, robot, Kind::Error);
-        self.record(t, robot, Kind::Error, Detail::Issue(Box::new(issue)), pos);
+        self.add_issue(t, robot, pos, Kind::Error, issue);
     }
 
     /// The cell handled more than `instant_limit` entries at instant `t`: robots that
@@ -797,8 +809,6 @@ impl Simulation {
                 Next::Event(_) => Ending::Running,
             })
             .collect();
-        let fold = std::mem::replace(&mut self.fold, Fold::new(Vec::new(), false));
-        let (robots, _) = fold.finish(end, &|r| endings.get(r).copied());
         let global_values: Vec<(String, Value)> = self
             .global_values()
             .into_iter()
@@ -812,6 +822,7 @@ impl Simulation {
             .zip(&self.globals)
             .map(|(g, (v, ty))| (g.name.clone(), format_value(*v, *ty)))
             .collect();
+        let (robots, _) = self.fold.finish(end, &|r| endings.get(r).copied());
         let outcome = self.outcome.unwrap_or(Outcome::Completed);
         let run_end = RunEnd {
             outcome,
@@ -819,7 +830,7 @@ impl Simulation {
             robots: &robots,
         };
         let mut log_counts = BTreeMap::new();
-        for mut sink in std::mem::take(&mut self.sinks) {
+        for mut sink in self.sinks {
             match sink.finish(&run_end) {
                 Ok(c) => log_counts.extend(c),
                 Err(e) => {

@@ -13,24 +13,29 @@ use super::races::Seen;
 use super::{Detail, Kind, Outcome, Simulation};
 
 impl Simulation {
-    pub(super) fn route(&mut self, r: usize, e: &Event) {
+    pub(super) fn route(&mut self, r: usize, e: &Event, kind: Kind) {
         let t = e.time;
-        let detail = match e.kind {
-            // A set is recorded with the cell's global and the value it replaces.
+        // A set is recorded with the cell's global and the value it replaces.
+        let set = match e.kind {
             EventKind::Set { global, value, .. } => {
-                let cg = self.cell.linked.robots[r].globals[global as usize];
-                let old = self.globals[cg as usize].0;
-                Detail::Set {
-                    global: cg,
-                    old,
-                    new: value,
-                }
+                Some((self.cell.linked.robots[r].globals[global as usize], value))
             }
-            _ => Detail::Vm(e.kind.clone()),
+            _ => None,
         };
-        self.record(t, Some(r), Kind::of(&e.kind), detail, Some(e.pos));
+        let detail = match set {
+            Some((cg, new)) => Detail::Set {
+                global: cg,
+                old: self.globals[cg as usize].0,
+                new,
+            },
+            None => Detail::Vm(e.kind.clone()),
+        };
+        self.record(t, Some(r), kind, detail, Some(e.pos));
+        if let Some((cg, value)) = set {
+            self.on_set(r, cg as usize, value, t, e.pos);
+            return;
+        }
         match &e.kind {
-            EventKind::Set { global, value, .. } => self.on_set(r, *global, *value, t, e.pos),
             EventKind::WaitUntil { cond, .. } => {
                 let cell = Arc::clone(&self.cell);
                 // A later set at this instant races with this read only if the wait passed
@@ -183,8 +188,8 @@ impl Simulation {
         }
     }
 
-    pub(super) fn on_set(&mut self, r: usize, g: u32, value: u64, t: i64, pos: SrcPos) {
-        let cg = self.cell.linked.robots[r].globals[g as usize] as usize;
+    /// Robot `r` sets cell global `cg` to `value` at `t`.
+    pub(super) fn on_set(&mut self, r: usize, cg: usize, value: u64, t: i64, pos: SrcPos) {
         self.check_race(cg, r, t, pos, true);
         if let Some((ot, q, qpos)) = self.last_timeout[cg]
             && ot == t

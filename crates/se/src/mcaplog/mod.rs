@@ -423,38 +423,6 @@ impl McapLog {
         Ok(())
     }
 
-    /// Whether the next boundary's state is logged (every `every`-th is).
-    pub(crate) fn logs_next_boundary(&self) -> bool {
-        self.boundary.is_multiple_of(self.every)
-    }
-
-    /// Counts a boundary that is not logged without computing its state.
-    pub(crate) fn skip_boundary(&mut self) {
-        self.boundary += 1;
-    }
-
-    /// Logs a cycle boundary (every `every`-th): `joints[r]` holds robot r's axis values,
-    /// `frames[r]` its link frames in the cell, `parts` the parts' poses in the cell. The writer thread builds `/state` and `/tf`
-    /// from them (see [`cycles`]).
-    pub(crate) fn cycle(
-        &mut self,
-        cell: &Cell,
-        t: i64,
-        joints: &[[f64; vworks_vm::MAX_AXES]],
-        frames: &[Vec<Iso>],
-        parts: &[Iso],
-    ) -> Result<(), LogError> {
-        let k = self.boundary;
-        self.boundary += 1;
-        if !k.is_multiple_of(self.every) {
-            return Ok(());
-        }
-        let payload = |b: &mut Vec<u8>| cycles::append_cycle(b, cell, joints, frames, parts);
-        self.sink
-            .cycle(t.max(0) as u64, k, payload)
-            .map_err(|reason| self.failed(reason))
-    }
-
     /// Records how the run ended ([`RESULT_METADATA`]).
     fn result(&mut self, end: &RunEnd<'_>) -> Result<(), LogError> {
         let ended: Vec<String> = end
@@ -474,6 +442,11 @@ impl McapLog {
 
     /// Finishes the file: summary, indexes, CRCs. Returns the counts per topic.
     pub fn finish(mut self) -> Result<BTreeMap<&'static str, u64>, LogError> {
+        self.close()
+    }
+
+    /// Writes what is left and closes the file; the messages written per topic.
+    fn close(&mut self) -> Result<BTreeMap<&'static str, u64>, LogError> {
         let counts = self.sink.finish().map_err(|reason| LogError::Io {
             file: self.file.clone(),
             reason,
@@ -487,16 +460,20 @@ impl RunSink for McapLog {
         McapLog::event(self, cell, e).map_err(|e| e.to_string())
     }
 
+    /// Logs every `every`-th boundary: the robots' joints and link frames and the parts'
+    /// poses, from which the writer thread builds `/state` and `/tf` (in the module `cycles`).
+    /// Other boundaries are only counted.
     fn cycle(&mut self, cell: &Cell, t: i64, world: &World) -> Result<(), String> {
-        if !self.logs_next_boundary() {
-            self.skip_boundary();
+        let k = self.boundary;
+        self.boundary += 1;
+        if !k.is_multiple_of(self.every) {
             return Ok(());
         }
-        let mut parts = std::mem::take(&mut self.parts);
-        world.part_poses_into(cell, &mut parts);
-        let done = McapLog::cycle(self, cell, t, world.joints(), world.frames(), &parts);
-        self.parts = parts;
-        done.map_err(|e| e.to_string())
+        world.part_poses_into(cell, &mut self.parts);
+        let (joints, frames, parts) = (world.joints(), world.frames(), &self.parts);
+        let payload = |b: &mut Vec<u8>| cycles::append_cycle(b, cell, joints, frames, parts);
+        let done = self.sink.cycle(t.max(0) as u64, k, payload);
+        done.map_err(|reason| self.failed(reason).to_string())
     }
 
     fn records_cycles(&self) -> bool {
@@ -505,14 +482,8 @@ impl RunSink for McapLog {
 
     fn finish(&mut self, end: &RunEnd<'_>) -> Result<BTreeMap<&'static str, u64>, String> {
         let recorded = self.result(end);
-        let counts = self.sink.finish().map_err(|reason| {
-            LogError::Io {
-                file: self.file.clone(),
-                reason,
-            }
-            .to_string()
-        })?;
+        let counts = self.close().map_err(|e| e.to_string())?;
         recorded.map_err(|e| e.to_string())?;
-        Ok(TOPICS.iter().copied().zip(counts).collect())
+        Ok(counts)
     }
 }

@@ -332,6 +332,19 @@ enum State {
     Done,
 }
 
+impl State {
+    /// Released at `time` (not by a timeout) from the wait at `pos`; `deadline`: the wait's,
+    /// if it had a timeout.
+    fn released(time: i64, deadline: Option<i64>, pos: SrcPos) -> State {
+        State::Released {
+            time,
+            timed_out: false,
+            timed: deadline.is_some(),
+            pos,
+        }
+    }
+}
+
 /// When an enabled handler fires.
 #[derive(Clone, Debug)]
 enum Firing {
@@ -950,12 +963,7 @@ impl Vm {
                             self.main.stack.pop();
                         }
                         self.state = if self.eval_cond(*cond, e.time) {
-                            State::Released {
-                                time: e.time,
-                                timed_out: false,
-                                timed: deadline.is_some(),
-                                pos: e.pos,
-                            }
+                            State::released(e.time, *deadline, e.pos)
                         } else {
                             State::Waiting {
                                 cond: Some(*cond),
@@ -972,12 +980,7 @@ impl Vm {
                         let have = self.signals.iter_mut().find(|(n, c)| n == name && *c > 0);
                         self.state = if let Some((_, c)) = have {
                             *c -= 1;
-                            State::Released {
-                                time: e.time,
-                                timed_out: false,
-                                timed: deadline.is_some(),
-                                pos: e.pos,
-                            }
+                            State::released(e.time, *deadline, e.pos)
                         } else {
                             State::Waiting {
                                 cond: None,
@@ -1002,12 +1005,7 @@ impl Vm {
                             }
                         } else {
                             self.par_depth = self.par_depth.saturating_sub(1);
-                            State::Released {
-                                time: e.time,
-                                timed_out: false,
-                                timed: false,
-                                pos: e.pos,
-                            }
+                            State::released(e.time, None, e.pos)
                         };
                     }
                     EventKind::RemoteStart { proc } => {

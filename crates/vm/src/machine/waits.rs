@@ -120,12 +120,7 @@ impl Vm {
             return false;
         };
         if self.eval_cond(c, t) {
-            self.state = State::Released {
-                time: t,
-                timed_out: false,
-                timed: deadline.is_some(),
-                pos,
-            };
+            self.state = State::released(t, deadline, pos);
             return true;
         }
         false
@@ -161,12 +156,7 @@ impl Vm {
         } = self.state
             && s == idx
         {
-            self.state = State::Released {
-                time: t,
-                timed_out: false,
-                timed: deadline.is_some(),
-                pos,
-            };
+            self.state = State::released(t, deadline, pos);
             return true;
         }
         match self.signals.iter_mut().find(|(n, _)| *n == idx) {
@@ -193,12 +183,7 @@ impl Vm {
             && !self.join.iter().any(|(d, _)| *d == depth)
         {
             self.par_depth = self.par_depth.saturating_sub(1);
-            self.state = State::Released {
-                time: t,
-                timed_out: false,
-                timed: false,
-                pos,
-            };
+            self.state = State::released(t, None, pos);
         }
     }
 }
