@@ -83,6 +83,7 @@ struct RobotFile {
     entry: Option<String>,
     serve_only: Option<bool>,
     default_speed: Option<toml::Value>,
+    jerk: Option<toml::Value>,
     home: Option<Vec<toml::Value>>,
     /// Allowed pairs may follow any table (TOML puts a key after `[[robot]]` into it).
     #[serde(default)]
@@ -219,6 +220,65 @@ impl Ctx<'_> {
             key: key.to_string(),
             message: message.into(),
         }
+    }
+
+    /// A robot's `jerk`: one value for every axis, or a list with one per axis (each
+    /// an angular jerk for a revolute axis, a jerk for a prismatic one; plain numbers are
+    /// SI). Replaces the URDF's `jerk` limits.
+    fn override_jerk(
+        &self,
+        model: &mut RobotModel,
+        v: &toml::Value,
+        key: &str,
+    ) -> Result<(), CellError> {
+        let n = model.dof();
+        let values: Vec<(&toml::Value, String)> = match v {
+            toml::Value::Array(list) => {
+                if list.len() != n {
+                    return Err(self.bad(
+                        key,
+                        format!(
+                            "has {} values but the robot has {n} axes; give one per axis, or one value for all",
+                            list.len()
+                        ),
+                    ));
+                }
+                list.iter()
+                    .enumerate()
+                    .map(|(k, x)| (x, format!("{key}[{k}]")))
+                    .collect()
+            }
+            one => (0..n).map(|_| (one, key.to_string())).collect(),
+        };
+        for (k, (x, at)) in values.into_iter().enumerate() {
+            let dim = if (model.linear_axes() >> k) & 1 == 1 {
+                Dim::JERK
+            } else {
+                Dim::ANGJERK
+            };
+            let hint: &dyn Fn() -> &'static str = &|| {
+                if dim == Dim::JERK {
+                    "\"5000mm/s3\" or 5 (m/s³)"
+                } else {
+                    "\"2000deg/s3\" or 34.9 (rad/s³)"
+                }
+            };
+            let j = self.quantity_unchecked(x, dim, &at, hint)?;
+            if !(j.is_finite() && j > 0.0) {
+                return Err(self.bad(
+                    &at,
+                    format!(
+                        "axis {} `{}`: a jerk limit must be greater than 0 and finite; write {}",
+                        k + 1,
+                        model.axis(k).name,
+                        hint()
+                    ),
+                ));
+            }
+            let joint = model.axes[k];
+            model.joints[joint].max_jerk = Some(j);
+        }
+        Ok(())
     }
 
     /// A quantity of dimension `dim`: a number (SI) or a string with a unit.
@@ -582,6 +642,10 @@ pub fn load_with(path: &Path, fs: &dyn Files) -> Result<Cell, CellError> {
                 "give either `model` (a built-in robot) or `urdf` (a file), not both or neither",
             )),
         };
+        let mut model = model;
+        if let Some(jerk) = &r.jerk {
+            cx.override_jerk(&mut model, jerk, &format!("{key}.jerk"))?;
+        }
         let serve_only = r.serve_only.unwrap_or(false);
         let Some(program) = &r.program else {
             return Err(cx.bad(

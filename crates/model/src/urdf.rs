@@ -283,7 +283,7 @@ pub fn load_str_with(
                 (lim.lower, lim.upper)
             }
         };
-        let (max_velocity, max_accel) = if kind.is_movable() {
+        let (max_velocity, max_accel, max_jerk) = if kind.is_movable() {
             if !(lim.velocity.is_finite() && lim.velocity > 0.0) {
                 return Err(invalid(
                     el(),
@@ -309,9 +309,10 @@ pub fn load_str_with(
                 (Some(a), None) | (None, Some(a)) => a,
                 (None, None) => lim.velocity / DEFAULT_ACCEL_TIME,
             };
-            (lim.velocity, acc)
+            let jerk = given("jerk", extra.and_then(|d| d.jerk))?;
+            (lim.velocity, acc, jerk)
         } else {
-            (0.0, 0.0)
+            (0.0, 0.0, None)
         };
         joints.push(Joint {
             name: j.name.clone(),
@@ -325,7 +326,7 @@ pub fn load_str_with(
             upper,
             max_velocity,
             max_accel,
-            max_jerk: dynamics.get(j.name.as_str()).and_then(|d| d.jerk),
+            max_jerk,
             axis_index: None,
         });
     }

@@ -354,6 +354,18 @@ fn dynamic_limits_are_read_whatever_the_version() {
         &["joint `j`", "acceleration limit is 0"],
     );
     expect_error(
+        "negative jerk",
+        load("jerk.urdf", &limits(r#"jerk="-5""#)),
+        "jerk.urdf",
+        &["joint `j`", "jerk limit is -5", "greater than 0"],
+    );
+    expect_error(
+        "infinite jerk",
+        load("inf.urdf", &limits(r#"jerk="inf""#)),
+        "inf.urdf",
+        &["joint `j`", "jerk limit is inf"],
+    );
+    expect_error(
         "not a number",
         load("nan.urdf", &limits(r#"deceleration="fast""#)),
         "nan.urdf",

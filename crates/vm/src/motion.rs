@@ -16,55 +16,185 @@ use vworks_model::math::{Iso, M3, V3, add, mat_mul, norm, rotation_vector, sub, 
 /// Nanoseconds per second.
 pub const NS: f64 = 1e9;
 
-/// A trapezoidal velocity profile from 0 to `dist` (≥ 0) within `vmax` and `amax`.
+/// A rest-to-rest velocity profile from 0 to `dist` (≥ 0) within a speed, an acceleration
+/// and (optionally) a jerk limit: a trapezoid (or triangle) without a jerk limit, else the
+/// time-optimal S-curve of up to 7 phases (jerk up, constant acceleration, jerk down,
+/// cruise, and the mirror image). The acceleration phase is point-symmetric about its
+/// middle, so the speed during it is `v − σ(t_acc − τ)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Profile {
     /// Distance covered.
     pub dist: f64,
-    /// Cruise speed actually reached.
+    /// Cruise (peak) speed actually reached.
     pub v: f64,
-    /// Acceleration used.
+    /// Peak acceleration used.
     pub a: f64,
-    /// Time of the acceleration phase (s).
+    /// Jerk (`f64::INFINITY`: a trapezoid).
+    pub j: f64,
+    /// Time of each jerk phase (s; 0 for a trapezoid).
+    pub t_jerk: f64,
+    /// Time of the whole acceleration phase (s): `2·t_jerk` + the constant-acceleration part.
     pub t_acc: f64,
     /// Total duration (s).
     pub t_total: f64,
 }
 
 impl Profile {
-    /// The fastest profile over `dist` within `vmax` and `amax` (both > 0).
+    /// The fastest trapezoidal profile over `dist` within `vmax` and `amax` (both > 0).
     pub fn new(dist: f64, vmax: f64, amax: f64) -> Profile {
+        let dist = dist.abs();
+        let trapezoid = |v: f64, a: f64, t_acc: f64, t_total: f64| Profile {
+            dist,
+            v,
+            a,
+            j: f64::INFINITY,
+            t_jerk: 0.0,
+            t_acc,
+            t_total,
+        };
+        if dist == 0.0 {
+            return trapezoid(0.0, amax, 0.0, 0.0);
+        }
+        // Reaching vmax takes vmax/amax and covers vmax²/amax (accelerate + decelerate).
+        if dist * amax >= vmax * vmax {
+            let t_acc = vmax / amax;
+            trapezoid(vmax, amax, t_acc, dist / vmax + t_acc)
+        } else {
+            // Triangular: peak speed sqrt(dist·amax).
+            let v = (dist * amax).sqrt();
+            let t_acc = v / amax;
+            trapezoid(v, amax, t_acc, 2.0 * t_acc)
+        }
+    }
+
+    /// The time-optimal profile over `dist` within `vmax`, `amax` and `jmax` (all > 0;
+    /// `jmax` infinite: the trapezoid of [`Profile::new`]).
+    ///
+    /// The acceleration phase to a speed `v` takes `t_j = a/j` of rising jerk, `v/a − a/j`
+    /// of constant acceleration and `t_j` of falling jerk when `v·j ≥ a²`; otherwise the
+    /// acceleration peaks at `√(v·j)` after `t_j = √(v/j)`. It covers `v·t_acc/2`. When the
+    /// two phases would cover more than `dist`, the peak speed is lowered until they cover
+    /// it exactly: `v = (a/2)(√(a²/j² + 4d/a) − a/j)` if that speed still reaches `a`,
+    /// else `t_j = ∛(d/(2j))` and the profile is four jerk phases.
+    pub fn with_jerk(dist: f64, vmax: f64, amax: f64, jmax: f64) -> Profile {
+        if !jmax.is_finite() {
+            return Profile::new(dist, vmax, amax);
+        }
         let dist = dist.abs();
         if dist == 0.0 {
             return Profile {
                 dist,
                 v: 0.0,
                 a: amax,
+                j: jmax,
+                t_jerk: 0.0,
                 t_acc: 0.0,
                 t_total: 0.0,
             };
         }
-        // Reaching vmax takes vmax/amax and covers vmax²/amax (accelerate + decelerate).
-        if dist * amax >= vmax * vmax {
-            let t_acc = vmax / amax;
-            Profile {
+        let full = Self::ramp(vmax, amax, jmax);
+        if vmax * full.t_acc <= dist {
+            return Profile {
                 dist,
-                v: vmax,
-                a: amax,
-                t_acc,
-                t_total: dist / vmax + t_acc,
-            }
+                t_total: 2.0 * full.t_acc + (dist - vmax * full.t_acc) / vmax,
+                ..full
+            };
+        }
+        let (a, j) = (amax, jmax);
+        let v = 0.5 * a * ((a * a / (j * j) + 4.0 * dist / a).sqrt() - a / j);
+        let p = if v * j >= a * a {
+            Self::ramp(v, a, j)
         } else {
-            // Triangular: peak speed sqrt(dist·amax).
-            let v = (dist * amax).sqrt();
-            let t_acc = v / amax;
+            let t_jerk = (dist / (2.0 * j)).cbrt();
             Profile {
-                dist,
-                v,
-                a: amax,
-                t_acc,
-                t_total: 2.0 * t_acc,
+                dist: 0.0,
+                v: j * t_jerk * t_jerk,
+                a: j * t_jerk,
+                j,
+                t_jerk,
+                t_acc: 2.0 * t_jerk,
+                t_total: 0.0,
             }
+        };
+        Profile {
+            dist,
+            t_total: 2.0 * p.t_acc,
+            ..p
+        }
+    }
+
+    /// The acceleration phase from rest to `v` within `a` and `j` (`dist` and `t_total`
+    /// left 0 for the caller).
+    fn ramp(v: f64, a: f64, j: f64) -> Profile {
+        let (t_jerk, a, t_acc) = if v * j >= a * a {
+            (a / j, a, v / a + a / j)
+        } else {
+            let t = (v / j).sqrt();
+            (t, j * t, 2.0 * t)
+        };
+        Profile {
+            dist: 0.0,
+            v,
+            a,
+            j,
+            t_jerk,
+            t_acc,
+            t_total: 0.0,
+        }
+    }
+
+    /// The profile over the same distance with the same acceleration and jerk limits
+    /// that lasts exactly `t_total` (≥ the time-optimal one's): the cruise speed is
+    /// lowered until it does — what time synchronisation of several axes needs (each axis
+    /// keeps its own limits and all end together). From `t_total = t_acc(v) + d/v`:
+    /// `v = (a/2)(T' − √(T'² − 4d/a))` with `T' = T − a/j` while `v·j ≥ a²`, else solved
+    /// by bisection.
+    pub fn lasting(&self, t_total: f64, amax: f64) -> Profile {
+        let d = self.dist;
+        if d == 0.0 || t_total <= self.t_total {
+            return *self;
+        }
+        let (a, j) = (amax, self.j);
+        let jt = if j.is_finite() { a / j } else { 0.0 };
+        let tp = t_total - jt;
+        let v = 0.5 * a * (tp - (tp * tp - 4.0 * d / a).max(0.0).sqrt());
+        let v = if !j.is_finite() || v * j >= a * a {
+            v
+        } else {
+            // t_acc = 2√(v/j): t_total = 2√(v/j) + d/v, decreasing in v below a²/j.
+            let (mut lo, mut hi) = (0.0f64, (a * a / j).min(self.v.max(f64::MIN_POSITIVE)));
+            for _ in 0..200 {
+                let mid = 0.5 * (lo + hi);
+                if mid <= lo || mid >= hi {
+                    break;
+                }
+                if 2.0 * (mid / j).sqrt() + d / mid > t_total {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            hi
+        };
+        let ramp = if j.is_finite() {
+            Self::ramp(v, a, j)
+        } else {
+            Profile {
+                dist: 0.0,
+                v,
+                a,
+                j,
+                t_jerk: 0.0,
+                t_acc: v / a,
+                t_total: 0.0,
+            }
+        };
+        Profile {
+            dist: d,
+            t_total,
+            // The cruise absorbs the rounding: it lasts t_total − 2·t_acc.
+            t_acc: ramp.t_acc.min(0.5 * t_total),
+            ..ramp
         }
     }
 
@@ -83,8 +213,28 @@ impl Profile {
             dist: self.dist,
             v,
             a: v / t_acc.max(f64::MIN_POSITIVE),
+            j: self.j / (k * k * k),
+            t_jerk: self.t_jerk * k,
             t_acc,
             t_total,
+        }
+    }
+
+    /// Distance covered during the acceleration phase by time `tau` ∈ [0, t_acc].
+    fn ramp_at(&self, tau: f64) -> f64 {
+        let (tj, ta) = (self.t_jerk, self.t_acc);
+        if tj == 0.0 {
+            return 0.5 * self.a * tau * tau;
+        }
+        let rising = |t: f64| self.j * t * t * t / 6.0;
+        if tau <= tj {
+            rising(tau)
+        } else if tau <= ta - tj {
+            let u = tau - tj;
+            rising(tj) + 0.5 * self.j * tj * tj * u + 0.5 * self.a * u * u
+        } else {
+            // Point symmetry of the phase: f(τ) = v·τ − f(t_acc) + f(t_acc − τ).
+            self.v * tau - 0.5 * self.v * ta + rising(ta - tau)
         }
     }
 
@@ -97,13 +247,51 @@ impl Profile {
             return self.dist;
         }
         let (ta, tt) = (self.t_acc, self.t_total);
+        if self.t_jerk == 0.0 {
+            // The trapezoid, as it always was (bit for bit).
+            return if t < ta {
+                0.5 * self.a * t * t
+            } else if t <= tt - ta {
+                0.5 * self.a * ta * ta + self.v * (t - ta)
+            } else {
+                let r = tt - t;
+                self.dist - 0.5 * self.a * r * r
+            };
+        }
         if t < ta {
-            0.5 * self.a * t * t
+            self.ramp_at(t)
         } else if t <= tt - ta {
-            0.5 * self.a * ta * ta + self.v * (t - ta)
+            0.5 * self.v * ta + self.v * (t - ta)
         } else {
-            let r = tt - t;
-            self.dist - 0.5 * self.a * r * r
+            self.dist - self.ramp_at(tt - t)
+        }
+    }
+
+    /// Speed at time `t` (s).
+    pub fn speed_at(&self, t: f64) -> f64 {
+        if t <= 0.0 || t >= self.t_total {
+            return 0.0;
+        }
+        let (ta, tt) = (self.t_acc, self.t_total);
+        let ramp = |tau: f64| {
+            let tj = self.t_jerk;
+            if tj == 0.0 {
+                self.a * tau
+            } else if tau <= tj {
+                0.5 * self.j * tau * tau
+            } else if tau <= ta - tj {
+                0.5 * self.j * tj * tj + self.a * (tau - tj)
+            } else {
+                let r = ta - tau;
+                self.v - 0.5 * self.j * r * r
+            }
+        };
+        if t < ta {
+            ramp(t)
+        } else if t <= tt - ta {
+            self.v
+        } else {
+            ramp(tt - t)
         }
     }
 
@@ -259,6 +447,85 @@ mod tests {
         let p = Profile::new(0.01, 1.0, 2.0);
         assert!((p.t_total - 2.0 * (0.01f64 / 2.0).sqrt()).abs() < 1e-15);
         assert!((p.at(p.t_total / 2.0) - 0.005).abs() < 1e-12);
+    }
+
+    /// Samples a profile at 100 kHz: position and speed continuous and consistent, speed
+    /// within `v`, acceleration within `a`, jerk within `j` (finite differences).
+    fn check_limits(p: &Profile, v: f64, a: f64, j: f64) {
+        let dt = 1e-5;
+        let n = (p.t_total / dt).ceil() as usize + 2;
+        let mut prev_speed = 0.0;
+        let mut prev_acc = 0.0;
+        for k in 1..n {
+            let t = k as f64 * dt;
+            let speed = p.speed_at(t);
+            let fd = (p.at(t) - p.at(t - dt)) / dt;
+            let mid = p.speed_at(t - 0.5 * dt);
+            assert!((fd - mid).abs() <= a * dt, "{p:?} at {t}: {fd} vs {mid}");
+            assert!(
+                speed <= v * (1.0 + 1e-12) && speed >= 0.0,
+                "{p:?} at {t}: {speed}"
+            );
+            let acc = (speed - prev_speed) / dt;
+            assert!(
+                acc.abs() <= a * (1.0 + 1e-6) + 1e-9,
+                "{p:?} at {t}: acc {acc}"
+            );
+            if j.is_finite() && k > 1 {
+                assert!(((acc - prev_acc) / dt).abs() <= j * (1.0 + 1e-3) + 1e-6);
+            }
+            prev_speed = speed;
+            prev_acc = acc;
+        }
+        assert_eq!(p.at(p.t_total), p.dist);
+    }
+
+    #[test]
+    fn s_curves_are_time_optimal_in_closed_form() {
+        // All seven phases: v·j ≥ a², and the two ramps (0.7 s, 0.35 m each) leave a
+        // 0.3 m cruise at 1 m/s: 1.7 s (Ruckig gives 1.7 s too).
+        let p = Profile::with_jerk(1.0, 1.0, 2.0, 10.0);
+        assert!((p.t_total - 1.7).abs() < 1e-15, "{p:?}");
+        check_limits(&p, 1.0, 2.0, 10.0);
+        // No cruise, still reaching a: v = (a/2)(√(a²/j² + 4d/a) − a/j) = √1.04 − 0.2.
+        let p = Profile::with_jerk(0.5, 1.0, 2.0, 10.0);
+        let v: f64 = (0.04f64 + 1.0).sqrt() - 0.2;
+        assert!((p.v - v).abs() < 1e-15 && (p.t_total - 2.0 * (v / 2.0 + 0.2)).abs() < 1e-15);
+        check_limits(&p, 1.0, 2.0, 10.0);
+        // Four jerk phases: t_j = ∛(d/2j), T = 4·t_j.
+        let p = Profile::with_jerk(0.002, 1.0, 2.0, 10.0);
+        assert!((p.t_total - 4.0 * 0.0001f64.cbrt()).abs() < 1e-15);
+        check_limits(&p, 1.0, 2.0, 10.0);
+        // Speed limit below a²/j: the acceleration peaks at √(v·j) = 1 < 2.
+        let p = Profile::with_jerk(1.0, 0.1, 2.0, 10.0);
+        // t_j = √(v/j) = 0.1 s, t_acc = 0.2 s covering 0.02 m: 0.4 s + 0.98 m at 0.1 m/s.
+        assert!((p.t_total - 10.2).abs() < 1e-12, "{p:?}");
+        check_limits(&p, 0.1, 2.0, 10.0);
+        // An infinite jerk is the trapezoid, bit for bit.
+        assert_eq!(
+            Profile::with_jerk(0.5, 1.0, 2.0, f64::INFINITY),
+            Profile::new(0.5, 1.0, 2.0)
+        );
+    }
+
+    #[test]
+    fn lasting_profiles_end_exactly_when_asked_within_their_limits() {
+        for (d, v, a, j) in [
+            (1.0, 1.0, 2.0, 10.0),
+            (0.05, 1.0, 2.0, 10.0),
+            (0.002, 1.0, 2.0, 10.0),
+            (1.0, 1.0, 2.0, f64::INFINITY),
+            (0.01, 1.0, 2.0, f64::INFINITY),
+        ] {
+            let p = Profile::with_jerk(d, v, a, j);
+            for k in [1.0, 1.0001, 1.3, 2.0, 10.0] {
+                let t = p.t_total * k;
+                let q = p.lasting(t, a);
+                assert_eq!(q.t_total, t);
+                assert!((q.at(t * (1.0 - 1e-12)) - d).abs() < 1e-9, "{q:?}");
+                check_limits(&q, v, a, j);
+            }
+        }
     }
 
     #[test]

@@ -43,6 +43,10 @@ impl Dim {
     pub const ACCEL: Dim = Dim::new(1, 0, -2);
     /// Angular acceleration (rad/s²).
     pub const ANGACCEL: Dim = Dim::new(0, 1, -2);
+    /// Linear jerk (m/s³).
+    pub const JERK: Dim = Dim::new(1, 0, -3);
+    /// Angular jerk (rad/s³).
+    pub const ANGJERK: Dim = Dim::new(0, 1, -3);
 
     /// A dimension from its exponents.
     pub const fn new(length: i8, angle: i8, time: i8) -> Dim {
@@ -95,6 +99,8 @@ impl Dim {
             Dim::ANGSPEED => "angular speed".into(),
             Dim::ACCEL => "acceleration".into(),
             Dim::ANGACCEL => "angular acceleration".into(),
+            Dim::JERK => "jerk".into(),
+            Dim::ANGJERK => "angular jerk".into(),
             _ => self.formula(),
         }
     }

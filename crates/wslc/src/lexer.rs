@@ -1,7 +1,7 @@
 //! The lexer: source text to tokens, never failing.
 //!
 //! A quantity literal is a number immediately followed by a unit (`250mm/s`, `50%`): the
-//! lexer converts it to SI and its dimension. `mm/s` is one unit only when `/s` (or `/s2`)
+//! lexer converts it to SI and its dimension. `mm/s` is one unit only when `/s` (or `/s2`, `/s3`)
 //! follows the base unit with no space; `10mm / s` divides by a variable `s`. Bad input
 //! (an unknown character, an unknown unit, an unterminated string) becomes an
 //! [`TokKind::Error`] token plus a diagnostic, and lexing goes on.
@@ -224,7 +224,7 @@ pub const UNITS: &[(&str, f64, Dim)] = &[
     ("s", 1.0, Dim::TIME),
 ];
 
-const UNIT_HELP: &str = "units are mm, m, deg, rad, ms, s and %, and the compound units mm/s, m/s, deg/s, rad/s, mm/s2, m/s2, deg/s2, rad/s2";
+const UNIT_HELP: &str = "units are mm, m, deg, rad, ms, s and %, and the compound units mm/s, m/s, deg/s, rad/s, mm/s2, m/s2, deg/s2, rad/s2, mm/s3, m/s3, deg/s3, rad/s3";
 
 /// Splits `src` into tokens (ending with [`TokKind::Eof`]); problems go to `diags`.
 pub fn lex(src: &str, diags: &mut Vec<Diagnostic>) -> Vec<Token> {
@@ -460,13 +460,16 @@ impl Lexer<'_, '_> {
             };
             let mut si = value * factor;
             let mut dim = dim;
-            // `/s` or `/s2` glued to a base unit of length or angle.
+            // `/s`, `/s2` or `/s3` glued to a base unit of length or angle.
             if self.peek(0) == b'/' && self.peek(1) == b's' && dim != Dim::TIME {
-                let two = self.peek(2) == b'2' && !is_ident_char(self.peek(3));
-                let one = !is_ident_char(self.peek(2));
-                if one || two {
-                    self.i += if two { 3 } else { 2 };
-                    dim.time = if two { -2 } else { -1 };
+                let power = match self.peek(2) {
+                    b'2' | b'3' if !is_ident_char(self.peek(3)) => (self.peek(2) - b'0') as i8,
+                    c if !is_ident_char(c) => 1,
+                    _ => 0,
+                };
+                if power > 0 {
+                    self.i += if power > 1 { 3 } else { 2 };
+                    dim.time = -power;
                     si = value * factor;
                 }
             }

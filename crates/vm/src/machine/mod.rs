@@ -284,6 +284,14 @@ enum Trajectory {
         delta: [f64; MAX_AXES],
         profile: Profile,
     },
+    /// Joint-space with a jerk limit on some axis: each axis from `from` by `delta` along
+    /// its own profile over `|delta|` (trapezoid or S-curve), all lasting the same time
+    /// (time synchronisation, as Ruckig's).
+    JointSynced {
+        from: [f64; MAX_AXES],
+        delta: [f64; MAX_AXES],
+        profiles: [Profile; MAX_AXES],
+    },
     /// Cartesian: the TCP along `path`, orientation by slerp; joints by IK.
     Cartesian {
         path: Path,
@@ -1024,7 +1032,12 @@ impl Vm {
             State::Moving { end, .. } => {
                 self.time = end;
                 self.rest = self.joints_at(end);
-                if let Some((_, Trajectory::Joint { from, delta, .. })) = &self.motion {
+                if let Some((
+                    _,
+                    Trajectory::Joint { from, delta, .. }
+                    | Trajectory::JointSynced { from, delta, .. },
+                )) = &self.motion
+                {
                     // Exactly the target, not the profile's last float.
                     let mut q = *from;
                     for (qi, d) in q.iter_mut().zip(delta) {

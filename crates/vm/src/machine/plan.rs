@@ -28,6 +28,17 @@ impl Vm {
                 }
                 q
             }
+            Trajectory::JointSynced {
+                from,
+                delta,
+                profiles,
+            } => {
+                let mut q = *from;
+                for ((qi, d), p) in q.iter_mut().zip(delta).zip(profiles) {
+                    *qi += p.at(dt).copysign(*d);
+                }
+                q
+            }
             Trajectory::Cartesian {
                 path,
                 from,
@@ -77,6 +88,11 @@ impl Vm {
                     *o = d.abs() * profile.v / profile.dist;
                 }
             }
+            Some((_, Trajectory::JointSynced { profiles, .. })) => {
+                for (o, p) in out.iter_mut().zip(profiles) {
+                    *o = p.v;
+                }
+            }
             Some((_, Trajectory::Cartesian { rates, .. })) => out = *rates,
             _ => {}
         }
@@ -106,6 +122,59 @@ impl Vm {
         }
         let q = self.joints_at(t);
         self.model.tcp(&q[..self.model.dof()], &self.cfg.tool)
+    }
+
+    /// The time a jerk-limited axis takes to ramp its acceleration up (`a/j`), the
+    /// longest over the axes with a jerk limit; 0 (no ramp: trapezoids) if none has one.
+    /// Cartesian motions give their path the same ramp time.
+    fn jerk_ramp_time(&self) -> f64 {
+        (0..self.model.dof())
+            .filter_map(|i| {
+                let j = self.model.axis(i);
+                j.max_jerk.map(|jerk| j.max_accel / jerk)
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// A `move_j` on a robot with jerk limits: every axis its own time-optimal profile
+    /// (S-curve where the axis has a jerk limit, trapezoid elsewhere) within its speed ×
+    /// `ratio` and acceleration × `aratio`; the slowest sets the duration, and every other
+    /// axis is slowed (lower cruise speed, same acceleration and jerk) to last exactly as
+    /// long — Ruckig's time synchronisation.
+    fn plan_synced(
+        &self,
+        from: [f64; MAX_AXES],
+        goal: [f64; MAX_AXES],
+        ratio: f64,
+        aratio: f64,
+    ) -> (Trajectory, i64) {
+        let n = self.model.dof();
+        let mut delta = [0.0; MAX_AXES];
+        let mut profiles = [Profile::new(0.0, 1.0, 1.0); MAX_AXES];
+        let mut t_total = 0.0f64;
+        for i in 0..n {
+            delta[i] = goal[i] - from[i];
+            let j = self.model.axis(i);
+            profiles[i] = Profile::with_jerk(
+                delta[i],
+                ratio * j.max_velocity,
+                aratio * j.max_accel,
+                j.max_jerk.unwrap_or(f64::INFINITY),
+            );
+            t_total = t_total.max(profiles[i].t_total);
+        }
+        for (i, p) in profiles.iter_mut().enumerate().take(n) {
+            *p = p.lasting(t_total, aratio * self.model.axis(i).max_accel);
+        }
+        let dur = (t_total * NS).ceil() as i64;
+        (
+            Trajectory::JointSynced {
+                from,
+                delta,
+                profiles,
+            },
+            dur,
+        )
     }
 
     /// The operands of a motion instruction, read (not popped) from the stack.
@@ -223,6 +292,9 @@ impl Vm {
                     aratio * 100.0
                 ));
             }
+            if (0..n).any(|i| goal[i] != from[i] && self.model.axis(i).max_jerk.is_some()) {
+                return Ok(self.plan_synced(from, goal, ratio, aratio));
+            }
             // One normalised profile s(t) ∈ [0, 1] within every axis's limits.
             let (mut vs, mut as_) = (f64::INFINITY, f64::INFINITY);
             let mut delta = [0.0; MAX_AXES];
@@ -277,16 +349,22 @@ impl Vm {
         ));
         // Orientation moves at most 180°/s (with the same ramp time).
         let w = std::f64::consts::PI;
+        let wa = w / vworks_model::model::DEFAULT_ACCEL_TIME;
+        // With jerk limits, the path's jerk ramps as long as the slowest axis's does.
+        let ramp = self.jerk_ramp_time();
         let mut vs = f64::INFINITY;
         let mut as_ = f64::INFINITY;
+        let mut js = f64::INFINITY;
         // Below 0.1 µm and 0.1 µrad a move is a rounding error, not a motion.
         if len > 1e-7 {
             vs = vs.min(v / len);
             as_ = as_.min(a / len);
+            js = js.min(a / ramp / len);
         }
         if angle > 1e-7 {
             vs = vs.min(w / angle);
-            as_ = as_.min(w / vworks_model::model::DEFAULT_ACCEL_TIME / angle);
+            as_ = as_.min(wa / angle);
+            js = js.min(wa / ramp / angle);
         }
         if !vs.is_finite() {
             let traj = Trajectory::Cartesian {
@@ -317,7 +395,8 @@ impl Vm {
                 let rate = (q[i] - prev[i]).abs() * SAMPLES as f64 * vs;
                 rates[i] = rates[i].max(rate);
                 let j = self.model.axis(i);
-                if rate > j.max_velocity && j.max_velocity / rate < worst {
+                // (A relative 1e-9 over the limit is rounding, not a faster axis.)
+                if rate > j.max_velocity * (1.0 + 1e-9) && j.max_velocity / rate < worst {
                     worst = j.max_velocity / rate;
                     worst_axis = i;
                 }
@@ -327,6 +406,7 @@ impl Vm {
         if worst < 1.0 {
             vs *= worst;
             as_ *= worst;
+            js *= worst;
             for r in &mut rates {
                 *r *= worst;
             }
@@ -338,7 +418,7 @@ impl Vm {
                 format!("the motion is slowed to {:.0}% of its speed: axis {} `{}` would exceed its speed limit", worst * 100.0, worst_axis + 1, j.name),
             ));
         }
-        let profile = Profile::new(1.0, vs, as_);
+        let profile = Profile::with_jerk(1.0, vs, as_, js);
         let dur = profile.duration_ns();
         let branch = self
             .model
