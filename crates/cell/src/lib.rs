@@ -83,6 +83,7 @@ struct RobotFile {
     entry: Option<String>,
     serve_only: Option<bool>,
     default_speed: Option<toml::Value>,
+    default_zone: Option<toml::Value>,
     jerk: Option<toml::Value>,
     home: Option<Vec<toml::Value>>,
     /// Allowed pairs may follow any table (TOML puts a key after `[[robot]]` into it).
@@ -141,6 +142,8 @@ pub struct Robot {
     pub entry: Option<u32>,
     /// Speed of `move_l`/`move_c` without `speed` (m/s).
     pub default_speed: f64,
+    /// Zone radius of motions without `zone` (m; `None`: `fine`).
+    pub default_zone: Option<f64>,
     /// Joints at the start.
     pub home: Vec<f64>,
 }
@@ -732,6 +735,20 @@ pub fn load_with(path: &Path, fs: &dyn Files) -> Result<Cell, CellError> {
                 "must be greater than zero: it is the speed of every move_l and move_c without `speed`; write e.g. \"250mm/s\"",
             ));
         }
+        let default_zone = match &r.default_zone {
+            None => None,
+            Some(toml::Value::String(s)) if s.trim() == "fine" => None,
+            Some(v) => {
+                let z = cx.quantity(v, Dim::LENGTH, &format!("{key}.default_zone"))?;
+                if z < 0.0 {
+                    return Err(cx.bad(
+                        &format!("{key}.default_zone"),
+                        "cannot be negative: it is the zone radius of every motion without `zone`; write e.g. \"10mm\", or \"fine\" to stop at every point",
+                    ));
+                }
+                (z > 0.0).then_some(z)
+            }
+        };
         let entry_name = r.entry.clone().unwrap_or_else(|| "main".into());
         let entry = if serve_only {
             None
@@ -748,6 +765,7 @@ pub fn load_with(path: &Path, fs: &dyn Files) -> Result<Cell, CellError> {
                 program: pname,
                 entry,
                 default_speed,
+                default_zone,
                 home,
             },
             entry_name,

@@ -146,7 +146,10 @@ impl Report {
         let mut issues = Vec::new();
         for e in &log.events {
             let r = e.robot.as_deref().and_then(|r| index.get(r)).copied();
-            fold.event(e.time_ns, r, e.kind);
+            // (Not a zoned motion's `motion_end`: the robot moves on; see `Fold::event`.)
+            if !matches!(e.data, Data::MotionEnd { .. }) {
+                fold.event(e.time_ns, r, e.kind);
+            }
             match (e.kind, r, &e.data) {
                 (Kind::Signal, Some(r), _) => signals[r].push((e.time_ns, e.details.clone())),
                 (Kind::CollisionStart, _, Data::Collision { a, b, .. }) => {

@@ -152,6 +152,12 @@ impl Fold {
 
     /// Folds in robot `robot`'s event of `kind` at `t` (events without a robot, and robots
     /// out of range, change nothing).
+    ///
+    /// A zoned motion's `motion_end` (its data is `Data::MotionEnd`) is not folded: the
+    /// TCP entered the zone and the robot moves on — through the next motion's corner, or
+    /// to the point, which the next statement that does not move waits for. Moving time
+    /// goes on until a motion stops (`motion_end` without a zone) or a statement that does
+    /// not move begins (`delay`, `wait_until`, a join, the end), which closes it.
     #[inline]
     pub fn event(&mut self, t: i64, robot: Option<usize>, kind: Kind) {
         let Some(r) = robot else { return };
@@ -164,7 +170,11 @@ impl Fold {
                 st.open[Activity::Moving as usize].get_or_insert(t);
             }
             Kind::MotionEnd => self.close(r, Activity::Moving, t),
+            // A zoned point ahead became a stop point: the robot moved until now.
+            Kind::Delay => self.close(r, Activity::Moving, t),
             Kind::WaitUntil | Kind::Join => {
+                self.close(r, Activity::Moving, t);
+                let st = &mut self.robots[r];
                 st.state = Ending::Waiting;
                 st.open[Activity::Waiting as usize].get_or_insert(t);
             }

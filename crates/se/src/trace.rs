@@ -16,10 +16,10 @@ use std::path::Path;
 
 use serde_json::{Value as Json, json};
 use vworks_cell::Cell;
-use vworks_vm::Type;
 use vworks_vm::bytecode::{Module, SrcPos};
 use vworks_vm::machine::EventKind;
 use vworks_vm::types::fmt_quantity;
+use vworks_vm::{Dim, Type};
 
 use crate::collide::Contact;
 
@@ -153,7 +153,7 @@ impl Kind {
     pub fn of(kind: &EventKind) -> Kind {
         match kind {
             EventKind::MotionStart { .. } => Kind::MotionStart,
-            EventKind::MotionEnd => Kind::MotionEnd,
+            EventKind::MotionEnd { .. } => Kind::MotionEnd,
             EventKind::Delay { .. } => Kind::Delay,
             EventKind::DelayEnd => Kind::DelayEnd,
             EventKind::Set { .. } => Kind::Set,
@@ -310,12 +310,27 @@ pub enum Data {
     /// No details (`motion_end`, `delay_end`, `join`, `end`), or a log written before
     /// events carried typed details.
     None,
-    /// `motion_start`: the command (`move_j`, `move_l`, `move_c`) and its exact duration.
+    /// `motion_start`: the command (`move_j`, `move_l`, `move_c`), the exact time to its
+    /// `motion_end`, its zone and how it blends out of the previous zoned point.
     Motion {
         /// `move_j`, `move_l` or `move_c`.
         command: String,
-        /// Duration (ns).
+        /// Time to its `motion_end` (ns).
         duration_ns: i64,
+        /// Its zone radius as programmed (m); `None`: `fine`.
+        zone_m: Option<f64>,
+        /// It starts inside the corner of the previous zoned point and stays within this
+        /// radius of it (m; 0: the corner could not overlap within the limits, so the
+        /// robot reached the point first).
+        blend_m: Option<f64>,
+    },
+    /// `motion_end` of a zoned motion: the TCP entered the zone, of this radius (the
+    /// programmed one, reduced to at most half the motion); the robot moves on.
+    MotionEnd {
+        /// The radius used (m).
+        zone_m: f64,
+        /// The radius programmed (m).
+        programmed_m: f64,
     },
     /// `delay`: its duration.
     Delay {
@@ -510,7 +525,32 @@ impl Data {
             Data::Motion {
                 command,
                 duration_ns,
-            } => format!("{command} duration={duration_ns}"),
+                zone_m,
+                blend_m,
+            } => {
+                let mut s = format!("{command} duration={duration_ns}");
+                if let Some(z) = zone_m {
+                    s += &format!(" zone={}", fmt_quantity(*z, Dim::LENGTH));
+                }
+                if let Some(b) = blend_m {
+                    s += &format!(" blend={}", fmt_quantity(*b, Dim::LENGTH));
+                }
+                s
+            }
+            Data::MotionEnd {
+                zone_m,
+                programmed_m,
+            } => {
+                if zone_m < programmed_m {
+                    format!(
+                        "zone={} (reduced from {}: at most half the motion)",
+                        fmt_quantity(*zone_m, Dim::LENGTH),
+                        fmt_quantity(*programmed_m, Dim::LENGTH)
+                    )
+                } else {
+                    format!("zone={}", fmt_quantity(*zone_m, Dim::LENGTH))
+                }
+            }
             Data::Delay { duration_ns } => format!("duration={duration_ns}"),
             Data::Set { global, new, .. } => match new {
                 Value::Bool(b) => format!("{global}={b}"),
@@ -536,7 +576,7 @@ impl Data {
             Data::Collision { a, b, contact } => match contact {
                 Some((depth, p)) => format!(
                     "{a} {b} depth={} point=({:.4}, {:.4}, {:.4})",
-                    fmt_quantity(*depth, vworks_vm::Dim::LENGTH),
+                    fmt_quantity(*depth, Dim::LENGTH),
                     p[0],
                     p[1],
                     p[2]
@@ -553,7 +593,22 @@ impl Data {
             Data::Motion {
                 command,
                 duration_ns,
-            } => json!({"command": command, "duration_ns": duration_ns}),
+                zone_m,
+                blend_m,
+            } => {
+                let mut o = json!({"command": command, "duration_ns": duration_ns});
+                if let Some(z) = zone_m {
+                    o["zone_m"] = json!(z);
+                }
+                if let Some(b) = blend_m {
+                    o["blend_m"] = json!(b);
+                }
+                o
+            }
+            Data::MotionEnd {
+                zone_m,
+                programmed_m,
+            } => json!({"zone_m": zone_m, "programmed_m": programmed_m}),
             Data::Delay { duration_ns } => json!({"duration_ns": duration_ns}),
             Data::Set { global, old, new } => {
                 json!({"global": global, "old": old.to_json(), "new": new.to_json()})
@@ -598,6 +653,12 @@ impl Data {
             Kind::MotionStart => Data::Motion {
                 command: s("command")?,
                 duration_ns: i("duration_ns")?,
+                zone_m: f("zone_m"),
+                blend_m: f("blend_m"),
+            },
+            Kind::MotionEnd if d.is_object() => Data::MotionEnd {
+                zone_m: f("zone_m")?,
+                programmed_m: f("programmed_m")?,
             },
             Kind::Delay => Data::Delay {
                 duration_ns: i("duration_ns")?,
@@ -794,9 +855,20 @@ fn vm_data(kind: &EventKind, m: &Module) -> Data {
         EventKind::MotionStart {
             command,
             duration_ns,
+            zone_m,
+            blend_m,
         } => Data::Motion {
             command: (*command).to_string(),
             duration_ns: *duration_ns,
+            zone_m: *zone_m,
+            blend_m: *blend_m,
+        },
+        EventKind::MotionEnd {
+            zone_m: Some(zone_m),
+            programmed_m,
+        } => Data::MotionEnd {
+            zone_m: *zone_m,
+            programmed_m: programmed_m.unwrap_or(*zone_m),
         },
         EventKind::Delay { duration_ns } => Data::Delay {
             duration_ns: *duration_ns,
@@ -843,7 +915,9 @@ fn vm_data(kind: &EventKind, m: &Module) -> Data {
             }
         }
         EventKind::RemoteStart { proc } | EventKind::RemoteEnd { proc } => procedure(*proc),
-        EventKind::MotionEnd | EventKind::DelayEnd | EventKind::Join | EventKind::End => Data::None,
+        EventKind::MotionEnd { .. } | EventKind::DelayEnd | EventKind::Join | EventKind::End => {
+            Data::None
+        }
     }
 }
 
@@ -871,6 +945,24 @@ mod tests {
                 Data::Motion {
                     command: "move_l".into(),
                     duration_ns: 1_500_000_000,
+                    zone_m: None,
+                    blend_m: None,
+                },
+            ),
+            (
+                Kind::MotionStart,
+                Data::Motion {
+                    command: "move_c".into(),
+                    duration_ns: 7,
+                    zone_m: Some(0.01),
+                    blend_m: Some(0.004),
+                },
+            ),
+            (
+                Kind::MotionEnd,
+                Data::MotionEnd {
+                    zone_m: 0.005,
+                    programmed_m: 0.05,
                 },
             ),
             (

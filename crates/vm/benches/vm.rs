@@ -63,6 +63,7 @@ fn sampling(c: &mut Criterion) {
         if let EventKind::MotionStart {
             command: "move_l",
             duration_ns,
+            ..
         } = e.kind
         {
             (t0, dur) = (e.time, duration_ns);

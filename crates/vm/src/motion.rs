@@ -295,6 +295,62 @@ impl Profile {
         }
     }
 
+    /// Acceleration at time `t` (s); at a phase boundary, the value of the phase that
+    /// starts there.
+    pub fn accel_at(&self, t: f64) -> f64 {
+        if t < 0.0 || t >= self.t_total {
+            return 0.0;
+        }
+        let (ta, tt, tj) = (self.t_acc, self.t_total, self.t_jerk);
+        let ramp = |tau: f64| {
+            if tj == 0.0 || (tau >= tj && tau < ta - tj) {
+                self.a
+            } else if tau < tj {
+                self.j * tau
+            } else {
+                self.j * (ta - tau)
+            }
+        };
+        if t < ta {
+            ramp(t)
+        } else if t < tt - ta {
+            0.0
+        } else {
+            -ramp(tt - t)
+        }
+    }
+
+    /// The times where a phase begins or ends (acceleration or jerk changes): within
+    /// each stretch between two of them the acceleration is linear in time.
+    pub fn breakpoints(&self) -> [f64; 8] {
+        let (ta, tt, tj) = (self.t_acc, self.t_total, self.t_jerk);
+        [0.0, tj, ta - tj, ta, tt - ta, tt - ta + tj, tt - tj, tt]
+    }
+
+    /// The first time the profile has covered `d` (clamped to [0, t_total]), by bisection
+    /// (the distance never decreases).
+    pub fn time_at(&self, d: f64) -> f64 {
+        if d <= 0.0 {
+            return 0.0;
+        }
+        if d >= self.dist {
+            return self.t_total;
+        }
+        let (mut lo, mut hi) = (0.0, self.t_total);
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if mid <= lo || mid >= hi {
+                break;
+            }
+            if self.at(mid) < d {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        hi
+    }
+
     /// Duration rounded up to whole nanoseconds.
     pub fn duration_ns(&self) -> i64 {
         (self.t_total * NS).ceil() as i64
@@ -506,6 +562,32 @@ mod tests {
             Profile::with_jerk(0.5, 1.0, 2.0, f64::INFINITY),
             Profile::new(0.5, 1.0, 2.0)
         );
+    }
+
+    #[test]
+    fn acceleration_is_the_derivative_of_speed_and_time_at_inverts_at() {
+        for p in [
+            Profile::with_jerk(1.0, 1.0, 2.0, 10.0),
+            Profile::with_jerk(0.002, 1.0, 2.0, 10.0),
+            Profile::new(0.5, 1.0, 2.0),
+            Profile::with_jerk(1.0, 1.0, 2.0, 10.0).lasting(3.0, 2.0),
+        ] {
+            let dt = 1e-7;
+            let bps = p.breakpoints();
+            for k in 1..1000 {
+                let t = p.t_total * k as f64 / 1000.0;
+                if bps.iter().any(|b| (t - b).abs() < 2.0 * dt) {
+                    continue;
+                }
+                let fd = (p.speed_at(t + dt) - p.speed_at(t - dt)) / (2.0 * dt);
+                assert!(
+                    (fd - p.accel_at(t)).abs() < 1e-5 * p.a.max(1.0),
+                    "{p:?} at {t}"
+                );
+                let d = p.at(t);
+                assert!((p.at(p.time_at(d)) - d).abs() < 1e-12);
+            }
+        }
     }
 
     #[test]

@@ -97,6 +97,7 @@ fn move_l_stays_on_its_line_and_ends_on_the_target() {
             EventKind::MotionStart {
                 command: "move_l",
                 duration_ns,
+                ..
             } => Some(duration_ns),
             _ => None,
         };

@@ -639,7 +639,27 @@ impl Parser<'_, '_> {
         };
         let mut speed = None;
         let mut accel = None;
+        let mut zone = None;
         loop {
+            if self.at_ident("zone") {
+                let t = self.bump();
+                let z = if self.at_ident("fine") {
+                    self.bump();
+                    Zone::Fine
+                } else {
+                    Zone::Radius(self.expr()?)
+                };
+                if zone.is_some() {
+                    let d = Diagnostic::error(
+                        Code::E0005,
+                        format!("`{}` is given twice", self.text(t.span)),
+                        t.span,
+                    );
+                    return Err(self.report(d));
+                }
+                zone = Some(z);
+                continue;
+            }
             let which = if self.at_ident("speed") {
                 &mut speed
             } else if self.at_ident("accel") {
@@ -666,7 +686,7 @@ impl Parser<'_, '_> {
                 format!("unknown motion option `{}`", self.text(t.span)),
                 t.span,
             )
-            .with_help("the options are `speed` and `accel`");
+            .with_help("the options are `speed`, `accel` and `zone`");
             return Err(self.report(d));
         }
         self.end(&format!("`{}`", kind.keyword()))?;
@@ -676,6 +696,7 @@ impl Parser<'_, '_> {
             target,
             speed,
             accel,
+            zone,
         })
     }
 

@@ -223,6 +223,8 @@ pub enum StmtKind {
         speed: Option<Expr>,
         /// `accel e`.
         accel: Option<Expr>,
+        /// `zone e` or `zone fine`.
+        zone: Option<Zone>,
     },
     /// `delay t;`
     Delay(Expr),
@@ -371,4 +373,13 @@ pub enum ExprKind {
     Index(Box<Expr>, Box<Expr>),
     /// Did not parse (already reported).
     Error,
+}
+
+/// The `zone` option of a motion.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Zone {
+    /// `zone fine`: stop at the point.
+    Fine,
+    /// `zone e`: fly by within the radius `e` (a length).
+    Radius(Expr),
 }

@@ -156,6 +156,7 @@ impl Simulation {
                 let cfg = VmConfig {
                     cycle_ns: cell.cycle_ns,
                     default_speed: r.default_speed,
+                    default_zone: r.default_zone,
                     tool: r.tool,
                     start_joints: r.home.clone(),
                     robot: i as u32,
@@ -688,7 +689,16 @@ impl Simulation {
         // Time per robot: the fold sees every event that can count — the robots' own (here)
         // and the errors the engine finds in them (`error`); check_wait, check_when,
         // collisions and warnings never change it.
-        self.fold.event(e.time, Some(r), kind);
+        // (Not a zoned motion's `motion_end`: the robot moves on; see `Fold::event`.)
+        if !matches!(
+            e.kind,
+            EventKind::MotionEnd {
+                zone_m: Some(_),
+                ..
+            }
+        ) {
+            self.fold.event(e.time, Some(r), kind);
+        }
         if let EventKind::MotionStart { .. } = e.kind {
             // Speed bounds behind skipped collision queries change with the motion.
             self.collider.motion_started(r);

@@ -223,6 +223,9 @@ fn operands(m: &Module, ins: &Instr) -> String {
             if f.has(MoveFlags::ACCEL) {
                 parts.push("accel");
             }
+            if f.has(MoveFlags::ZONE) {
+                parts.push("zone");
+            }
             parts.join(" ")
         }
         Instr::WaitUntil(c, t) => format!("c{c}{}", if t { " timeout" } else { "" }),

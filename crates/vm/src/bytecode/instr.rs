@@ -79,7 +79,9 @@ impl MoveFlags {
     pub const SPEED: u8 = 4;
     /// An `accel` operand is on the stack.
     pub const ACCEL: u8 = 8;
-    const ALL: u8 = 15;
+    /// A `zone` operand (radius in m; 0 for `zone fine`) is on the stack.
+    pub const ZONE: u8 = 16;
+    const ALL: u8 = 31;
 
     /// True if every bit of `bit` is set.
     pub fn has(self, bit: u8) -> bool {
@@ -425,7 +427,9 @@ impl Instr {
                     Instr::MoveC(_) => P,
                     _ => 0,
                 };
-                let extra = u32::from(f.has(MoveFlags::SPEED)) + u32::from(f.has(MoveFlags::ACCEL));
+                let extra = u32::from(f.has(MoveFlags::SPEED))
+                    + u32::from(f.has(MoveFlags::ACCEL))
+                    + u32::from(f.has(MoveFlags::ZONE));
                 eff(target + via + extra, 0)
             }
             Instr::Delay => eff(1, 0),

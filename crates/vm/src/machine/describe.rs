@@ -41,19 +41,22 @@ impl Vm {
             }
             Instr::ParJoin => EventKind::Join,
             Instr::MoveJ(_) | Instr::MoveL(_) | Instr::MoveC(_) => {
-                let (traj, dur) = self.plan(ins)?;
-                if dur < 0 || dur > TIME_LIMIT_NS - t {
+                let p = self.plan(ins)?;
+                if p.point_ns < 0 || p.point_ns > TIME_LIMIT_NS - p.start {
                     return Err("the motion would end after the last instant the simulator can represent (2^62 ns, about 146 years); check its speed".into());
                 }
-                self.pending_motion = Some(traj);
-                EventKind::MotionStart {
+                let kind = EventKind::MotionStart {
                     command: match ins {
                         Instr::MoveJ(_) => "move_j",
                         Instr::MoveL(_) => "move_l",
                         _ => "move_c",
                     },
-                    duration_ns: dur,
-                }
+                    duration_ns: p.end_ns,
+                    zone_m: p.programmed,
+                    blend_m: p.blend,
+                };
+                self.pending_motion = Some(p);
+                kind
             }
             Instr::Delay => {
                 let d = f64::from_bits(self.top(false, 0));

@@ -18,10 +18,14 @@ use crate::exec::{Reader, RuntimeError, Stop, Thread};
 use crate::motion::{NS, Path, Profile, cartesian_at};
 use crate::types::{Dim, Type, fmt_quantity};
 
+mod blend;
 mod describe;
 mod handlers;
 mod plan;
 mod waits;
+
+use blend::{Fading, Planned};
+use plan::Trajectory;
 
 /// The latest simulated time an event may have: 2^62 ns, about 146 years. A delay, a
 /// timeout, a motion or a handler period that would end later is a runtime error at its
@@ -44,6 +48,8 @@ pub struct VmConfig {
     pub cycle_ns: i64,
     /// Speed of `move_l`/`move_c` without `speed` (m/s).
     pub default_speed: f64,
+    /// Zone radius of motions without `zone` (m; `None`: `fine`, stop at the point).
+    pub default_zone: Option<f64>,
     /// TCP in the tool-link frame.
     pub tool: Iso,
     /// Joints at the start.
@@ -60,6 +66,7 @@ impl Default for VmConfig {
             max_depth: 256,
             cycle_ns: 4_000_000,
             default_speed: 0.25,
+            default_zone: None,
             tool: Iso::IDENTITY,
             start_joints: Vec::new(),
             robot: 0,
@@ -70,15 +77,27 @@ impl Default for VmConfig {
 /// What an event is.
 #[derive(Clone, Debug, PartialEq)]
 pub enum EventKind {
-    /// A motion begins; it ends `duration_ns` later.
+    /// A motion begins; its `motion_end` comes `duration_ns` later.
     MotionStart {
         /// `move_j`, `move_l` or `move_c`.
         command: &'static str,
-        /// Exact duration.
+        /// Exact time to its `motion_end`.
         duration_ns: i64,
+        /// Its zone radius as programmed (or the workcell's default); `None`: `fine`.
+        zone_m: Option<f64>,
+        /// It starts inside the corner of the previous zoned point, which it blends out
+        /// of within this radius (m).
+        blend_m: Option<f64>,
     },
-    /// The motion reached its target.
-    MotionEnd,
+    /// The motion reached its target — or, for a zoned one, the TCP entered its zone
+    /// (the robot goes on moving; the program runs ahead).
+    MotionEnd {
+        /// The zone radius its end was placed with (the programmed one, at most half the
+        /// motion), for a zoned motion.
+        zone_m: Option<f64>,
+        /// The zone radius programmed, for a zoned motion.
+        programmed_m: Option<f64>,
+    },
     /// The robot holds still for `duration_ns`.
     Delay {
         /// How long.
@@ -190,7 +209,7 @@ impl EventKind {
     pub fn name(&self) -> &'static str {
         match self {
             EventKind::MotionStart { .. } => "motion_start",
-            EventKind::MotionEnd => "motion_end",
+            EventKind::MotionEnd { .. } => "motion_end",
             EventKind::Delay { .. } => "delay",
             EventKind::DelayEnd => "delay_end",
             EventKind::Set { .. } => "set",
@@ -238,73 +257,6 @@ pub enum Next {
     Idle,
     /// The program failed (or the VM was stopped): nothing more will happen.
     Done,
-}
-
-/// Up to 12 slots of a pose (6) or joints (12) operand, without allocating.
-#[derive(Clone, Copy)]
-struct Slots {
-    v: [u64; MAX_AXES],
-    len: usize,
-}
-
-impl Slots {
-    fn read(stack: &[u64], from: usize, len: usize) -> Slots {
-        let mut v = [0u64; MAX_AXES];
-        v[..len].copy_from_slice(&stack[from..from + len]);
-        Slots { v, len }
-    }
-    fn get(&self) -> &[u64] {
-        &self.v[..self.len]
-    }
-}
-
-/// The operands of a motion instruction.
-struct MotionOperands {
-    /// Target slots (6 for a pose, 12 for joints).
-    target: Slots,
-    /// Via point slots of `move_c`.
-    via: Option<Slots>,
-    /// `speed`, if given.
-    speed: Option<f64>,
-    /// `accel`, if given.
-    accel: Option<f64>,
-    /// Slots they take on the stack.
-    width: usize,
-}
-
-/// A planned motion.
-// One per VM (its current motion), never in a collection: the variants' sizes do not
-// matter, and boxing would add an allocation per motion.
-#[allow(clippy::large_enum_variant)]
-#[derive(Clone, Debug)]
-enum Trajectory {
-    /// Joint-space: each axis from `from` by `delta` along a shared normalised profile.
-    Joint {
-        from: [f64; MAX_AXES],
-        delta: [f64; MAX_AXES],
-        profile: Profile,
-    },
-    /// Joint-space with a jerk limit on some axis: each axis from `from` by `delta` along
-    /// its own profile over `|delta|` (trapezoid or S-curve), all lasting the same time
-    /// (time synchronisation, as Ruckig's).
-    JointSynced {
-        from: [f64; MAX_AXES],
-        delta: [f64; MAX_AXES],
-        profiles: [Profile; MAX_AXES],
-    },
-    /// Cartesian: the TCP along `path`, orientation by slerp; joints by IK.
-    Cartesian {
-        path: Path,
-        from: Iso,
-        to: Iso,
-        profile: Profile,
-        end_joints: [f64; MAX_AXES],
-        /// The analytic IK branch the motion stays on (spherical-wrist arms).
-        branch: Option<u8>,
-        /// Per axis, the largest speed found at the samples the motion was checked at
-        /// (rad/s or m/s).
-        rates: [f64; MAX_AXES],
-    },
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -404,7 +356,16 @@ pub struct Vm {
     rest: [f64; MAX_AXES],
     motion: Option<(i64, Trajectory)>,
     /// The motion planned by `next_event`, started by `perform`.
-    pending_motion: Option<Trajectory>,
+    pending_motion: Option<Planned>,
+    /// The current motion's zone radius (0: it stops at its point) and when it reaches
+    /// its point.
+    motion_zone: f64,
+    motion_programmed: Option<f64>,
+    motion_point_end: i64,
+    /// The rest of a zoned motion after its `motion_end`, while the robot finishes it.
+    fading: Option<Fading>,
+    /// Statements already warned about making a zoned point a stop point.
+    zone_warned: Vec<u32>,
     timed_out: bool,
     /// Scratch thread for evaluating conditions.
     cond_thread: Thread,
@@ -554,6 +515,11 @@ impl Vm {
             rest,
             motion: None,
             pending_motion: None,
+            motion_zone: 0.0,
+            motion_programmed: None,
+            motion_point_end: 0,
+            fading: None,
+            zone_warned: Vec::new(),
             timed_out: false,
             cond_thread: Thread::default(),
             handler: Thread::default(),
@@ -651,6 +617,10 @@ impl Vm {
     pub fn moving_at(&self, t: i64) -> bool {
         matches!(self.state, State::Moving { end, .. } if t < end)
             && self.motion.as_ref().is_some_and(|(s, _)| t > *s)
+            || self
+                .fading
+                .as_ref()
+                .is_some_and(|f| t > f.start && t < f.end)
     }
 
     /// Warnings produced so far (time, position, message); the SE drains them.
@@ -711,7 +681,10 @@ impl Vm {
             State::Moving { end, pos } => Next::Event(Event {
                 robot: self.cfg.robot,
                 time: *end,
-                kind: EventKind::MotionEnd,
+                kind: EventKind::MotionEnd {
+                    zone_m: (self.motion_zone > 0.0).then_some(self.motion_zone),
+                    programmed_m: self.motion_programmed,
+                },
                 pos: *pos,
             }),
             State::Delaying { end, pos } => Next::Event(Event {
@@ -802,6 +775,12 @@ impl Vm {
             } else {
                 pc
             });
+            // A zoned point still ahead becomes a stop point before some statements.
+            let t = match (in_handler, &stop) {
+                (false, Ok(Stop::Finished)) => self.stop_point(None, pc.saturating_sub(1), t),
+                (false, Ok(Stop::Event(ins))) => self.stop_point(Some(*ins), pc, t),
+                _ => t,
+            };
             let kind = match stop {
                 Err(e) => return self.error_event(&e, t),
                 Ok(Stop::Finished) => match (in_handler, self.hrun, self.serving) {
@@ -829,9 +808,14 @@ impl Vm {
                     Err(message) => EventKind::Error { message },
                 },
             };
+            // A motion may start later, within the corner of the zoned point before it.
+            let time = match (&kind, &self.pending_motion) {
+                (EventKind::MotionStart { .. }, Some(p)) => p.start,
+                _ => t,
+            };
             return Event {
                 robot: self.cfg.robot,
-                time: t,
+                time,
                 kind,
                 pos,
             };
@@ -858,6 +842,9 @@ impl Vm {
             Source::Handler => self.perform_handler(),
             Source::Fire(i) => self.perform_fire(i),
             Source::None => return,
+        }
+        if self.fading.as_ref().is_some_and(|f| self.time >= f.end) {
+            self.fading = None;
         }
         self.enter_instant(self.time);
         self.instant_events += 1;
@@ -906,9 +893,10 @@ impl Vm {
     /// wait) is abandoned, the robot holds still where it is, and the program ends (`end`)
     /// — or, in remote work, the remote work ends (`remote_end`).
     fn stop_program(&mut self, t: i64, pos: SrcPos) {
-        if self.motion.is_some() {
+        if self.motion.is_some() || self.fading.is_some() {
             self.rest = self.joints_at(t);
             self.motion = None;
+            self.fading = None;
         }
         self.pending_motion = None;
         self.state = State::At(Event {
@@ -951,8 +939,11 @@ impl Vm {
                         let width = self.motion_operands(ins).width;
                         let l = self.main.stack.len() - width;
                         self.main.stack.truncate(l);
-                        if let Some(traj) = self.pending_motion.take() {
-                            self.motion = Some((e.time, traj));
+                        if let Some(p) = self.pending_motion.take() {
+                            self.motion_zone = p.zone;
+                            self.motion_programmed = p.programmed;
+                            self.motion_point_end = e.time + p.point_ns;
+                            self.motion = Some((e.time, p.traj));
                         }
                         self.state = State::Moving {
                             end: e.time + duration_ns,
@@ -1029,23 +1020,28 @@ impl Vm {
                 }
                 self.main.pc = pc + 1;
             }
-            State::Moving { end, .. } => {
+            State::Moving { end, pos } => {
                 self.time = end;
-                self.rest = self.joints_at(end);
-                if let Some((
-                    _,
-                    Trajectory::Joint { from, delta, .. }
-                    | Trajectory::JointSynced { from, delta, .. },
-                )) = &self.motion
-                {
+                if let Some((start, traj)) = self.motion.take() {
                     // Exactly the target, not the profile's last float.
-                    let mut q = *from;
-                    for (qi, d) in q.iter_mut().zip(delta) {
-                        *qi += d;
+                    self.rest = traj.end_joints();
+                    if self.motion_zone > 0.0 && self.motion_point_end > end {
+                        let n = self.model.dof();
+                        let corner_pose = match &traj {
+                            Trajectory::Cartesian { to, .. } => *to,
+                            _ => self.model.tcp(&self.rest[..n], &self.cfg.tool),
+                        };
+                        self.fading = Some(Fading {
+                            start,
+                            end: self.motion_point_end,
+                            traj,
+                            corner: self.rest,
+                            corner_pose,
+                            zone: self.motion_zone,
+                            pos,
+                        });
                     }
-                    self.rest = q;
                 }
-                self.motion = None;
             }
             State::Delaying { end, .. } => self.time = end,
             State::Waiting {

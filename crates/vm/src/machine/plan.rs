@@ -1,16 +1,146 @@
 //! Motion planning and sampling: a motion's operands, inverse kinematics of its target,
-//! its trajectory and exact duration (`plan`), and the joints and TCP at any time inside
-//! it (`joints_at`, `tcp_at`, the speed bounds the collider's sweep uses).
+//! its trajectory and exact duration (`plan_path`), and the joints and TCP at any time
+//! inside a trajectory (`eval_joints`, `eval_pose`, the speed bounds the collider's
+//! sweep uses).
 
 use super::*;
 
+/// Up to 12 slots of a pose (6) or joints (12) operand, without allocating.
+#[derive(Clone, Copy)]
+pub(super) struct Slots {
+    v: [u64; MAX_AXES],
+    len: usize,
+}
+
+impl Slots {
+    pub(super) fn read(stack: &[u64], from: usize, len: usize) -> Slots {
+        let mut v = [0u64; MAX_AXES];
+        v[..len].copy_from_slice(&stack[from..from + len]);
+        Slots { v, len }
+    }
+    pub(super) fn get(&self) -> &[u64] {
+        &self.v[..self.len]
+    }
+}
+
+/// The operands of a motion instruction.
+pub(super) struct MotionOperands {
+    /// Target slots (6 for a pose, 12 for joints).
+    target: Slots,
+    /// Via point slots of `move_c`.
+    via: Option<Slots>,
+    /// `speed`, if given.
+    speed: Option<f64>,
+    /// `accel`, if given.
+    accel: Option<f64>,
+    /// `zone` radius (m; 0 for `zone fine`), if given.
+    pub(super) zone: Option<f64>,
+    /// Slots they take on the stack.
+    pub(super) width: usize,
+}
+
+/// A planned motion.
+// One per VM (its current motion), never in a collection: the variants' sizes do not
+// matter, and boxing would add an allocation per motion.
+#[allow(clippy::large_enum_variant)]
+#[derive(Clone, Debug)]
+pub(super) enum Trajectory {
+    /// Joint-space: each axis from `from` by `delta` along a shared normalised profile.
+    Joint {
+        from: [f64; MAX_AXES],
+        delta: [f64; MAX_AXES],
+        profile: Profile,
+    },
+    /// Joint-space with a jerk limit on some axis: each axis from `from` by `delta` along
+    /// its own profile over `|delta|` (trapezoid or S-curve), all lasting the same time
+    /// (time synchronisation, as Ruckig's).
+    JointSynced {
+        from: [f64; MAX_AXES],
+        delta: [f64; MAX_AXES],
+        profiles: [Profile; MAX_AXES],
+    },
+    /// Cartesian: the TCP along `path`, orientation by slerp; joints by IK.
+    Cartesian {
+        path: Path,
+        from: Iso,
+        to: Iso,
+        profile: Profile,
+        end_joints: [f64; MAX_AXES],
+        /// The analytic IK branch the motion stays on (spherical-wrist arms).
+        branch: Option<u8>,
+        /// Per axis, the largest speed found at the samples the motion was checked at
+        /// (rad/s or m/s).
+        rates: [f64; MAX_AXES],
+        /// The joints it starts from (the seed of numeric IK).
+        seed: [f64; MAX_AXES],
+    },
+}
+
+impl Trajectory {
+    /// The joints at the end: exactly the target (not the profile's last float).
+    pub(super) fn end_joints(&self) -> [f64; MAX_AXES] {
+        match self {
+            Trajectory::Joint { from, delta, .. } | Trajectory::JointSynced { from, delta, .. } => {
+                let mut q = *from;
+                for (qi, d) in q.iter_mut().zip(delta) {
+                    *qi += d;
+                }
+                q
+            }
+            Trajectory::Cartesian { end_joints, .. } => *end_joints,
+        }
+    }
+
+    /// True for `move_l`/`move_c` (the TCP follows a path).
+    pub(super) fn is_cartesian(&self) -> bool {
+        matches!(self, Trajectory::Cartesian { .. })
+    }
+
+    /// Per axis, a bound on its speed (rad/s or m/s): exact for joint motions; for a
+    /// Cartesian one the largest speed at the samples its axis speeds were checked at.
+    pub(super) fn rates(&self) -> [f64; MAX_AXES] {
+        let mut out = [0.0; MAX_AXES];
+        match self {
+            Trajectory::Joint { delta, profile, .. } if profile.dist > 0.0 => {
+                for (o, d) in out.iter_mut().zip(delta) {
+                    *o = d.abs() * profile.v / profile.dist;
+                }
+            }
+            Trajectory::JointSynced { profiles, .. } => {
+                for (o, p) in out.iter_mut().zip(profiles) {
+                    *o = p.v;
+                }
+            }
+            Trajectory::Cartesian { rates, .. } => out = *rates,
+            _ => {}
+        }
+        out
+    }
+
+    /// Axis `i`'s profile and the factor from the profile's distance to the axis's
+    /// (signed) motion, for joint motions: the axis moves `k·p.at(t)`.
+    pub(super) fn axis_profile(&self, i: usize) -> Option<(&Profile, f64)> {
+        match self {
+            Trajectory::Joint { delta, profile, .. } => {
+                let k = if profile.dist > 0.0 {
+                    delta[i] / profile.dist
+                } else {
+                    0.0
+                };
+                Some((profile, k))
+            }
+            Trajectory::JointSynced {
+                delta, profiles, ..
+            } => Some((&profiles[i], if delta[i] < 0.0 { -1.0 } else { 1.0 })),
+            Trajectory::Cartesian { .. } => None,
+        }
+    }
+}
+
 impl Vm {
-    /// The joints at time `t` (inside or after the current motion).
-    pub fn joints_at(&self, t: i64) -> [f64; MAX_AXES] {
-        let Some((start, traj)) = &self.motion else {
-            return self.rest;
-        };
-        let dt = (t - start) as f64 / NS;
+    /// The joints `dt` seconds into `traj` (its start before, its end after); `None` if
+    /// the inverse kinematics of a Cartesian motion's pose fails there.
+    pub(super) fn eval_joints(&self, traj: &Trajectory, dt: f64) -> Option<[f64; MAX_AXES]> {
         match traj {
             Trajectory::Joint {
                 from,
@@ -26,7 +156,7 @@ impl Vm {
                 for (qi, d) in q.iter_mut().zip(delta) {
                     *qi += d * s;
                 }
-                q
+                Some(q)
             }
             Trajectory::JointSynced {
                 from,
@@ -37,91 +167,61 @@ impl Vm {
                 for ((qi, d), p) in q.iter_mut().zip(delta).zip(profiles) {
                     *qi += p.at(dt).copysign(*d);
                 }
-                q
+                Some(q)
             }
             Trajectory::Cartesian {
-                path,
-                from,
-                to,
                 profile,
                 end_joints,
-                branch,
                 ..
             } => {
                 if dt >= profile.t_total {
-                    return *end_joints;
+                    return Some(*end_joints);
                 }
-                let s = if profile.dist > 0.0 {
-                    profile.at(dt) / profile.dist
-                } else {
-                    1.0
-                };
-                let tcp = cartesian_at(path, from, to, s);
-                let flange = tcp.mul(&self.cfg.tool.inverse());
-                let mut q = [0.0; MAX_AXES];
-                // On the motion's branch (one analytic solution), or seeded from the start
-                // joints (numeric IK) — either way the configuration the move started in.
-                let n = self.model.dof();
-                let solved = match branch {
-                    Some(b) => self
-                        .model
-                        .ik_in_branch(&flange, &self.rest[..n], *b, &mut q[..n]),
-                    None => self.model.ik(&flange, &self.rest[..n], &mut q[..n]),
-                };
-                if solved.is_err() {
-                    return self.rest;
-                }
-                q
+                self.ik_on(traj, &self.eval_pose(traj, dt))
             }
         }
     }
 
-    /// Per axis, a bound on its speed during the current motion (rad/s or m/s; 0 when
-    /// not moving): for a joint motion exact; for a Cartesian one the largest speed at the
-    /// 64 samples its axis speeds were checked at (between samples it can be somewhat
-    /// higher; the collision sweep adds a margin).
-    pub fn axis_rate_bounds(&self) -> [f64; MAX_AXES] {
-        let mut out = [0.0; MAX_AXES];
-        match &self.motion {
-            Some((_, Trajectory::Joint { delta, profile, .. })) if profile.dist > 0.0 => {
-                for (o, d) in out.iter_mut().zip(delta) {
-                    *o = d.abs() * profile.v / profile.dist;
-                }
-            }
-            Some((_, Trajectory::JointSynced { profiles, .. })) => {
-                for (o, p) in out.iter_mut().zip(profiles) {
-                    *o = p.v;
-                }
-            }
-            Some((_, Trajectory::Cartesian { rates, .. })) => out = *rates,
-            _ => {}
-        }
-        out
+    /// The joints of a TCP pose on the configuration of Cartesian motion `traj`: on its
+    /// analytic branch, or seeded from its start joints (numeric IK).
+    pub(super) fn ik_on(&self, traj: &Trajectory, tcp: &Iso) -> Option<[f64; MAX_AXES]> {
+        let Trajectory::Cartesian { branch, seed, .. } = traj else {
+            return None;
+        };
+        let flange = tcp.mul(&self.cfg.tool.inverse());
+        let mut q = [0.0; MAX_AXES];
+        let n = self.model.dof();
+        let solved = match branch {
+            Some(b) => self
+                .model
+                .ik_in_branch(&flange, &seed[..n], *b, &mut q[..n]),
+            None => self.model.ik(&flange, &seed[..n], &mut q[..n]),
+        };
+        solved.is_ok().then_some(q)
     }
 
-    /// The TCP pose at time `t`.
-    pub fn tcp_at(&self, t: i64) -> Iso {
-        if let Some((
-            start,
+    /// The TCP pose `dt` seconds into `traj`.
+    pub(super) fn eval_pose(&self, traj: &Trajectory, dt: f64) -> Iso {
+        match traj {
             Trajectory::Cartesian {
                 path,
                 from,
                 to,
                 profile,
                 ..
-            },
-        )) = &self.motion
-        {
-            let dt = (t - start) as f64 / NS;
-            let s = if profile.dist > 0.0 {
-                (profile.at(dt) / profile.dist).min(1.0)
-            } else {
-                1.0
-            };
-            return cartesian_at(path, from, to, s);
+            } => {
+                let s = if profile.dist > 0.0 {
+                    (profile.at(dt) / profile.dist).min(1.0)
+                } else {
+                    1.0
+                };
+                cartesian_at(path, from, to, s)
+            }
+            _ => {
+                let q = self.eval_joints(traj, dt).unwrap_or(self.rest);
+                self.model.tcp(&q[..self.model.dof()], &self.cfg.tool)
+            }
         }
-        let q = self.joints_at(t);
-        self.model.tcp(&q[..self.model.dof()], &self.cfg.tool)
     }
 
     /// The time a jerk-limited axis takes to ramp its acceleration up (`a/j`), the
@@ -185,6 +285,10 @@ impl Vm {
         };
         let s = &self.main.stack;
         let mut k = 0;
+        let zone = f.has(MoveFlags::ZONE).then(|| {
+            k += 1;
+            f64::from_bits(s[s.len() - k])
+        });
         let accel = f.has(MoveFlags::ACCEL).then(|| {
             k += 1;
             f64::from_bits(s[s.len() - k])
@@ -215,6 +319,7 @@ impl Vm {
             via,
             speed,
             accel,
+            zone,
             width: k,
         }
     }
@@ -243,8 +348,9 @@ impl Vm {
         Ok(q)
     }
 
-    /// Plans the motion of `ins` from the robot's state now; returns it and its duration.
-    pub(super) fn plan(&mut self, ins: Instr) -> Result<(Trajectory, i64), String> {
+    /// Plans the path and profile of `ins` from the robot's state now (from the corner
+    /// of a zoned motion still finishing: see `blend`); returns it and its duration.
+    pub(super) fn plan_path(&mut self, ins: Instr) -> Result<(Trajectory, i64), String> {
         let MotionOperands {
             target: target_slots,
             via,
@@ -252,9 +358,9 @@ impl Vm {
             accel,
             ..
         } = self.motion_operands(ins);
+        let from = self.rest;
         let target = target_slots.get();
         let n = self.model.dof();
-        let from = self.rest;
         if let Instr::MoveJ(_) = ins {
             let goal = if target.len() == MAX_AXES {
                 let mut q = [0.0; MAX_AXES];
@@ -323,7 +429,10 @@ impl Vm {
             ));
         }
         // Cartesian: line or arc, orientation by slerp.
-        let start = self.tcp_at(self.time);
+        let start = match &self.fading {
+            Some(f) => f.corner_pose,
+            None => self.tcp_at(self.time),
+        };
         let goal = self.operand_pose(target);
         let path = match &via {
             None => Path::Line {
@@ -375,6 +484,7 @@ impl Vm {
                 end_joints: from,
                 branch: None,
                 rates: [0.0; MAX_AXES],
+                seed: from,
             };
             return Ok((traj, 0));
         }
@@ -432,6 +542,7 @@ impl Vm {
                 end_joints: prev,
                 branch,
                 rates,
+                seed: from,
             },
             dur,
         ))

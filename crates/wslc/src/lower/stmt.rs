@@ -158,12 +158,16 @@ impl Compiler<'_> {
                 target,
                 speed,
                 accel,
+                zone,
             } => self.move_stmt(
                 *kind,
                 via.as_ref(),
                 target,
-                speed.as_ref(),
-                accel.as_ref(),
+                MoveOptions {
+                    speed: speed.as_ref(),
+                    accel: accel.as_ref(),
+                    zone: zone.as_ref(),
+                },
                 sp,
             ),
             StmtKind::Delay(t) => {
@@ -746,8 +750,7 @@ impl Compiler<'_> {
         kind: MoveKind,
         via: Option<&Expr>,
         target: &Expr,
-        speed: Option<&Expr>,
-        accel: Option<&Expr>,
+        MoveOptions { speed, accel, zone }: MoveOptions<'_>,
         sp: Span,
     ) {
         self.takes_time("move", sp);
@@ -791,6 +794,31 @@ impl Compiler<'_> {
         if let Some(a) = accel {
             flags |= MoveFlags::ACCEL;
             self.motion_rate(kind, a, Dim::ACCEL, "acceleration");
+        }
+        match zone {
+            None => {}
+            Some(Zone::Fine) => {
+                flags |= MoveFlags::ZONE;
+                self.emit(Instr::PushNum(0.0), sp);
+            }
+            Some(Zone::Radius(e)) => {
+                flags |= MoveFlags::ZONE;
+                let out = self.expr(e);
+                let what = format!("the zone of `{}`", kind.keyword());
+                let out = self.coerce(out, Ty::Num(Dim::LENGTH), e.span, &what);
+                if let Some(ConstValue::Num(x)) = out.k
+                    && (x.is_nan() || x < 0.0)
+                {
+                    self.err(
+                        Diagnostic::error(
+                            Code::E0025,
+                            format!("{what} cannot be negative"),
+                            e.span,
+                        )
+                        .with_help("write a radius such as `zone 10mm`, or `zone fine` to stop at the point"),
+                    );
+                }
+            }
         }
         let f = MoveFlags(flags);
         self.emit(
@@ -967,4 +995,11 @@ impl Compiler<'_> {
             }
         }
     }
+}
+
+/// The options of a motion statement.
+pub(super) struct MoveOptions<'a> {
+    pub(super) speed: Option<&'a Expr>,
+    pub(super) accel: Option<&'a Expr>,
+    pub(super) zone: Option<&'a Zone>,
 }

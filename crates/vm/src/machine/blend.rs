@@ -1,0 +1,503 @@
+//! Zones (fly-by points), as a controller makes them.
+//!
+//! - A zoned motion's `motion_end` happens when the TCP enters its zone (`zone_entry`):
+//!   the program runs ahead from there while the robot goes on toward the point (the
+//!   motion becomes [`Fading`]).
+//! - The next motion is planned from the corner as if from rest, and *superposed* on the
+//!   rest of the previous one: `q(t) = q₁(t) + q₂(t − t_s) − corner` in joint space, or
+//!   `p(t) = p₁(t) + p₂(t − t_s) − P` (orientation `R₂·R_Pᵀ·R₁`) when both are Cartesian.
+//!   `blend_start` picks the earliest start `t_s` at which the corner stays within the zone
+//!   and the axes within their limits (`docs/engine.md`, "Zones", gives the conditions).
+//! - A statement that takes time without moving (or grips, or ends the program) makes the
+//!   zoned point a stop point: its event waits until the robot is there (`stop_point`).
+//!
+//! Everything that samples the robot (`joints_at`, `tcp_at`, `axis_rate_bounds`,
+//! `moving_at`) sees the blended path.
+
+use super::*;
+
+/// The rest of a zoned motion after its `motion_end`: the robot goes on along it until
+/// `end`, and the next motion is superposed on it.
+#[derive(Clone, Debug)]
+pub(super) struct Fading {
+    /// When the motion started.
+    pub(super) start: i64,
+    /// When it reaches its point.
+    pub(super) end: i64,
+    pub(super) traj: Trajectory,
+    /// The point, exactly: the joints and the TCP pose.
+    pub(super) corner: [f64; MAX_AXES],
+    pub(super) corner_pose: Iso,
+    /// The zone radius its `motion_end` was placed with (the programmed one, at most half
+    /// the motion).
+    pub(super) zone: f64,
+    /// The statement of the motion.
+    pub(super) pos: SrcPos,
+}
+
+/// A motion ready to start: its trajectory, when it starts, when its `motion_end` comes
+/// and when it reaches its point (both from its start).
+#[derive(Clone, Debug)]
+pub(super) struct Planned {
+    pub(super) traj: Trajectory,
+    pub(super) start: i64,
+    pub(super) end_ns: i64,
+    pub(super) point_ns: i64,
+    /// The zone radius its `motion_end` is placed with (0: a stop point).
+    pub(super) zone: f64,
+    /// The zone as programmed (or the workcell's default); `None`: `fine`.
+    pub(super) programmed: Option<f64>,
+    /// The radius within which it blends out of the previous zoned point, if it does.
+    pub(super) blend: Option<f64>,
+}
+
+/// Samples of the corner checked for reachability, axis speeds and (joint-space corners)
+/// the zone.
+const CORNER_SAMPLES: usize = 32;
+
+impl Vm {
+    /// The previous motion's rest, while it goes on at `t`.
+    fn fading_at(&self, t: i64) -> Option<&Fading> {
+        self.fading.as_ref().filter(|f| t < f.end)
+    }
+
+    /// The joints at time `t` (inside or after the current motion, through a corner).
+    pub fn joints_at(&self, t: i64) -> [f64; MAX_AXES] {
+        let Some(f) = self.fading_at(t) else {
+            return match &self.motion {
+                Some((start, traj)) => self
+                    .eval_joints(traj, (t - start) as f64 / NS)
+                    .unwrap_or(self.rest),
+                None => self.rest,
+            };
+        };
+        match &self.motion {
+            Some((start, traj)) => self.blend_joints(f, traj, *start, t).unwrap_or(self.rest),
+            None => self
+                .eval_joints(&f.traj, (t - f.start) as f64 / NS)
+                .unwrap_or(self.rest),
+        }
+    }
+
+    /// The joints at `t` of motion `next` starting at `ts` superposed on the rest of `f`
+    /// (in Cartesian space when both are Cartesian); `None` where IK fails.
+    fn blend_joints(
+        &self,
+        f: &Fading,
+        next: &Trajectory,
+        ts: i64,
+        t: i64,
+    ) -> Option<[f64; MAX_AXES]> {
+        let d1 = (t - f.start) as f64 / NS;
+        let d2 = (t - ts) as f64 / NS;
+        if f.traj.is_cartesian() && next.is_cartesian() {
+            if t <= ts {
+                return self.eval_joints(&f.traj, d1);
+            }
+            if t >= f.end {
+                return self.eval_joints(next, d2);
+            }
+            return self.ik_on(next, &self.blend_pose(f, next, ts, t));
+        }
+        let q1 = self.eval_joints(&f.traj, d1)?;
+        let mut q = self.eval_joints(next, d2)?;
+        for ((qi, a), c) in q.iter_mut().zip(q1).zip(f.corner) {
+            *qi += a - c;
+        }
+        Some(q)
+    }
+
+    /// The TCP of a Cartesian corner at `t`: `p₁ + p₂ − P`, orientation `R₂·R_Pᵀ·R₁`.
+    fn blend_pose(&self, f: &Fading, next: &Trajectory, ts: i64, t: i64) -> Iso {
+        use vworks_model::math::{mat_mul, transpose};
+        let a = self.eval_pose(&f.traj, (t - f.start) as f64 / NS);
+        let b = self.eval_pose(next, (t - ts) as f64 / NS);
+        let p = f.corner_pose;
+        Iso {
+            r: mat_mul(&mat_mul(&b.r, &transpose(&p.r)), &a.r),
+            t: [
+                a.t[0] + b.t[0] - p.t[0],
+                a.t[1] + b.t[1] - p.t[1],
+                a.t[2] + b.t[2] - p.t[2],
+            ],
+        }
+    }
+
+    /// The TCP pose at time `t`.
+    pub fn tcp_at(&self, t: i64) -> Iso {
+        match (self.fading_at(t), &self.motion) {
+            (None, Some((start, traj))) if traj.is_cartesian() => {
+                self.eval_pose(traj, (t - start) as f64 / NS)
+            }
+            (Some(f), Some((start, traj)))
+                if f.traj.is_cartesian() && traj.is_cartesian() && t > *start =>
+            {
+                self.blend_pose(f, traj, *start, t)
+            }
+            _ => {
+                let q = self.joints_at(t);
+                self.model.tcp(&q[..self.model.dof()], &self.cfg.tool)
+            }
+        }
+    }
+
+    /// Per axis, a bound on its speed during the current motion (rad/s or m/s; 0 when
+    /// not moving): for a joint motion exact; for a Cartesian one the largest speed at the
+    /// samples its axis speeds were checked at (between samples it can be somewhat higher;
+    /// the collision sweep adds a margin). Through a corner, the two motions' bounds add.
+    pub fn axis_rate_bounds(&self) -> [f64; MAX_AXES] {
+        let mut out = match &self.motion {
+            Some((_, traj)) => traj.rates(),
+            None => [0.0; MAX_AXES],
+        };
+        if let Some(f) = &self.fading {
+            for (o, r) in out.iter_mut().zip(f.traj.rates()) {
+                *o += r;
+            }
+        }
+        out
+    }
+
+    /// Plans motion `ins`: its path and profile, when it starts (at once, or later within
+    /// the corner of a zoned motion still finishing), and where its own zone begins.
+    pub(super) fn plan(&mut self, ins: Instr) -> Result<Planned, String> {
+        let programmed = match self.motion_operands(ins).zone.or(self.cfg.default_zone) {
+            Some(z) if z.is_nan() || z < 0.0 => {
+                return Err(format!(
+                    "the zone cannot be negative (got {}); write a radius such as `zone 10mm`, or `zone fine`",
+                    fmt_quantity(z, Dim::LENGTH)
+                ));
+            }
+            Some(z) if z > 0.0 => Some(z),
+            _ => None,
+        };
+        let (traj, point_ns) = self.plan_path(ins)?;
+        let (start, blend) = match self.fading_at(self.time) {
+            Some(f) => {
+                let (ts, radius) = self.blend_start(f, &traj, point_ns);
+                (ts, Some(radius))
+            }
+            None => (self.time, None),
+        };
+        let (mut end_ns, zone) = match programmed {
+            Some(r) => self.zone_entry(&traj, point_ns, r),
+            None => (point_ns, 0.0),
+        };
+        // The next corner begins after this one has ended.
+        if let Some(f) = self.fading_at(self.time) {
+            end_ns = end_ns.max((f.end - start).min(point_ns));
+        }
+        Ok(Planned {
+            traj,
+            start,
+            end_ns,
+            point_ns,
+            zone: if end_ns < point_ns { zone } else { 0.0 },
+            programmed,
+            blend,
+        })
+    }
+
+    /// Where a motion of `point_ns` enters the zone of radius `r` around its point: the
+    /// time from its start, and the radius used. A Cartesian motion's zone is at most
+    /// half its path (`s = 1 − r/L` along it); a joint motion's begins where the TCP comes
+    /// within `r` of the point, and not before half its duration.
+    fn zone_entry(&self, traj: &Trajectory, point_ns: i64, r: f64) -> (i64, f64) {
+        let total = point_ns as f64 / NS;
+        let to_ns = |t: f64| ((t * NS).ceil() as i64).clamp(0, point_ns);
+        if let Trajectory::Cartesian { path, profile, .. } = traj {
+            let len = path.length();
+            if len <= 1e-7 || profile.dist <= 0.0 {
+                return (point_ns, 0.0);
+            }
+            let r1 = r.min(0.5 * len);
+            let t = profile.time_at(profile.dist * (1.0 - r1 / len));
+            return (to_ns(t), r1);
+        }
+        let n = self.model.dof();
+        let point = self.model.tcp(&traj.end_joints()[..n], &self.cfg.tool).t;
+        let dist = |t: f64| {
+            let q = self.eval_joints(traj, t).unwrap_or(self.rest);
+            vworks_model::math::norm(vworks_model::math::sub(
+                self.model.tcp(&q[..n], &self.cfg.tool).t,
+                point,
+            ))
+        };
+        const STEPS: usize = 32;
+        let at = |k: usize| 0.5 * total + 0.5 * total * k as f64 / STEPS as f64;
+        // The last sample still outside the zone, from the end back to the middle.
+        let Some(k) = (0..STEPS).rev().find(|&k| dist(at(k)) > r) else {
+            return (to_ns(0.5 * total), dist(0.5 * total));
+        };
+        let (mut lo, mut hi) = (at(k), at(k + 1));
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if dist(mid) > r {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        (to_ns(hi), r)
+    }
+
+    /// The earliest start of `next` (lasting `next_ns`, planned from the corner) within
+    /// the rest of `f` at which the corner is feasible, and the radius around the point
+    /// the corner stays within. Feasibility only gets easier as the start moves later
+    /// (less overlap), so a bisection over whole nanoseconds finds it; at `f.end` there
+    /// is no overlap (a stop point).
+    fn blend_start(&self, f: &Fading, next: &Trajectory, next_ns: i64) -> (i64, f64) {
+        let lo = self.time.max(f.start);
+        let hi = f.end;
+        if lo >= hi {
+            return (hi, 0.0);
+        }
+        let search = |ok: &dyn Fn(i64) -> Option<f64>, mut lo: i64| -> (i64, f64) {
+            if let Some(r) = ok(lo) {
+                return (lo, r);
+            }
+            let mut hi = hi;
+            let mut best = 0.0;
+            while hi - lo > 1 {
+                let mid = lo + (hi - lo) / 2;
+                match ok(mid) {
+                    Some(r) => {
+                        hi = mid;
+                        best = r;
+                    }
+                    None => lo = mid,
+                }
+            }
+            (hi, if hi >= f.end { 0.0 } else { best })
+        };
+        let (ts, radius) = search(&|ts| self.corner_bounds(f, next, next_ns, ts), lo);
+        if ts >= f.end {
+            return (f.end, 0.0);
+        }
+        // The sampled checks (inverse kinematics, axis speeds, the zone of a joint-space
+        // corner) cost more: at the start found, and only if they fail, searched again.
+        if let Some(r) = self.corner_samples(f, next, ts) {
+            return (ts, radius.max(r));
+        }
+        search(
+            &|t| {
+                let a = self.corner_bounds(f, next, next_ns, t)?;
+                Some(a.max(self.corner_samples(f, next, t)?))
+            },
+            ts,
+        )
+    }
+
+    /// The exact conditions of a corner starting at `ts`; the radius it stays within (a
+    /// bound) if they hold.
+    ///
+    /// - Cartesian corners: the TCP is at most `A` from the point on the way in and `B`
+    ///   on the way out (`A` the path left of the first motion at `ts`, `B` the path the
+    ///   second has covered when the first ends); for two lines it stays within
+    ///   `max(A, B, |B·u₂ − A·u₁|)` (a norm is convex: its maximum over the box is at a
+    ///   corner), else within `A + B`. That must be at most the zone, itself at most half
+    ///   the second path. The path speed (the two speeds' sum bounds it) stays within the
+    ///   faster motion's cruise speed.
+    /// - Joint-space corners: every axis's summed speed and acceleration within its limits
+    ///   (exact: checked at every phase boundary of both profiles and where the summed
+    ///   acceleration crosses zero), and at most half the second motion's time overlaps.
+    fn corner_bounds(&self, f: &Fading, next: &Trajectory, next_ns: i64, ts: i64) -> Option<f64> {
+        let window = (f.end - ts) as f64 / NS;
+        if window <= 0.0 {
+            return Some(0.0);
+        }
+        let off1 = (ts - f.start) as f64 / NS;
+        match (&f.traj, next) {
+            (
+                Trajectory::Cartesian {
+                    path: p1,
+                    profile: s1,
+                    ..
+                },
+                Trajectory::Cartesian {
+                    path: p2,
+                    profile: s2,
+                    ..
+                },
+            ) => {
+                let (l1, l2) = (p1.length(), p2.length());
+                let frac = |p: &Profile, t: f64| {
+                    if p.dist > 0.0 { p.at(t) / p.dist } else { 1.0 }
+                };
+                let a = l1 * (1.0 - frac(s1, off1));
+                let b = l2 * frac(s2, window);
+                let radius = match (p1, p2) {
+                    (Path::Line { from, to }, Path::Line { to: to2, .. })
+                        if l1 > 0.0 && l2 > 0.0 =>
+                    {
+                        use vworks_model::math::{norm, sub};
+                        let u1 = sub(*to, *from);
+                        let u2 = sub(*to2, *to);
+                        let v = [
+                            b * u2[0] / l2 - a * u1[0] / l1,
+                            b * u2[1] / l2 - a * u1[1] / l1,
+                            b * u2[2] / l2 - a * u1[2] / l1,
+                        ];
+                        a.max(b).max(norm(v))
+                    }
+                    _ => a + b,
+                };
+                if radius > f.zone.min(0.5 * l2) + 1e-12 {
+                    return None;
+                }
+                let k1 = if s1.dist > 0.0 { l1 / s1.dist } else { 0.0 };
+                let k2 = if s2.dist > 0.0 { l2 / s2.dist } else { 0.0 };
+                let vmax = (k1 * s1.v).max(k2 * s2.v);
+                let (speed, _) = window_extremes(window, [(s1, off1, k1), (s2, 0.0, k2)]);
+                (speed <= vmax * (1.0 + 1e-9)).then_some(radius)
+            }
+            _ => {
+                if 2.0 * window > next_ns as f64 / NS {
+                    return None;
+                }
+                if let (Some(_), Some(_)) = (f.traj.axis_profile(0), next.axis_profile(0)) {
+                    for i in 0..self.model.dof() {
+                        let (Some((p1, k1)), Some((p2, k2))) =
+                            (f.traj.axis_profile(i), next.axis_profile(i))
+                        else {
+                            continue;
+                        };
+                        let j = self.model.axis(i);
+                        let (speed, acc) = window_extremes(window, [(p1, off1, k1), (p2, 0.0, k2)]);
+                        if speed > j.max_velocity * (1.0 + 1e-9) || acc > j.max_accel * (1.0 + 1e-9)
+                        {
+                            return None;
+                        }
+                    }
+                }
+                Some(0.0)
+            }
+        }
+    }
+
+    /// The corner starting at `ts`, sampled: every pose reachable (Cartesian corners), no
+    /// axis faster than its limit between samples, and for joint-space corners the TCP
+    /// within the zone. The largest distance from the point seen, if all hold.
+    fn corner_samples(&self, f: &Fading, next: &Trajectory, ts: i64) -> Option<f64> {
+        let n = self.model.dof();
+        let span = f.end - ts;
+        if span <= 0 {
+            return Some(0.0);
+        }
+        let joint_space = !(f.traj.is_cartesian() && next.is_cartesian());
+        let mut prev = self.blend_joints(f, next, ts, ts)?;
+        let mut prev_t = ts;
+        let mut farthest = 0.0f64;
+        for k in 1..=CORNER_SAMPLES {
+            let t = ts + span * k as i64 / CORNER_SAMPLES as i64;
+            if t <= prev_t {
+                continue;
+            }
+            let q = self.blend_joints(f, next, ts, t)?;
+            let dt = (t - prev_t) as f64 / NS;
+            for i in 0..n {
+                if (q[i] - prev[i]).abs() / dt > self.model.axis(i).max_velocity * (1.0 + 1e-6) {
+                    return None;
+                }
+            }
+            if joint_space {
+                let p = self.model.tcp(&q[..n], &self.cfg.tool).t;
+                let d = vworks_model::math::norm(vworks_model::math::sub(p, f.corner_pose.t));
+                if d > f.zone + 1e-9 {
+                    return None;
+                }
+                farthest = farthest.max(d);
+            }
+            prev = q;
+            prev_t = t;
+        }
+        Some(farthest)
+    }
+
+    /// The time of the main program's event at instruction `ins` (`None`: the program's
+    /// end) reached at `t`: a statement that takes time without moving, grips or releases,
+    /// or ends the program makes a zoned point still ahead a stop point, so its event comes
+    /// when the robot is there — with a warning, once per statement.
+    pub(super) fn stop_point(&mut self, ins: Option<Instr>, pc: u32, t: i64) -> i64 {
+        let what = match ins {
+            None | Some(Instr::Stop) => "the end of the program",
+            Some(Instr::Delay) => "`delay`",
+            Some(Instr::WaitUntil(..)) => "`wait_until`",
+            Some(Instr::WaitSignal(..)) => "`wait_signal`",
+            Some(Instr::ParJoin) => "the end of a `parallel` block",
+            Some(Instr::Grip(_)) => "`grip`",
+            Some(Instr::Release(_)) => "`release`",
+            _ => return t,
+        };
+        let Some(f) = self.fading_at(t) else {
+            return t;
+        };
+        let (end, line) = (f.end, f.pos.line);
+        // Warned at the stop point's time, where the trace shows the statement's event.
+        if !self.zone_warned.contains(&pc) {
+            self.zone_warned.push(pc);
+            let pos = self.m.pos_of(pc);
+            self.warnings.push((
+                end,
+                pos,
+                format!(
+                    "{what} makes the zoned point of the motion at line {line} a stop point: the robot reaches it first; write `zone fine` on that motion to say so"
+                ),
+            ));
+        }
+        end
+    }
+}
+
+/// The largest |summed speed| and |summed acceleration| over `[0, window]` of motions
+/// `k·p(t + offset)`: exact for these piecewise-polynomial profiles (acceleration linear
+/// between phase boundaries), as every boundary (and a point just before it) is
+/// evaluated, and the speed also where the summed acceleration crosses zero.
+fn window_extremes(window: f64, parts: [(&Profile, f64, f64); 2]) -> (f64, f64) {
+    const GRID: usize = 8;
+    let mut ts = [0.0f64; GRID + 1 + 2 * 2 * 8];
+    let mut n = 0;
+    for k in 0..=GRID {
+        ts[n] = window * k as f64 / GRID as f64;
+        n += 1;
+    }
+    for (p, off, _) in parts {
+        for b in p.breakpoints() {
+            let t = b - off;
+            if t > 0.0 && t < window {
+                ts[n] = t;
+                ts[n + 1] = (t - 1e-9).max(0.0);
+                n += 2;
+            }
+        }
+    }
+    let ts = &mut ts[..n];
+    ts.sort_unstable_by(f64::total_cmp);
+    let speed = |t: f64| {
+        parts
+            .iter()
+            .map(|(p, off, k)| k * p.speed_at(t + off))
+            .sum::<f64>()
+    };
+    let acc = |t: f64| {
+        parts
+            .iter()
+            .map(|(p, off, k)| k * p.accel_at(t + off))
+            .sum::<f64>()
+    };
+    let (mut vmax, mut amax) = (0.0f64, 0.0f64);
+    for w in 0..ts.len() {
+        let t = ts[w];
+        let a = acc(t);
+        vmax = vmax.max(speed(t).abs());
+        amax = amax.max(a.abs());
+        if let Some(&t2) = ts.get(w + 1) {
+            let a2 = acc((t2 - 1e-12).max(t));
+            if a * a2 < 0.0 {
+                let z = t + (t2 - t) * a / (a - a2);
+                vmax = vmax.max(speed(z).abs());
+            }
+        }
+    }
+    (vmax, amax)
+}
