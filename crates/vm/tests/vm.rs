@@ -609,7 +609,7 @@ fn limits_reach_and_speed_are_checked() {
     let w = v.take_warnings();
     assert!(
         w.iter()
-            .any(|(_, pos, m)| m.contains("slowed") && pos.line == 3),
+            .any(|w| w.message.contains("slowed") && w.pos.line == 3 && w.kind == "slowdown"),
         "{w:?}"
     );
 }

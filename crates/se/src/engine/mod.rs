@@ -677,8 +677,10 @@ impl Simulation {
         let kind = Kind::of(&e.kind);
         self.account(r, &e, kind);
         self.route(r, &e, kind);
-        for (t, pos, m) in self.vms[r].take_warnings() {
-            self.warning(t, Some(r), Some(pos), "slowdown", m);
+        // Found while the VM described this event (or planned it): at its time at the
+        // earliest, so the trace stays in time order.
+        for w in self.vms[r].take_warnings() {
+            self.warning(w.time.max(e.time), Some(r), Some(w.pos), w.kind, w.message);
         }
         if self.outcome.is_none() {
             self.requeue(r);

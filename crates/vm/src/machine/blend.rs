@@ -437,13 +437,14 @@ impl Vm {
         if !self.zone_warned.contains(&pc) {
             self.zone_warned.push(pc);
             let pos = self.m.pos_of(pc);
-            self.warnings.push((
-                end,
+            self.warnings.push(Warning {
+                time: end,
                 pos,
-                format!(
+                kind: "stop-point",
+                message: format!(
                     "{what} makes the zoned point of the motion at line {line} a stop point: the robot reaches it first; write `zone fine` on that motion to say so"
                 ),
-            ));
+            });
         }
         end
     }

@@ -246,6 +246,20 @@ pub struct Event {
     pub pos: SrcPos,
 }
 
+/// A warning about the program's motions, for the SE to report.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Warning {
+    /// When.
+    pub time: i64,
+    /// The statement.
+    pub pos: SrcPos,
+    /// `slowdown` (a motion slowed to keep an axis within its speed) or `stop-point` (a
+    /// zoned point the robot must reach before the next statement).
+    pub kind: &'static str,
+    /// What happened and what to do.
+    pub message: String,
+}
+
 /// What the VM does after its current event.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Next {
@@ -392,7 +406,7 @@ pub struct Vm {
     /// Globals as the SE last gave them (slot bits by module global index).
     globals: Vec<u64>,
     /// Warnings to report (e.g. a move slowed by an axis speed limit).
-    warnings: Vec<(i64, SrcPos, String)>,
+    warnings: Vec<Warning>,
     /// The simulated instant the budgets below count for, the instructions left at it and
     /// the events performed at it.
     instant: i64,
@@ -623,8 +637,8 @@ impl Vm {
                 .is_some_and(|f| t > f.start && t < f.end)
     }
 
-    /// Warnings produced so far (time, position, message); the SE drains them.
-    pub fn take_warnings(&mut self) -> Vec<(i64, SrcPos, String)> {
+    /// Warnings produced so far; the SE drains them.
+    pub fn take_warnings(&mut self) -> Vec<Warning> {
         std::mem::take(&mut self.warnings)
     }
 

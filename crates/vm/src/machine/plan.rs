@@ -522,11 +522,12 @@ impl Vm {
             }
             let pos = self.m.pos_of(self.main.pc);
             let j = self.model.axis(worst_axis);
-            self.warnings.push((
-                self.time,
+            self.warnings.push(Warning {
+                time: self.time,
                 pos,
-                format!("the motion is slowed to {:.0}% of its speed: axis {} `{}` would exceed its speed limit", worst * 100.0, worst_axis + 1, j.name),
-            ));
+                kind: "slowdown",
+                message: format!("the motion is slowed to {:.0}% of its speed: axis {} `{}` would exceed its speed limit", worst * 100.0, worst_axis + 1, j.name),
+            });
         }
         let profile = Profile::with_jerk(1.0, vs, as_, js);
         let dur = profile.duration_ns();

@@ -1,0 +1,328 @@
+//! Property tests of zones (fly-by points), from `docs/engine.md` ("Zones"): random
+//! programs of zoned `move_l`/`move_j` on an IRB 120 (with and without jerk limits), run
+//! by one VM and sampled at 1 kHz as the simulation engine samples it.
+//!
+//! - A Cartesian corner stays within its zone: from the `motion_end` of a zoned point
+//!   until the next motion's `motion_end`, the TCP is within the zone radius of the point
+//!   (plus 1e-9 m) or on the next motion's straight line.
+//! - Joint-space programs never exceed an axis's speed or acceleration (first and second
+//!   differences at 1 kHz; a second difference is a weighted mean of the acceleration).
+//! - Position and velocity are continuous at every event: the joints and their one-sided
+//!   finite-difference velocities agree before and after the event is performed.
+//! - A zoned program is never slower than the same program with `fine` points, and a
+//!   Cartesian one never faster than its straight segments' lower bound
+//!   `Σ (Lₖ − zₖ₋₁ − zₖ)⁺ / vₖ` (outside the zones only one motion moves the TCP).
+
+#![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)] // tests fail by panicking
+
+use std::sync::Arc;
+
+use proptest::prelude::*;
+use vworks_model::builtin;
+use vworks_model::math::{norm, sub};
+use vworks_vm::machine::{Event, EventKind, Next, Vm, VmConfig};
+
+const HOME: &str = "joints(0deg, -30deg, 30deg, 0deg, 60deg, 0deg)";
+const MS: i64 = 1_000_000;
+
+fn vm(src: &str, jerk: Option<f64>) -> Vm {
+    let out = vworks_wslc::compile("t.wsl", src).unwrap_or_else(|e| panic!("{e}\n{src}"));
+    let m = Arc::new(out.module);
+    let entry = m.proc_index("main").unwrap();
+    let mut model = builtin::load("irb120").unwrap();
+    if let Some(ramp) = jerk {
+        // Jerk limits that ramp each axis's acceleration up in `ramp` seconds.
+        for k in 0..model.dof() {
+            let j = model.axes[k];
+            model.joints[j].max_jerk = Some(model.joints[j].max_accel / ramp);
+        }
+    }
+    let cfg = VmConfig {
+        start_joints: vec![
+            0.0,
+            -30f64.to_radians(),
+            30f64.to_radians(),
+            0.0,
+            60f64.to_radians(),
+            0.0,
+        ],
+        ..VmConfig::default()
+    };
+    Vm::new(m, Arc::new(model), cfg, Some(entry))
+}
+
+/// What a run gives: its events, and at every millisecond (and every event, on both
+/// sides) the joints and the TCP position.
+struct Run {
+    events: Vec<Event>,
+    samples: Vec<(i64, [f64; 12], [f64; 3])>,
+    end: i64,
+}
+
+/// Runs `v` alone, sampling it as the SE does: a time is sampled with every event at or
+/// before it performed. At each event, continuity of position and velocity is checked.
+fn run(v: &mut Vm, vel_tol: f64) -> Run {
+    let h = 1_000; // 1 µs
+    let mut events = Vec::new();
+    let mut samples = Vec::new();
+    let mut tick = 0i64;
+    let sample = |v: &Vm, t: i64| (t, v.joints_at(t), v.tcp_at(t).t);
+    loop {
+        let e = match v.next_event() {
+            Next::Event(e) => e,
+            _ => break,
+        };
+        while tick < e.time {
+            samples.push(sample(v, tick));
+            tick += MS;
+        }
+        let t = e.time;
+        let (q0, qa) = (v.joints_at(t - h), v.joints_at(t));
+        v.perform();
+        let (qb, q1) = (v.joints_at(t), v.joints_at(t + h));
+        for i in 0..6 {
+            assert!(
+                (qa[i] - qb[i]).abs() < 1e-9,
+                "axis {i} jumps at {t} ({:?}): {} → {}",
+                e.kind,
+                qa[i],
+                qb[i]
+            );
+            let (vl, vr) = ((qa[i] - q0[i]) / 1e-6, (q1[i] - qb[i]) / 1e-6);
+            assert!(
+                (vl - vr).abs() <= vel_tol,
+                "axis {i} speed jumps at {t} ({:?}): {vl} → {vr}",
+                e.kind
+            );
+        }
+        events.push(e);
+    }
+    let end = events.last().map_or(0, |e| e.time);
+    while tick <= end {
+        samples.push(sample(v, tick));
+        tick += MS;
+    }
+    Run {
+        events,
+        samples,
+        end,
+    }
+}
+
+fn zone_text(z: u32) -> String {
+    if z == 0 {
+        "zone fine".into()
+    } else {
+        format!("zone {z}mm")
+    }
+}
+
+/// A program of straight moves through `points` (offsets from the start pose, mm) at
+/// `speeds` (mm/s) with `zones` (mm, 0: fine).
+fn line_program(points: &[(i32, i32, i32)], speeds: &[u32], zones: &[u32]) -> String {
+    let mut s = format!("proc main() {{\n    move_j {HOME};\n    var p = current_pose();\n");
+    for ((x, y, z), (v, zone)) in points.iter().zip(speeds.iter().zip(zones)) {
+        s += &format!(
+            "    move_l offset(p, {x}mm, {y}mm, {z}mm) speed {v}mm/s {};\n",
+            zone_text(*zone)
+        );
+    }
+    s + "}\n"
+}
+
+fn joint_program(targets: &[[i32; 6]], speeds: &[u32], zones: &[u32]) -> String {
+    let mut s = format!("proc main() {{\n    move_j {HOME};\n");
+    for (t, (v, zone)) in targets.iter().zip(speeds.iter().zip(zones)) {
+        let home = [0, -30, 30, 0, 60, 0];
+        let q: Vec<String> = t
+            .iter()
+            .zip(home)
+            .map(|(d, h)| format!("{}deg", h + d))
+            .collect();
+        s += &format!(
+            "    move_j joints({}) speed {v}% {};\n",
+            q.join(", "),
+            zone_text(*zone)
+        );
+    }
+    s + "}\n"
+}
+
+fn fine(src: &str) -> String {
+    let mut out = String::new();
+    for line in src.lines() {
+        let l = match line.find(" zone ") {
+            Some(k) => format!("{};", &line[..k]),
+            None => line.to_string(),
+        };
+        out += &l;
+        out.push('\n');
+    }
+    out
+}
+
+fn points() -> impl Strategy<Value = Vec<(i32, i32, i32)>> {
+    prop::collection::vec((-120i32..120, -120i32..120, -100i32..100), 2..6)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    #[test]
+    fn cartesian_corners_stay_in_their_zones_and_cost_no_more_than_stops(
+        pts in points(),
+        speeds in prop::collection::vec(100u32..800, 6),
+        zones in prop::collection::vec(prop_oneof![Just(0u32), 1u32..60], 6),
+        jerk in prop_oneof![Just(None), Just(Some(0.05)), Just(Some(0.15))],
+    ) {
+        let src = line_program(&pts, &speeds, &zones);
+        let mut v = vm(&src, jerk);
+        let r = run(&mut v, 50.0);
+        prop_assert!(r.events.iter().all(|e| !matches!(e.kind, EventKind::Error { .. })), "{src}");
+        let mut f = vm(&fine(&src), jerk);
+        let rf = run(&mut f, 50.0);
+        prop_assert!(r.end <= rf.end, "zoned {} > fine {}\n{src}", r.end, rf.end);
+
+        // The points (TCP positions at each motion_end of the fine run), then the zones.
+        let ends: Vec<[f64; 3]> = {
+            let mut out = Vec::new();
+            let mut f = vm(&fine(&src), jerk);
+            loop {
+                let Next::Event(e) = f.next_event() else { break };
+                f.perform();
+                if matches!(e.kind, EventKind::MotionEnd { .. }) {
+                    out.push(f.tcp_at(e.time).t);
+                }
+            }
+            out
+        };
+        // ends[0] is home; ends[k + 1] is point k.
+        let starts: Vec<usize> = r.events.iter().enumerate()
+            .filter(|(_, e)| matches!(e.kind, EventKind::MotionStart { .. })).map(|(i, _)| i).collect();
+        let motion_ends: Vec<i64> = r.events.iter()
+            .filter(|e| matches!(e.kind, EventKind::MotionEnd { .. })).map(|e| e.time).collect();
+        prop_assert_eq!(starts.len(), pts.len() + 1);
+        for k in 0..pts.len().saturating_sub(1) {
+            let EventKind::MotionEnd { zone_m: Some(zone), .. } = r.events.iter()
+                .filter(|e| matches!(e.kind, EventKind::MotionEnd { .. })).nth(k + 1).unwrap().kind.clone()
+            else { continue };
+            let (p, next) = (ends[k + 1], ends[k + 2]);
+            let (from, to) = (motion_ends[k + 1], motion_ends[k + 2]);
+            for (t, _, tcp) in r.samples.iter().filter(|(t, ..)| *t >= from && *t <= to) {
+                let d = norm(sub(*tcp, p));
+                // Or on the next line: distance to the segment p → next.
+                let u = sub(next, p);
+                let l2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+                let w = sub(*tcp, p);
+                let s = ((w[0] * u[0] + w[1] * u[1] + w[2] * u[2]) / l2).clamp(0.0, 1.0);
+                let off = norm(sub(w, [u[0] * s, u[1] * s, u[2] * s]));
+                prop_assert!(d <= zone + 1e-9 || off <= 1e-7,
+                    "at {t}: {d} m from point {k} (zone {zone}), {off} m off the next line\n{src}");
+            }
+        }
+        // Lower bound: outside the zones, one motion at a time at most at its speed.
+        let mut bound = 0.0;
+        let mut prev = ends[0];
+        for k in 0..pts.len() {
+            let p = ends[k + 1];
+            let z_in = if k > 0 { zones[k - 1] as f64 / 1000.0 } else { 0.0 };
+            let z_out = zones[k] as f64 / 1000.0;
+            bound += (norm(sub(p, prev)) - z_in - z_out).max(0.0) / (speeds[k] as f64 / 1000.0);
+            prev = p;
+        }
+        let first_move = r.events.iter().find(|e| matches!(e.kind, EventKind::MotionEnd { .. })).unwrap().time;
+        prop_assert!((r.end - first_move) as f64 / 1e9 >= bound - 1e-9, "{} < {bound}\n{src}", r.end);
+    }
+
+    #[test]
+    fn joint_corners_keep_every_axis_within_its_speed_and_acceleration(
+        targets in prop::collection::vec(prop::array::uniform6(-40i32..40), 2..6),
+        speeds in prop::collection::vec(20u32..=100, 6),
+        zones in prop::collection::vec(prop_oneof![Just(0u32), 1u32..120], 6),
+        jerk in prop_oneof![Just(None), Just(Some(0.05)), Just(Some(0.15))],
+    ) {
+        let src = joint_program(&targets, &speeds, &zones);
+        let mut v = vm(&src, jerk);
+        let model = builtin::load("irb120").unwrap();
+        // Velocity continuity: over 2 µs the speed changes by at most 2 µs × the limit.
+        let amax = (0..6).map(|i| model.axis(i).max_accel).fold(0.0, f64::max);
+        let r = run(&mut v, 2e-6 * amax * 1.01 + 1e-9);
+        prop_assert!(r.events.iter().all(|e| !matches!(e.kind, EventKind::Error { .. })), "{src}");
+        let dt = 1e-3;
+        for w in r.samples.windows(3) {
+            let (t, q0, q1, q2) = (w[1].0, w[0].1, w[1].1, w[2].1);
+            for i in 0..6 {
+                let j = model.axis(i);
+                let speed = (q2[i] - q1[i]).abs() / dt;
+                prop_assert!(speed <= j.max_velocity * (1.0 + 1e-9) + 1e-9,
+                    "axis {i} at {t}: {speed} > {}\n{src}", j.max_velocity);
+                let acc = (q2[i] - 2.0 * q1[i] + q0[i]).abs() / (dt * dt);
+                prop_assert!(acc <= j.max_accel * (1.0 + 1e-6) + 1e-6,
+                    "axis {i} at {t}: acceleration {acc} > {}\n{src}", j.max_accel);
+            }
+        }
+        let mut f = vm(&fine(&src), jerk);
+        let rf = run(&mut f, 2e-6 * amax * 1.01 + 1e-9);
+        prop_assert!(r.end <= rf.end, "zoned {} > fine {}\n{src}", r.end, rf.end);
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 32, ..ProptestConfig::default() })]
+
+    /// Mixed corners (`move_j` → `move_l` and back) blend in joint space: continuous
+    /// joints and speeds at every event, and never slower than stopping.
+    #[test]
+    fn mixed_corners_are_continuous_and_cost_no_more_than_stops(
+        pts in points(),
+        zones in prop::collection::vec(prop_oneof![Just(0u32), 1u32..60], 6),
+        jerk in prop_oneof![Just(None), Just(Some(0.1))],
+    ) {
+        let mut src = format!("proc main() {{\n    move_j {HOME};\n    var p = current_pose();\n");
+        for (k, ((x, y, z), zone)) in pts.iter().zip(&zones).enumerate() {
+            let cmd = if k % 2 == 0 { "move_j" } else { "move_l" };
+            src += &format!("    {cmd} offset(p, {x}mm, {y}mm, {z}mm) {};\n", zone_text(*zone));
+        }
+        src += "}\n";
+        let mut v = vm(&src, jerk);
+        let r = run(&mut v, 50.0);
+        prop_assert!(r.events.iter().all(|e| !matches!(e.kind, EventKind::Error { .. })), "{src}");
+        let mut f = vm(&fine(&src), jerk);
+        let rf = run(&mut f, 50.0);
+        prop_assert!(r.end <= rf.end, "zoned {} > fine {}\n{src}", r.end, rf.end);
+    }
+}
+
+#[test]
+fn a_delay_after_a_zoned_point_waits_for_the_robot_with_one_warning() {
+    let src = format!(
+        "proc main() {{\n    move_j {HOME};\n    var p = current_pose();\n    var k = 0;\n    while k < 2 {{\n        move_l offset(p, 100mm, 0mm, 0mm) zone 10mm;\n        delay 0.1s;\n        move_l p zone fine;\n        k += 1;\n    }}\n}}\n"
+    );
+    let mut v = vm(&src, None);
+    let r = run(&mut v, 50.0);
+    let warnings = v.take_warnings();
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert_eq!(warnings[0].kind, "stop-point");
+    assert!(
+        warnings[0]
+            .message
+            .contains("`delay` makes the zoned point of the motion at line 6 a stop point")
+    );
+    // The delay starts when the robot reaches the point: the moves take as long as fine.
+    let mut f = vm(&fine(&src), None);
+    let rf = run(&mut f, 50.0);
+    assert_eq!(r.end, rf.end);
+    let delays: Vec<i64> = r
+        .events
+        .iter()
+        .filter(|e| matches!(e.kind, EventKind::Delay { .. }))
+        .map(|e| e.time)
+        .collect();
+    let fine_delays: Vec<i64> = rf
+        .events
+        .iter()
+        .filter(|e| matches!(e.kind, EventKind::Delay { .. }))
+        .map(|e| e.time)
+        .collect();
+    assert_eq!(delays, fine_delays);
+}
