@@ -67,11 +67,7 @@ fn run(v: &mut Vm, vel_tol: f64) -> Run {
     let mut samples = Vec::new();
     let mut tick = 0i64;
     let sample = |v: &Vm, t: i64| (t, v.joints_at(t), v.tcp_at(t).t);
-    loop {
-        let e = match v.next_event() {
-            Next::Event(e) => e,
-            _ => break,
-        };
+    while let Next::Event(e) = v.next_event() {
         while tick < e.time {
             samples.push(sample(v, tick));
             tick += MS;
@@ -187,8 +183,7 @@ proptest! {
         let ends: Vec<[f64; 3]> = {
             let mut out = Vec::new();
             let mut f = vm(&fine(&src), jerk);
-            loop {
-                let Next::Event(e) = f.next_event() else { break };
+            while let Next::Event(e) = f.next_event() {
                 f.perform();
                 if matches!(e.kind, EventKind::MotionEnd { .. }) {
                     out.push(f.tcp_at(e.time).t);
