@@ -121,7 +121,7 @@ def test_cell_properties():
     assert "handoff" in repr(cell)
 
 
-@pytest.mark.parametrize("name", ["handoff", "weldline", "monitor", "crash", "deadlock", "track"])
+@pytest.mark.parametrize("name", ["handoff", "weldline", "monitor", "crash", "deadlock", "track", "palletize"])
 def test_run_matches_the_golden_trace(name):
     result = vworks.load_cell(ROOT / "workcells" / name / "cell.toml").run()
     lines, outcome = golden(name)
@@ -425,3 +425,26 @@ def test_a_log_that_cannot_be_written():
         cell.run(until=1.0, log="/dev/full")
     r = cell.run(until=1.0, log="/dev/full", check=False)
     assert r.outcome == "until" and "/dev/full" in r.log_error and r.log_counts == {}
+
+
+def test_zones_reach_python_and_stepping_sees_the_corner():
+    # palletize flies by its approach points: a zoned motion_end carries its zone, the
+    # next motion_start the radius it blends within, and between them the robot moves on.
+    cell = vworks.load_cell(ROOT / "workcells" / "palletize" / "cell.toml")
+    r = cell.run()
+    ends = [e for e in r.events if e.kind == "motion_end" and e.data is not None]
+    assert ends and all(e.data["zone_m"] <= e.data["programmed_m"] for e in ends)
+    assert ends[0].data == {"zone_m": 0.02, "programmed_m": 0.02}
+    starts = [e for e in r.events if e.kind == "motion_start" and "blend_m" in (e.data or {})]
+    assert starts and all(0.0 <= e.data["blend_m"] <= 0.05 + 1e-9 for e in starts)
+    # Stepping: just after the first zoned motion_end the robot has not stopped.
+    sim = cell.simulation()
+    while not any(e.kind == "motion_end" and e.data for e in sim.events_since(0)):
+        assert sim.step_event()
+    t = sim.time
+    q = sim.robot("r1").joints
+    sim.run_until(t + 0.004)
+    assert not np.allclose(sim.robot("r1").joints, q)
+    # Moving time runs through the corners: the robot never idles in this cell.
+    (r1,) = r.to_dict()["robots"]
+    assert r1["idle_ns"] == 0 and r1["moving_ns"] == r1["end_time_ns"]

@@ -17,7 +17,7 @@ from mcap.reader import make_reader
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 VWORKS = os.environ.get("VWORKS", str(ROOT / "target" / "debug" / "vworks"))
-CELLS = ["handoff", "weldline", "monitor", "crash", "deadlock", "track"]
+CELLS = ["handoff", "weldline", "monitor", "crash", "deadlock", "track", "palletize"]
 
 
 def run_logged(cell, *extra):

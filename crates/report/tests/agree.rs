@@ -27,6 +27,9 @@ fn the_report_gives_the_runs_own_statistics() {
         ("crash", None, 1),
         ("weldline", None, 25),
         ("track", None, 3),
+        // Zoned points: moving time runs through corners, and a cut inside one.
+        ("palletize", None, 5),
+        ("palletize", Some(3_300_000_000), 1),
     ] {
         let c = Arc::new(
             vworks_cell::load(&root().join(format!("workcells/{cell}/cell.toml"))).unwrap(),
@@ -54,7 +57,7 @@ fn the_report_gives_the_runs_own_statistics() {
         );
         checked += 1;
     }
-    assert_eq!(checked, 7);
+    assert_eq!(checked, 9);
 }
 
 /// The defect of issue 15: `vworks run` gave r2 of handoff 8.720 s idle and the report

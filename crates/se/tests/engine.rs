@@ -20,6 +20,7 @@ const EXAMPLES: &[(&str, Outcome)] = &[
     ("crash", Outcome::Collision),
     ("deadlock", Outcome::Deadlock),
     ("track", Outcome::Completed),
+    ("palletize", Outcome::Completed),
 ];
 
 fn root() -> PathBuf {

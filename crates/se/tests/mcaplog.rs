@@ -225,7 +225,7 @@ fn the_cell_and_its_programs_are_attached() {
     // The run's result closes the log: outcome, end time, each robot's ending, as the
     // run itself gave them.
     let log = vworks_se::mcaplog::read_log_bytes("attach.mcap", &bytes).unwrap();
-    assert_eq!(log.metadata["log_version"], "2");
+    assert_eq!(log.metadata["log_version"], "3");
     assert_eq!(log.result["outcome"], "until");
     assert_eq!(log.result["end_time_ns"], "1000000000");
     let ended: Vec<String> = r

@@ -223,7 +223,13 @@ fn adaptive_checking_finds_what_the_exhaustive_check_finds() {
     // Every example cell, and the crash cell going on through its collision: skipping the
     // queries that speed bounds prove unneeded changes no event, only the query count.
     let mut cells: Vec<PathBuf> = [
-        "handoff", "weldline", "monitor", "crash", "deadlock", "track",
+        "handoff",
+        "weldline",
+        "monitor",
+        "crash",
+        "deadlock",
+        "track",
+        "palletize",
     ]
     .iter()
     .map(|n| root().join("workcells").join(n).join("cell.toml"))

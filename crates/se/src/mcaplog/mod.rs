@@ -56,8 +56,10 @@ pub type LoggedEvent = crate::trace::Event;
 
 /// The version of the log's layout and `/events` schema, in the `vworks` metadata as
 /// `log_version`: 2 since events carry typed `data` and the log ends with
-/// [`RESULT_METADATA`]; logs without it are version 1 (read too, without typed data).
-pub const LOG_VERSION: u32 = 2;
+/// [`RESULT_METADATA`]; 3 since motions carry zones (`zone_m`, `blend_m` on
+/// `motion_start`, data on a zoned `motion_end`). Logs without it are version 1 (read
+/// too, without typed data); versions 2 and 3 read alike.
+pub const LOG_VERSION: u32 = 3;
 
 /// The name of the metadata record written at the end of a run: `outcome`,
 /// `end_time_ns`, and `ended`, each robot's ending (`r1=ended,r2=waiting`).

@@ -403,7 +403,7 @@ impl Vm {
             if joint_space {
                 let p = self.model.tcp(&q[..n], &self.cfg.tool).t;
                 let d = vworks_model::math::norm(vworks_model::math::sub(p, f.corner_pose.t));
-                if d > f.zone + 1e-9 {
+                if d > f.zone {
                     return None;
                 }
                 farthest = farthest.max(d);
