@@ -430,3 +430,45 @@ fn until_stops_the_run_at_that_time() {
     assert_eq!(r.robots[1].moving_ns, 1_500_000_000);
     assert_eq!(r.robots[1].ended, Ending::Running);
 }
+
+/// The motion example of docs/language.md (the block with `zone 10mm`) runs as written on
+/// an IRB 120: it completes, its zoned points fly by (zoned `motion_end`s, motions that
+/// start inside the corners) and the `zone fine` at its end stops.
+#[test]
+fn the_language_references_motion_example_runs_with_its_zones() {
+    let doc = std::fs::read_to_string(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../docs/language.md"),
+    )
+    .unwrap();
+    let block = doc
+        .split("```wsl\n")
+        .skip(1)
+        .map(|b| &b[..b.find("```").unwrap()])
+        .find(|b| b.contains("zone 10mm"))
+        .unwrap();
+    let path = write_cell(
+        "motion-example",
+        &[
+            (
+                "cell.toml",
+                "name = \"m\"\n[[robot]]\nname = \"r1\"\nmodel = \"irb120\"\nprogram = \"r1.wsl\"\nhome = [\"0deg\", \"-30deg\", \"30deg\", \"0deg\", \"60deg\", \"0deg\"]\n",
+            ),
+            ("r1.wsl", block),
+        ],
+    );
+    let (cell, r) = run(&path);
+    assert_eq!(r.outcome, Outcome::Completed, "{:?}", r.errors);
+    let lines: Vec<String> = r.trace.iter().map(|e| e.line(&cell)).collect();
+    let zoned_ends = lines
+        .iter()
+        .filter(|l| l.contains("motion_end zone="))
+        .count();
+    let blended = lines.iter().filter(|l| l.contains(" blend=")).count();
+    assert_eq!((zoned_ends, blended), (2, 2), "{lines:#?}");
+    assert!(
+        lines
+            .iter()
+            .any(|l| l.contains("motion_end -") && l.contains("r1.wsl:12:")),
+        "{lines:#?}"
+    );
+}

@@ -80,5 +80,51 @@ fn sampling(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, dispatch, sampling);
+/// Sampling a robot inside a corner (two motions superposed, IK of the blended pose)
+/// against the same straight line: two 100 mm lines at 90°, 500 mm/s, `zone 10mm`, whose
+/// corner overlaps them for 92 ms (docs/engine.md, "Zones").
+fn corner_sampling(c: &mut Criterion) {
+    let src = "
+        const start = joints(0deg, -30deg, 30deg, 0deg, 60deg, 0deg);
+        proc main() {
+            move_j start;
+            var p = current_pose();
+            move_l offset(p, 100mm, 0mm, 0mm) speed 500mm/s zone 10mm;
+            move_l offset(p, 100mm, 100mm, 0mm) speed 500mm/s;
+        }";
+    let mut g = c.benchmark_group("motion");
+    for (name, corner) in [
+        ("joints_at_line_straight", false),
+        ("joints_at_line_corner", true),
+    ] {
+        let mut v = vm(src, "irb120");
+        let mut starts = 0;
+        let mut t0 = 0;
+        while let Next::Event(e) = v.next_event() {
+            v.perform();
+            if let EventKind::MotionStart {
+                command: "move_l", ..
+            } = e.kind
+            {
+                starts += 1;
+                t0 = e.time;
+                // The first line from its start, or the second from its start in the corner.
+                if starts == if corner { 2 } else { 1 } {
+                    break;
+                }
+            }
+        }
+        let window = 90_000_000; // within the 92 ms overlap
+        let mut k = 0i64;
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                k = (k + 7_919_000) % window;
+                black_box(v.joints_at(t0 + k))
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, dispatch, sampling, corner_sampling);
 criterion_main!(benches);

@@ -157,6 +157,21 @@ fn fine(src: &str) -> String {
     out
 }
 
+/// Runs `src` as written and with every zone `fine`: the zoned run has no error and ends
+/// no later than the fine one. Returns the zoned run.
+fn zoned_and_fine(src: &str, jerk: Option<f64>, vel_tol: f64) -> Result<Run, TestCaseError> {
+    let r = run(&mut vm(src, jerk), vel_tol);
+    prop_assert!(
+        r.events
+            .iter()
+            .all(|e| !matches!(e.kind, EventKind::Error { .. })),
+        "{src}"
+    );
+    let rf = run(&mut vm(&fine(src), jerk), vel_tol);
+    prop_assert!(r.end <= rf.end, "zoned {} > fine {}\n{src}", r.end, rf.end);
+    Ok(r)
+}
+
 fn points() -> impl Strategy<Value = Vec<(i32, i32, i32)>> {
     prop::collection::vec((-120i32..120, -120i32..120, -100i32..100), 2..6)
 }
@@ -172,12 +187,7 @@ proptest! {
         jerk in prop_oneof![Just(None), Just(Some(0.05)), Just(Some(0.15))],
     ) {
         let src = line_program(&pts, &speeds, &zones);
-        let mut v = vm(&src, jerk);
-        let r = run(&mut v, 50.0);
-        prop_assert!(r.events.iter().all(|e| !matches!(e.kind, EventKind::Error { .. })), "{src}");
-        let mut f = vm(&fine(&src), jerk);
-        let rf = run(&mut f, 50.0);
-        prop_assert!(r.end <= rf.end, "zoned {} > fine {}\n{src}", r.end, rf.end);
+        let r = zoned_and_fine(&src, jerk, 50.0)?;
 
         // The points (TCP positions at each motion_end of the fine run), then the zones.
         let ends: Vec<[f64; 3]> = {
@@ -237,12 +247,10 @@ proptest! {
         jerk in prop_oneof![Just(None), Just(Some(0.05)), Just(Some(0.15))],
     ) {
         let src = joint_program(&targets, &speeds, &zones);
-        let mut v = vm(&src, jerk);
         let model = builtin::load("irb120").unwrap();
         // Velocity continuity: over 2 µs the speed changes by at most 2 µs × the limit.
         let amax = (0..6).map(|i| model.axis(i).max_accel).fold(0.0, f64::max);
-        let r = run(&mut v, 2e-6 * amax * 1.01 + 1e-9);
-        prop_assert!(r.events.iter().all(|e| !matches!(e.kind, EventKind::Error { .. })), "{src}");
+        let r = zoned_and_fine(&src, jerk, 2e-6 * amax * 1.01 + 1e-9)?;
         let dt = 1e-3;
         for w in r.samples.windows(3) {
             let (t, q0, q1, q2) = (w[1].0, w[0].1, w[1].1, w[2].1);
@@ -256,9 +264,6 @@ proptest! {
                     "axis {i} at {t}: acceleration {acc} > {}\n{src}", j.max_accel);
             }
         }
-        let mut f = vm(&fine(&src), jerk);
-        let rf = run(&mut f, 2e-6 * amax * 1.01 + 1e-9);
-        prop_assert!(r.end <= rf.end, "zoned {} > fine {}\n{src}", r.end, rf.end);
     }
 }
 
@@ -279,12 +284,7 @@ proptest! {
             src += &format!("    {cmd} offset(p, {x}mm, {y}mm, {z}mm) {};\n", zone_text(*zone));
         }
         src += "}\n";
-        let mut v = vm(&src, jerk);
-        let r = run(&mut v, 50.0);
-        prop_assert!(r.events.iter().all(|e| !matches!(e.kind, EventKind::Error { .. })), "{src}");
-        let mut f = vm(&fine(&src), jerk);
-        let rf = run(&mut f, 50.0);
-        prop_assert!(r.end <= rf.end, "zoned {} > fine {}\n{src}", r.end, rf.end);
+        zoned_and_fine(&src, jerk, 50.0)?;
     }
 }
 

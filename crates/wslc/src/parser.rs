@@ -122,6 +122,16 @@ impl Parser<'_, '_> {
         }
     }
 
+    /// E0005 for a motion option given a second time (token `t`).
+    fn given_twice(&mut self, t: &Token) -> Reported {
+        let d = Diagnostic::error(
+            Code::E0005,
+            format!("`{}` is given twice", self.text(t.span)),
+            t.span,
+        );
+        self.report(d)
+    }
+
     fn report(&mut self, d: Diagnostic) -> Reported {
         // A lexer error already explains an error token; do not pile on.
         let on_error_token = self.kind() == &TokKind::Error;
@@ -650,12 +660,7 @@ impl Parser<'_, '_> {
                     Zone::Radius(self.expr()?)
                 };
                 if zone.is_some() {
-                    let d = Diagnostic::error(
-                        Code::E0005,
-                        format!("`{}` is given twice", self.text(t.span)),
-                        t.span,
-                    );
-                    return Err(self.report(d));
+                    return Err(self.given_twice(&t));
                 }
                 zone = Some(z);
                 continue;
@@ -670,12 +675,7 @@ impl Parser<'_, '_> {
             let t = self.bump();
             let e = self.expr()?;
             if which.is_some() {
-                let d = Diagnostic::error(
-                    Code::E0005,
-                    format!("`{}` is given twice", self.text(t.span)),
-                    t.span,
-                );
-                return Err(self.report(d));
+                return Err(self.given_twice(&t));
             }
             *which = Some(e);
         }

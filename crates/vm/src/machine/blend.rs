@@ -376,8 +376,9 @@ impl Vm {
     }
 
     /// The corner starting at `ts`, sampled: every pose reachable (Cartesian corners), no
-    /// axis faster than its limit between samples, and for joint-space corners the TCP
-    /// within the zone. The largest distance from the point seen, if all hold.
+    /// axis faster than its limit between samples, and for joint-space corners every axis
+    /// within its range and the TCP within the zone. The largest distance from the point
+    /// seen, if all hold.
     fn corner_samples(&self, f: &Fading, next: &Trajectory, ts: i64) -> Option<f64> {
         let n = self.model.dof();
         let span = f.end - ts;
@@ -394,6 +395,9 @@ impl Vm {
                 continue;
             }
             let q = self.blend_joints(f, next, ts, t)?;
+            if joint_space && !self.model.within_limits(&q[..n]) {
+                return None;
+            }
             let dt = (t - prev_t) as f64 / NS;
             for i in 0..n {
                 if (q[i] - prev[i]).abs() / dt > self.model.axis(i).max_velocity * (1.0 + 1e-6) {
@@ -420,6 +424,7 @@ impl Vm {
     /// when the robot is there — with a warning, once per statement.
     pub(super) fn stop_point(&mut self, ins: Option<Instr>, pc: u32, t: i64) -> i64 {
         let what = match ins {
+            None | Some(Instr::Stop) if self.serving.is_some() => "the end of the remote procedure",
             None | Some(Instr::Stop) => "the end of the program",
             Some(Instr::Delay) => "`delay`",
             Some(Instr::WaitUntil(..)) => "`wait_until`",
