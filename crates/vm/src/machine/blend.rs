@@ -180,7 +180,11 @@ impl Vm {
             None => (self.time, None),
         };
         let (mut end_ns, zone) = match programmed {
-            Some(r) => self.zone_entry(&traj, point_ns, r),
+            // A TCP that does not move (a turntable's, on its axis) enters no zone.
+            Some(r) => match self.zone_entry(&traj, point_ns, r) {
+                (_, z) if z <= 1e-9 => (point_ns, 0.0),
+                entry => entry,
+            },
             None => (point_ns, 0.0),
         };
         // The next corner begins after this one has ended.
