@@ -175,6 +175,9 @@ impl Vm {
         let (start, blend) = match self.fading_at(self.time) {
             Some(f) => {
                 let (ts, radius) = self.blend_start(f, &traj, point_ns);
+                if ts >= f.end {
+                    self.corner_failed(f.end, f.pos.line);
+                }
                 (ts, Some(radius))
             }
             None => (self.time, None),
@@ -200,6 +203,25 @@ impl Vm {
             programmed,
             blend,
         })
+    }
+
+    /// The motion about to start cannot overlap the previous one (`blend_start` found no
+    /// start before the point at `end`): a warning, once per statement, as a controller's
+    /// "corner path failure".
+    fn corner_failed(&mut self, end: i64, line: u32) {
+        let pc = self.main.pc;
+        if self.zone_warned.contains(&pc) {
+            return;
+        }
+        self.zone_warned.push(pc);
+        self.warnings.push(Warning {
+            time: end,
+            pos: self.m.pos_of(pc),
+            kind: "corner",
+            message: format!(
+                "this motion cannot start inside the zone of the motion at line {line} within the zone and the axes' limits: the robot stops at that point first (a corner path failure); a larger zone, a lower speed or a jerk limit can let it fly by"
+            ),
+        });
     }
 
     /// Where a motion of `point_ns` enters the zone of radius `r` around its point: the

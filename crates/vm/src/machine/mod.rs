@@ -253,8 +253,9 @@ pub struct Warning {
     pub time: i64,
     /// The statement.
     pub pos: SrcPos,
-    /// `slowdown` (a motion slowed to keep an axis within its speed) or `stop-point` (a
-    /// zoned point the robot must reach before the next statement).
+    /// `slowdown` (a motion slowed to keep an axis within its speed), `stop-point` (a
+    /// zoned point the robot must reach before the next statement) or `corner` (a motion
+    /// that cannot start inside the previous zone: the robot stops at that point).
     pub kind: &'static str,
     /// What happened and what to do.
     pub message: String,
