@@ -61,6 +61,13 @@ impl Vm {
         self.fading.as_ref().filter(|f| t < f.end)
     }
 
+    /// While the robot finishes a zoned motion after its `motion_end` (the next motion,
+    /// if any, superposed on it): the time it reaches that point and the point's TCP
+    /// position.
+    pub fn zoned_point(&self) -> Option<(i64, [f64; 3])> {
+        self.fading.as_ref().map(|f| (f.end, f.corner_pose.t))
+    }
+
     /// The joints at time `t` (inside or after the current motion, through a corner).
     pub fn joints_at(&self, t: i64) -> [f64; MAX_AXES] {
         let Some(f) = self.fading_at(t) else {
