@@ -23,6 +23,8 @@ use vworks_se::trace::{Data, Kind};
 
 pub use vworks_se::stats::Activity;
 
+pub mod playback;
+
 /// The README's Rust example, compiled by `cargo test --doc` so that it stays true (this
 /// crate sits at the end of the run's data flow, so it can see every crate the example
 /// uses).

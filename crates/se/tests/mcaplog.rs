@@ -12,7 +12,9 @@ use prost::Message as _;
 use vworks_cell::{Cell, load};
 use vworks_model::math::Iso;
 use vworks_se::engine::{Outcome, RunResult, Simulation};
-use vworks_se::mcaplog::{Encoding, LogOptions, McapLog};
+use vworks_se::mcaplog::{
+    Encoding, LogOptions, McapLog, ReadOptions, read_log_bytes, read_log_bytes_with,
+};
 use vworks_se::trace::Kind;
 
 /// `vworks.CycleState` as the log's descriptor defines it (the descriptor itself is checked
@@ -224,7 +226,7 @@ fn the_cell_and_its_programs_are_attached() {
     assert_eq!(names, ["vworks", "vworks_result"]);
     // The run's result closes the log: outcome, end time, each robot's ending, as the
     // run itself gave them.
-    let log = vworks_se::mcaplog::read_log_bytes("attach.mcap", &bytes).unwrap();
+    let log = read_log_bytes("attach.mcap", &bytes).unwrap();
     assert_eq!(log.metadata["log_version"], "3");
     assert_eq!(log.result["outcome"], "until");
     assert_eq!(log.result["end_time_ns"], "1000000000");
@@ -433,6 +435,35 @@ fn protobuf_and_json_logs_carry_the_same_states_and_poses() {
         let bytes = std::fs::read(&path).unwrap();
         let _ = std::fs::remove_file(&path);
         check(&cell, &r, &bytes);
+        // vworks's own reader (for playback) decodes /tf as the foxglove crate does, and
+        // reads every /scene message.
+        let read = read_log_bytes_with("t.mcap", &bytes, ReadOptions { poses: true }).unwrap();
+        let ours: Vec<Transform> = read
+            .transforms
+            .iter()
+            .flat_map(|(t, ts)| {
+                let names = &read.frames;
+                ts.iter().map(move |f| {
+                    (
+                        *t,
+                        names[f.parent as usize].clone(),
+                        names[f.child as usize].clone(),
+                        f.translation,
+                        f.rotation,
+                    )
+                })
+            })
+            .collect();
+        assert_eq!(ours, transforms(&bytes), "{name}");
+        assert_eq!(read.scene.len() as u64, read.counts["/scene"]);
+        assert!(
+            read.scene[0].1["entities"]
+                .as_array()
+                .is_some_and(|e| !e.is_empty())
+        );
+        // Without the option, only counted.
+        let plain = read_log_bytes("t.mcap", &bytes).unwrap();
+        assert!(plain.transforms.is_empty() && plain.scene.is_empty() && plain.frames.is_empty());
         logs.push((transforms(&bytes), states(&bytes)));
     }
     // The JSON writer prints shortest round-trip decimals; serde_json's default parser may
@@ -694,7 +725,7 @@ fn a_chunk_claiming_an_absurd_size_is_damage_not_an_abort() {
     let path =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/log-chunk-claims-2-56-bytes.mcap");
     let bytes = std::fs::read(&path).unwrap();
-    match vworks_se::mcaplog::read_log_bytes("damaged.mcap", &bytes) {
+    match read_log_bytes("damaged.mcap", &bytes) {
         Ok(contents) => {
             let (_, why) = contents.damage.expect("reported as damaged");
             assert!(why.contains("claims") || !why.is_empty(), "{why}");
@@ -710,7 +741,7 @@ fn a_field_longer_than_its_record_is_damage_not_a_huge_allocation() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/data/log-metadata-map-claims-3-5-gb.mcap");
     let bytes = std::fs::read(&path).unwrap();
-    match vworks_se::mcaplog::read_log_bytes("damaged.mcap", &bytes) {
+    match read_log_bytes("damaged.mcap", &bytes) {
         Ok(contents) => assert!(contents.damage.is_some()),
         Err(e) => assert!(e.to_string().contains("damaged.mcap"), "{e}"),
     }
@@ -725,7 +756,7 @@ fn a_record_longer_than_its_chunk_is_damage() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/data/log-record-longer-than-its-chunk.mcap");
     let bytes = std::fs::read(&path).unwrap();
-    let contents = vworks_se::mcaplog::read_log_bytes("damaged.mcap", &bytes).unwrap();
+    let contents = read_log_bytes("damaged.mcap", &bytes).unwrap();
     let (read, why) = contents.damage.expect("reported as damaged");
     assert_eq!(read, 0);
     assert!(

@@ -30,6 +30,7 @@
 
 mod cycles;
 mod json;
+mod poses;
 mod proto;
 mod read;
 mod scene;
@@ -44,7 +45,10 @@ use std::sync::{Arc, OnceLock};
 use foxglove::messages::FrameTransforms;
 use vworks_model::math::Iso;
 
-pub use read::{LogContents, read_log, read_log_bytes};
+pub use poses::FrameTransform;
+pub use read::{
+    LogContents, ReadOptions, read_log, read_log_bytes, read_log_bytes_with, read_log_with,
+};
 
 use crate::sink::{RunEnd, RunSink};
 use crate::trace::{Data, Kind, TraceEvent};

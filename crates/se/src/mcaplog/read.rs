@@ -5,7 +5,16 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use super::poses::{self, FrameTransform};
 use super::{LogError, LoggedEvent, RESULT_METADATA};
+
+/// What to decode besides the counts, span, events and metadata.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ReadOptions {
+    /// Also the poses and shapes: every `/tf` message's transforms and every `/scene`
+    /// message (what plays the run back in 3D). Off, they are only counted.
+    pub poses: bool,
+}
 
 /// What a log holds.
 #[derive(Clone, Debug, Default)]
@@ -26,10 +35,23 @@ pub struct LogContents {
     /// time and each robot's ending (empty if the run did not finish the log, or for
     /// logs of version 1).
     pub result: BTreeMap<String, String>,
+    /// With [`ReadOptions::poses`]: the frame names `transforms` refer to, in the order
+    /// first seen.
+    pub frames: Vec<String>,
+    /// With [`ReadOptions::poses`]: every `/tf` message, its time (ns) and transforms.
+    pub transforms: Vec<(u64, Vec<FrameTransform>)>,
+    /// With [`ReadOptions::poses`]: every `/scene` message (`foxglove.SceneUpdate` as
+    /// JSON), with its time (ns).
+    pub scene: Vec<(u64, serde_json::Value)>,
 }
 
-/// Reads the log at `path`.
+/// Reads the log at `path` (counts, span, events, metadata).
 pub fn read_log(path: &Path) -> Result<LogContents, LogError> {
+    read_log_with(path, ReadOptions::default())
+}
+
+/// Reads the log at `path`, decoding what `options` asks for besides.
+pub fn read_log_with(path: &Path, options: ReadOptions) -> Result<LogContents, LogError> {
     let file = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| LogError::Read {
         file: file.clone(),
@@ -40,11 +62,21 @@ pub fn read_log(path: &Path) -> Result<LogContents, LogError> {
             _ => e.to_string(),
         },
     })?;
-    read_log_bytes(&file, &bytes)
+    read_log_bytes_with(&file, &bytes, options)
 }
 
 /// Reads a log from its bytes; `file` names it in errors.
 pub fn read_log_bytes(file: &str, bytes: &[u8]) -> Result<LogContents, LogError> {
+    read_log_bytes_with(file, bytes, ReadOptions::default())
+}
+
+/// Reads a log from its bytes, decoding what `options` asks for; `file` names it in
+/// errors.
+pub fn read_log_bytes_with(
+    file: &str,
+    bytes: &[u8],
+    options: ReadOptions,
+) -> Result<LogContents, LogError> {
     if !bytes.starts_with(mcap::MAGIC) {
         return Err(LogError::NotMcap { file: file.into() });
     }
@@ -61,9 +93,9 @@ pub fn read_log_bytes(file: &str, bytes: &[u8]) -> Result<LogContents, LogError>
     // underflows its count: found by fuzzing). Such a chunk is the damage: everything
     // before it is read (the reader then finds the file cut short there).
     let damage = match uncompressed_chunks_fit(bytes) {
-        Ok(()) => scan(bytes, &mut out, &invalid)?,
+        Ok(()) => scan(bytes, &mut out, &invalid, options)?,
         Err((at, why)) => {
-            scan(&bytes[..at], &mut out, &invalid)?;
+            scan(&bytes[..at], &mut out, &invalid, options)?;
             Some(why)
         }
     };
@@ -80,6 +112,7 @@ fn scan(
     bytes: &[u8],
     out: &mut LogContents,
     invalid: &dyn Fn(String) -> LogError,
+    options: ReadOptions,
 ) -> Result<Option<String>, LogError> {
     use mcap::records::op;
     use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
@@ -88,8 +121,10 @@ fn scan(
     );
     let mut rest = bytes;
     let mut messages = 0u64;
-    // Channel id → topic.
+    // Channel id → topic, and whether its messages are JSON.
     let mut topics: BTreeMap<u16, String> = BTreeMap::new();
+    let mut json_channels: BTreeMap<u16, bool> = BTreeMap::new();
+    let mut frame_index: BTreeMap<String, u32> = BTreeMap::new();
     let u16_at = |d: &[u8], at: usize| d.get(at..at + 2).map(|b| u16::from_le_bytes([b[0], b[1]]));
     let u64_at = |d: &[u8], at: usize| {
         d.get(at..at + 8)
@@ -128,6 +163,12 @@ fn scan(
                 if let Some(topic) = data.get(8..8 + len) {
                     topics.insert(id, String::from_utf8_lossy(topic).into_owned());
                 }
+                // … message encoding (u32 length, bytes).
+                let enc = data.get(8 + len..12 + len).and_then(|l| {
+                    let n = u32::from_le_bytes([l[0], l[1], l[2], l[3]]) as usize;
+                    data.get(12 + len..12 + len + n)
+                });
+                json_channels.insert(id, enc == Some(b"json".as_slice()));
             }
             // The run's metadata (its lengths fit: safe to parse).
             op::METADATA => {
@@ -164,6 +205,47 @@ fn scan(
                         ))
                     })?;
                     out.events.push(event);
+                } else if options.poses && topic == "/tf" {
+                    let payload = data.get(22..).unwrap_or_default();
+                    let named = if json_channels.get(&channel).copied().unwrap_or(false) {
+                        serde_json::from_slice(payload)
+                            .ok()
+                            .and_then(|v| poses::decode_json(&v))
+                    } else {
+                        poses::decode_protobuf(payload)
+                    };
+                    let Some(named) = named else {
+                        return Ok(Some(format!(
+                            "/tf message {} cannot be decoded: the file is damaged there",
+                            out.transforms.len()
+                        )));
+                    };
+                    let mut index = |name: String| {
+                        let next = frame_index.len() as u32;
+                        *frame_index.entry(name.clone()).or_insert_with(|| {
+                            out.frames.push(name);
+                            next
+                        })
+                    };
+                    let ts = named
+                        .into_iter()
+                        .map(|(parent, child, translation, rotation)| FrameTransform {
+                            parent: index(parent),
+                            child: index(child),
+                            translation,
+                            rotation,
+                        })
+                        .collect();
+                    out.transforms.push((log_time, ts));
+                } else if options.poses && topic == "/scene" {
+                    let payload = data.get(22..).unwrap_or_default();
+                    let Ok(v) = serde_json::from_slice(payload) else {
+                        return Ok(Some(format!(
+                            "/scene message {} is not JSON: the file is damaged there",
+                            out.scene.len()
+                        )));
+                    };
+                    out.scene.push((log_time, v));
                 }
             }
             _ => {}
