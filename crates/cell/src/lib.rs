@@ -739,7 +739,14 @@ pub fn load_with(path: &Path, fs: &dyn Files) -> Result<Cell, CellError> {
             None => None,
             Some(toml::Value::String(s)) if s.trim() == "fine" => None,
             Some(v) => {
-                let z = cx.quantity(v, Dim::LENGTH, &format!("{key}.default_zone"))?;
+                let at = format!("{key}.default_zone");
+                let hint: &dyn Fn() -> &'static str = &|| "a radius such as \"10mm\", or \"fine\"";
+                let z = cx.quantity_unchecked(v, Dim::LENGTH, &at, hint)?;
+                if !z.is_finite() || z > MAX_LENGTH {
+                    return Err(
+                        cx.bad(&at, format!("{z} m is not a zone radius; write {}", hint()))
+                    );
+                }
                 if z < 0.0 {
                     return Err(cx.bad(
                         &format!("{key}.default_zone"),
