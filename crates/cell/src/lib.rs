@@ -616,7 +616,7 @@ pub fn load_with(path: &Path, fs: &dyn Files) -> Result<Cell, CellError> {
     let mut render_sources = Sources::new();
     for (i, r) in cf.robot.iter().enumerate() {
         let key = format!("robot[{i}] `{}`", r.name);
-        let model = match (&r.model, &r.urdf) {
+        let mut model = match (&r.model, &r.urdf) {
             (Some(m), None) => {
                 builtin::load(m).map_err(|e| cx.bad(&format!("{key}.model"), e.to_string()))?
             }
@@ -645,7 +645,6 @@ pub fn load_with(path: &Path, fs: &dyn Files) -> Result<Cell, CellError> {
                 "give either `model` (a built-in robot) or `urdf` (a file), not both or neither",
             )),
         };
-        let mut model = model;
         if let Some(jerk) = &r.jerk {
             cx.override_jerk(&mut model, jerk, &format!("{key}.jerk"))?;
         }
@@ -749,7 +748,7 @@ pub fn load_with(path: &Path, fs: &dyn Files) -> Result<Cell, CellError> {
                 }
                 if z < 0.0 {
                     return Err(cx.bad(
-                        &format!("{key}.default_zone"),
+                        &at,
                         "cannot be negative: it is the zone radius of every motion without `zone`; write e.g. \"10mm\", or \"fine\" to stop at every point",
                     ));
                 }

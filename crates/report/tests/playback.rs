@@ -49,6 +49,12 @@ fn links_are_sampled_and_the_rest_keeps_its_pose() {
         p.moving.iter().map(|&m| name(m)).collect::<Vec<_>>()
     );
     assert!(p.moving.len() >= 6);
+    // The frame tree as /tf gives it: each link under the one before it.
+    let index = |n: &str| p.frames.iter().position(|f| f == n).unwrap() as u32;
+    assert_eq!(
+        p.parents[index("left.link_2") as usize],
+        Some(index("left.link_1"))
+    );
     // Each sample is the latest transform at or before its time.
     for (k, &t) in p.times_ns.iter().enumerate().step_by(7) {
         for &m in &p.moving {

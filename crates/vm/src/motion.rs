@@ -198,28 +198,6 @@ impl Profile {
         }
     }
 
-    /// The same shape stretched to last `t_total` (≥ the profile's own): used to make
-    /// every axis of a `move_j` finish with the slowest one. Keeps the ratio of
-    /// acceleration time to total time.
-    pub fn stretched(&self, t_total: f64) -> Profile {
-        if self.t_total <= 0.0 || t_total <= 0.0 {
-            return Profile { t_total, ..*self };
-        }
-        let k = t_total / self.t_total;
-        let t_acc = self.t_acc * k;
-        // dist = v·(t_total − t_acc)
-        let v = self.dist / (t_total - t_acc);
-        Profile {
-            dist: self.dist,
-            v,
-            a: v / t_acc.max(f64::MIN_POSITIVE),
-            j: self.j / (k * k * k),
-            t_jerk: self.t_jerk * k,
-            t_acc,
-            t_total,
-        }
-    }
-
     /// Distance covered during the acceleration phase by time `tau` ∈ [0, t_acc].
     fn ramp_at(&self, tau: f64) -> f64 {
         let (tj, ta) = (self.t_jerk, self.t_acc);
@@ -611,9 +589,9 @@ mod tests {
     }
 
     #[test]
-    fn stretched_profiles_end_together() {
+    fn profiles_made_to_last_longer_end_together() {
         let fast = Profile::new(0.5, 2.0, 4.0);
-        let s = fast.stretched(2.0);
+        let s = fast.lasting(2.0, 4.0);
         assert!((s.at(2.0) - 0.5).abs() < 1e-12 && (s.at(1.0) - 0.25).abs() < 1e-12);
     }
 

@@ -17,26 +17,32 @@
 use super::*;
 
 /// The rest of a zoned motion after its `motion_end`: the robot goes on along it until
-/// `end`, and the next motion is superposed on it.
+/// it reaches its point ([`Fading::end`]), and the next motion is superposed on it.
 #[derive(Clone, Debug)]
 pub(super) struct Fading {
-    /// When the motion started.
-    pub(super) start: i64,
-    /// When it reaches its point.
-    pub(super) end: i64,
-    pub(super) traj: Trajectory,
+    /// The motion (its zone: [`Planned::zone`]).
+    pub(super) motion: Planned,
     /// The point, exactly: the joints and the TCP pose.
     pub(super) corner: [f64; MAX_AXES],
     pub(super) corner_pose: Iso,
-    /// The zone radius its `motion_end` was placed with (the programmed one, at most half
-    /// the motion).
-    pub(super) zone: f64,
     /// The statement of the motion.
     pub(super) pos: SrcPos,
 }
 
-/// A motion ready to start: its trajectory, when it starts, when its `motion_end` comes
-/// and when it reaches its point (both from its start).
+impl Fading {
+    /// When the robot reaches the point.
+    pub(super) fn end(&self) -> i64 {
+        self.motion.start + self.motion.point_ns
+    }
+
+    /// Seconds from the motion's start to `t` (ns).
+    fn dt(&self, t: i64) -> f64 {
+        (t - self.motion.start) as f64 / NS
+    }
+}
+
+/// A motion ready to start, then the current one: its trajectory, when it starts, when
+/// its `motion_end` comes and when it reaches its point (both from its start).
 #[derive(Clone, Debug)]
 pub(super) struct Planned {
     pub(super) traj: Trajectory,
@@ -58,30 +64,32 @@ const CORNER_SAMPLES: usize = 32;
 impl Vm {
     /// The previous motion's rest, while it goes on at `t`.
     fn fading_at(&self, t: i64) -> Option<&Fading> {
-        self.fading.as_ref().filter(|f| t < f.end)
+        self.fading.as_ref().filter(|f| t < f.end())
     }
 
     /// While the robot finishes a zoned motion after its `motion_end` (the next motion,
     /// if any, superposed on it): the time it reaches that point and the point's TCP
     /// position.
     pub fn zoned_point(&self) -> Option<(i64, [f64; 3])> {
-        self.fading.as_ref().map(|f| (f.end, f.corner_pose.t))
+        self.fading.as_ref().map(|f| (f.end(), f.corner_pose.t))
     }
 
     /// The joints at time `t` (inside or after the current motion, through a corner).
     pub fn joints_at(&self, t: i64) -> [f64; MAX_AXES] {
         let Some(f) = self.fading_at(t) else {
             return match &self.motion {
-                Some((start, traj)) => self
-                    .eval_joints(traj, (t - start) as f64 / NS)
+                Some(m) => self
+                    .eval_joints(&m.traj, (t - m.start) as f64 / NS)
                     .unwrap_or(self.rest),
                 None => self.rest,
             };
         };
         match &self.motion {
-            Some((start, traj)) => self.blend_joints(f, traj, *start, t).unwrap_or(self.rest),
+            Some(m) => self
+                .blend_joints(f, &m.traj, m.start, t)
+                .unwrap_or(self.rest),
             None => self
-                .eval_joints(&f.traj, (t - f.start) as f64 / NS)
+                .eval_joints(&f.motion.traj, f.dt(t))
                 .unwrap_or(self.rest),
         }
     }
@@ -95,18 +103,18 @@ impl Vm {
         ts: i64,
         t: i64,
     ) -> Option<[f64; MAX_AXES]> {
-        let d1 = (t - f.start) as f64 / NS;
+        let d1 = f.dt(t);
         let d2 = (t - ts) as f64 / NS;
-        if f.traj.is_cartesian() && next.is_cartesian() {
+        if f.motion.traj.is_cartesian() && next.is_cartesian() {
             if t <= ts {
-                return self.eval_joints(&f.traj, d1);
+                return self.eval_joints(&f.motion.traj, d1);
             }
-            if t >= f.end {
+            if t >= f.end() {
                 return self.eval_joints(next, d2);
             }
             return self.ik_on(next, &self.blend_pose(f, next, ts, t));
         }
-        let q1 = self.eval_joints(&f.traj, d1)?;
+        let q1 = self.eval_joints(&f.motion.traj, d1)?;
         let mut q = self.eval_joints(next, d2)?;
         for ((qi, a), c) in q.iter_mut().zip(q1).zip(f.corner) {
             *qi += a - c;
@@ -117,7 +125,7 @@ impl Vm {
     /// The TCP of a Cartesian corner at `t`: `p₁ + p₂ − P`, orientation `R₂·R_Pᵀ·R₁`.
     fn blend_pose(&self, f: &Fading, next: &Trajectory, ts: i64, t: i64) -> Iso {
         use vworks_model::math::{mat_mul, transpose};
-        let a = self.eval_pose(&f.traj, (t - f.start) as f64 / NS);
+        let a = self.eval_pose(&f.motion.traj, f.dt(t));
         let b = self.eval_pose(next, (t - ts) as f64 / NS);
         let p = f.corner_pose;
         Iso {
@@ -133,13 +141,13 @@ impl Vm {
     /// The TCP pose at time `t`.
     pub fn tcp_at(&self, t: i64) -> Iso {
         match (self.fading_at(t), &self.motion) {
-            (None, Some((start, traj))) if traj.is_cartesian() => {
-                self.eval_pose(traj, (t - start) as f64 / NS)
+            (None, Some(m)) if m.traj.is_cartesian() => {
+                self.eval_pose(&m.traj, (t - m.start) as f64 / NS)
             }
-            (Some(f), Some((start, traj)))
-                if f.traj.is_cartesian() && traj.is_cartesian() && t > *start =>
+            (Some(f), Some(m))
+                if f.motion.traj.is_cartesian() && m.traj.is_cartesian() && t > m.start =>
             {
-                self.blend_pose(f, traj, *start, t)
+                self.blend_pose(f, &m.traj, m.start, t)
             }
             _ => {
                 let q = self.joints_at(t);
@@ -154,11 +162,11 @@ impl Vm {
     /// the collision sweep adds a margin). Through a corner, the two motions' bounds add.
     pub fn axis_rate_bounds(&self) -> [f64; MAX_AXES] {
         let mut out = match &self.motion {
-            Some((_, traj)) => traj.rates(),
+            Some(m) => m.traj.rates(),
             None => [0.0; MAX_AXES],
         };
         if let Some(f) = &self.fading {
-            for (o, r) in out.iter_mut().zip(f.traj.rates()) {
+            for (o, r) in out.iter_mut().zip(f.motion.traj.rates()) {
                 *o += r;
             }
         }
@@ -179,16 +187,25 @@ impl Vm {
             _ => None,
         };
         let (traj, point_ns) = self.plan_path(ins)?;
-        let (start, blend) = match self.fading_at(self.time) {
-            Some(f) => {
-                let (ts, radius) = self.blend_start(f, &traj, point_ns);
-                if ts >= f.end {
-                    self.corner_failed(f.end, f.pos.line);
-                }
-                (ts, Some(radius))
-            }
-            None => (self.time, None),
-        };
+        // Inside a zoned motion's corner: when this one can start, the radius it blends
+        // within, and when the robot would reach that corner's point.
+        let corner = self.fading_at(self.time).map(|f| {
+            let (ts, radius) = self.blend_start(f, &traj, point_ns);
+            (ts, radius, f.end(), f.pos.line)
+        });
+        if let Some((ts, _, point, line)) = corner
+            && ts >= point
+        {
+            self.warn_once(
+                self.main.pc,
+                point,
+                "corner",
+                format!(
+                    "this motion cannot start inside the zone of the motion at line {line} within the zone and the axes' limits: the robot stops at that point first (a corner path failure); a larger zone, a lower speed or a jerk limit can let it fly by"
+                ),
+            );
+        }
+        let (start, blend) = corner.map_or((self.time, None), |(ts, r, ..)| (ts, Some(r)));
         let (mut end_ns, zone) = match programmed {
             // A TCP that does not move (a turntable's, on its axis) enters no zone.
             Some(r) => match self.zone_entry(&traj, point_ns, r) {
@@ -198,8 +215,8 @@ impl Vm {
             None => (point_ns, 0.0),
         };
         // The next corner begins after this one has ended.
-        if let Some(f) = self.fading_at(self.time) {
-            end_ns = end_ns.max((f.end - start).min(point_ns));
+        if let Some((_, _, point, _)) = corner {
+            end_ns = end_ns.max((point - start).min(point_ns));
         }
         Ok(Planned {
             traj,
@@ -212,22 +229,18 @@ impl Vm {
         })
     }
 
-    /// The motion about to start cannot overlap the previous one (`blend_start` found no
-    /// start before the point at `end`): a warning, once per statement, as a controller's
-    /// "corner path failure".
-    fn corner_failed(&mut self, end: i64, line: u32) {
-        let pc = self.main.pc;
+    /// A warning about the statement at `pc`, at `time`, once per statement (a loop
+    /// repeats it every round).
+    fn warn_once(&mut self, pc: u32, time: i64, kind: &'static str, message: String) {
         if self.zone_warned.contains(&pc) {
             return;
         }
         self.zone_warned.push(pc);
         self.warnings.push(Warning {
-            time: end,
+            time,
             pos: self.m.pos_of(pc),
-            kind: "corner",
-            message: format!(
-                "this motion cannot start inside the zone of the motion at line {line} within the zone and the axes' limits: the robot stops at that point first (a corner path failure); a larger zone, a lower speed or a jerk limit can let it fly by"
-            ),
+            kind,
+            message,
         });
     }
 
@@ -277,11 +290,11 @@ impl Vm {
     /// The earliest start of `next` (lasting `next_ns`, planned from the corner) within
     /// the rest of `f` at which the corner is feasible, and the radius around the point
     /// the corner stays within. Feasibility only gets easier as the start moves later
-    /// (less overlap), so a bisection over whole nanoseconds finds it; at `f.end` there
+    /// (less overlap), so a bisection over whole nanoseconds finds it; at `f.end()` there
     /// is no overlap (a stop point).
     fn blend_start(&self, f: &Fading, next: &Trajectory, next_ns: i64) -> (i64, f64) {
-        let lo = self.time.max(f.start);
-        let hi = f.end;
+        let lo = self.time.max(f.motion.start);
+        let hi = f.end();
         if lo >= hi {
             return (hi, 0.0);
         }
@@ -301,11 +314,11 @@ impl Vm {
                     None => lo = mid,
                 }
             }
-            (hi, if hi >= f.end { 0.0 } else { best })
+            (hi, if hi >= f.end() { 0.0 } else { best })
         };
         let (ts, radius) = search(&|ts| self.corner_bounds(f, next, next_ns, ts), lo);
-        if ts >= f.end {
-            return (f.end, 0.0);
+        if ts >= f.end() {
+            return (f.end(), 0.0);
         }
         // The sampled checks (inverse kinematics, axis speeds, the zone of a joint-space
         // corner) cost more: at the start found, and only if they fail, searched again.
@@ -335,12 +348,12 @@ impl Vm {
     ///   (exact: checked at every phase boundary of both profiles and where the summed
     ///   acceleration crosses zero), and at most half the second motion's time overlaps.
     fn corner_bounds(&self, f: &Fading, next: &Trajectory, next_ns: i64, ts: i64) -> Option<f64> {
-        let window = (f.end - ts) as f64 / NS;
+        let window = (f.end() - ts) as f64 / NS;
         if window <= 0.0 {
             return Some(0.0);
         }
-        let off1 = (ts - f.start) as f64 / NS;
-        match (&f.traj, next) {
+        let off1 = (ts - f.motion.start) as f64 / NS;
+        match (&f.motion.traj, next) {
             (
                 Trajectory::Cartesian {
                     path: p1,
@@ -375,7 +388,7 @@ impl Vm {
                     }
                     _ => a + b,
                 };
-                if radius > f.zone.min(0.5 * l2) + 1e-12 {
+                if radius > f.motion.zone.min(0.5 * l2) + 1e-12 {
                     return None;
                 }
                 let k1 = if s1.dist > 0.0 { l1 / s1.dist } else { 0.0 };
@@ -388,19 +401,17 @@ impl Vm {
                 if 2.0 * window > next_ns as f64 / NS {
                     return None;
                 }
-                if let (Some(_), Some(_)) = (f.traj.axis_profile(0), next.axis_profile(0)) {
-                    for i in 0..self.model.dof() {
-                        let (Some((p1, k1)), Some((p2, k2))) =
-                            (f.traj.axis_profile(i), next.axis_profile(i))
-                        else {
-                            continue;
-                        };
-                        let j = self.model.axis(i);
-                        let (speed, acc) = window_extremes(window, [(p1, off1, k1), (p2, 0.0, k2)]);
-                        if speed > j.max_velocity * (1.0 + 1e-9) || acc > j.max_accel * (1.0 + 1e-9)
-                        {
-                            return None;
-                        }
+                // Between two joint motions (a mixed corner is checked by samples).
+                for i in 0..self.model.dof() {
+                    let (Some((p1, k1)), Some((p2, k2))) =
+                        (f.motion.traj.axis_profile(i), next.axis_profile(i))
+                    else {
+                        break;
+                    };
+                    let j = self.model.axis(i);
+                    let (speed, acc) = window_extremes(window, [(p1, off1, k1), (p2, 0.0, k2)]);
+                    if speed > j.max_velocity * (1.0 + 1e-9) || acc > j.max_accel * (1.0 + 1e-9) {
+                        return None;
                     }
                 }
                 Some(0.0)
@@ -414,11 +425,11 @@ impl Vm {
     /// seen, if all hold.
     fn corner_samples(&self, f: &Fading, next: &Trajectory, ts: i64) -> Option<f64> {
         let n = self.model.dof();
-        let span = f.end - ts;
+        let span = f.end() - ts;
         if span <= 0 {
             return Some(0.0);
         }
-        let joint_space = !(f.traj.is_cartesian() && next.is_cartesian());
+        let joint_space = !(f.motion.traj.is_cartesian() && next.is_cartesian());
         let mut prev = self.blend_joints(f, next, ts, ts)?;
         let mut prev_t = ts;
         let mut farthest = 0.0f64;
@@ -440,7 +451,7 @@ impl Vm {
             if joint_space {
                 let p = self.model.tcp(&q[..n], &self.cfg.tool).t;
                 let d = vworks_model::math::norm(vworks_model::math::sub(p, f.corner_pose.t));
-                if d > f.zone {
+                if d > f.motion.zone {
                     return None;
                 }
                 farthest = farthest.max(d);
@@ -470,20 +481,16 @@ impl Vm {
         let Some(f) = self.fading_at(t) else {
             return t;
         };
-        let (end, line) = (f.end, f.pos.line);
+        let (end, line) = (f.end(), f.pos.line);
         // Warned at the stop point's time, where the trace shows the statement's event.
-        if !self.zone_warned.contains(&pc) {
-            self.zone_warned.push(pc);
-            let pos = self.m.pos_of(pc);
-            self.warnings.push(Warning {
-                time: end,
-                pos,
-                kind: "stop-point",
-                message: format!(
-                    "{what} makes the zoned point of the motion at line {line} a stop point: the robot reaches it first; write `zone fine` on that motion to say so"
-                ),
-            });
-        }
+        self.warn_once(
+            pc,
+            end,
+            "stop-point",
+            format!(
+                "{what} makes the zoned point of the motion at line {line} a stop point: the robot reaches it first; write `zone fine` on that motion to say so"
+            ),
+        );
         end
     }
 }

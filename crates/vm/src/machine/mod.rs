@@ -369,17 +369,13 @@ pub struct Vm {
     time: i64,
     /// Joints when not moving (at `time`, or at the start of the current motion).
     rest: [f64; MAX_AXES],
-    motion: Option<(i64, Trajectory)>,
+    /// The current motion (its start time is `start`).
+    motion: Option<Planned>,
     /// The motion planned by `next_event`, started by `perform`.
     pending_motion: Option<Planned>,
-    /// The current motion's zone radius (0: it stops at its point) and when it reaches
-    /// its point.
-    motion_zone: f64,
-    motion_programmed: Option<f64>,
-    motion_point_end: i64,
     /// The rest of a zoned motion after its `motion_end`, while the robot finishes it.
     fading: Option<Fading>,
-    /// Statements already warned about making a zoned point a stop point.
+    /// Statements already warned about their zoned points (`blend::warn_once`).
     zone_warned: Vec<u32>,
     timed_out: bool,
     /// Scratch thread for evaluating conditions.
@@ -530,9 +526,6 @@ impl Vm {
             rest,
             motion: None,
             pending_motion: None,
-            motion_zone: 0.0,
-            motion_programmed: None,
-            motion_point_end: 0,
             fading: None,
             zone_warned: Vec::new(),
             timed_out: false,
@@ -631,11 +624,11 @@ impl Vm {
     /// True while a motion is in progress at time `t`.
     pub fn moving_at(&self, t: i64) -> bool {
         matches!(self.state, State::Moving { end, .. } if t < end)
-            && self.motion.as_ref().is_some_and(|(s, _)| t > *s)
+            && self.motion.as_ref().is_some_and(|m| t > m.start)
             || self
                 .fading
                 .as_ref()
-                .is_some_and(|f| t > f.start && t < f.end)
+                .is_some_and(|f| t > f.motion.start && t < f.end())
     }
 
     /// Warnings produced so far; the SE drains them.
@@ -697,8 +690,8 @@ impl Vm {
                 robot: self.cfg.robot,
                 time: *end,
                 kind: EventKind::MotionEnd {
-                    zone_m: (self.motion_zone > 0.0).then_some(self.motion_zone),
-                    programmed_m: self.motion_programmed,
+                    zone_m: self.motion.as_ref().map(|m| m.zone).filter(|z| *z > 0.0),
+                    programmed_m: self.motion.as_ref().and_then(|m| m.programmed),
                 },
                 pos: *pos,
             }),
@@ -858,7 +851,7 @@ impl Vm {
             Source::Fire(i) => self.perform_fire(i),
             Source::None => return,
         }
-        if self.fading.as_ref().is_some_and(|f| self.time >= f.end) {
+        if self.fading.as_ref().is_some_and(|f| self.time >= f.end()) {
             self.fading = None;
         }
         self.enter_instant(self.time);
@@ -954,12 +947,8 @@ impl Vm {
                         let width = self.motion_operands(ins).width;
                         let l = self.main.stack.len() - width;
                         self.main.stack.truncate(l);
-                        if let Some(p) = self.pending_motion.take() {
-                            self.motion_zone = p.zone;
-                            self.motion_programmed = p.programmed;
-                            self.motion_point_end = e.time + p.point_ns;
-                            self.motion = Some((e.time, p.traj));
-                        }
+                        // (Planned to start at this event's time.)
+                        self.motion = self.pending_motion.take();
                         self.state = State::Moving {
                             end: e.time + duration_ns,
                             pos: e.pos,
@@ -1037,22 +1026,19 @@ impl Vm {
             }
             State::Moving { end, pos } => {
                 self.time = end;
-                if let Some((start, traj)) = self.motion.take() {
+                if let Some(motion) = self.motion.take() {
                     // Exactly the target, not the profile's last float.
-                    self.rest = traj.end_joints();
-                    if self.motion_zone > 0.0 && self.motion_point_end > end {
+                    self.rest = motion.traj.end_joints();
+                    if motion.zone > 0.0 && motion.end_ns < motion.point_ns {
                         let n = self.model.dof();
-                        let corner_pose = match &traj {
+                        let corner_pose = match &motion.traj {
                             Trajectory::Cartesian { to, .. } => *to,
                             _ => self.model.tcp(&self.rest[..n], &self.cfg.tool),
                         };
                         self.fading = Some(Fading {
-                            start,
-                            end: self.motion_point_end,
-                            traj,
+                            motion,
                             corner: self.rest,
                             corner_pose,
-                            zone: self.motion_zone,
                             pos,
                         });
                     }

@@ -266,7 +266,7 @@ impl Vm {
         for (i, p) in profiles.iter_mut().enumerate().take(n) {
             *p = p.lasting(t_total, aratio * self.model.axis(i).max_accel);
         }
-        let dur = (t_total * NS).ceil() as i64;
+        let dur = profiles.iter().map(Profile::duration_ns).max().unwrap_or(0);
         (
             Trajectory::JointSynced {
                 from,
