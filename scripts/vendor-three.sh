@@ -14,7 +14,11 @@ cd "$work"
 npm init -y >/dev/null
 npm install --no-audit --no-fund --ignore-scripts "three@$THREE_VERSION" "esbuild@$ESBUILD_VERSION" >/dev/null
 node node_modules/esbuild/install.js >/dev/null
-echo "export * from 'three';" > entry.js
+# The core, and the one addon the report's 3D view uses (orbit, pan and zoom with the mouse).
+cat > entry.js <<'JS'
+export * from 'three';
+export { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+JS
 node_modules/.bin/esbuild entry.js --bundle --minify --format=iife --global-name=THREE \
   --legal-comments=inline --target=es2020 --outfile=three.iife.min.js
 cp three.iife.min.js "$out/three.iife.min.js"
