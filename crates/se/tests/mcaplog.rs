@@ -493,11 +493,12 @@ fn protobuf_and_json_logs_carry_the_same_states_and_poses() {
             );
         }
     }
-    // Between keyframes only changed frames are sent; at t = 0 every frame is, each once.
+    // Between keyframes only changed frames are sent; at t = 0 every frame is, each once
+    // (a robot's links and its TCP).
     let frames = cell
         .robots
         .iter()
-        .map(|r| r.model.links.len())
+        .map(|r| r.model.links.len() + 1)
         .sum::<usize>()
         + cell.devices.len()
         + cell.parts.len();
@@ -509,7 +510,7 @@ fn frame_transforms_are_the_forward_kinematics_of_the_logged_joints() {
     // /tf is a tree (world → each robot's root link → its links by joint; devices and parts
     // under world). Replaying it, every link's pose in the world (its chain of latest
     // transforms) equals base × FK(the joints /state logged at that time), and /state's
-    // TCP equals base × FK × tool.
+    // TCP equals base × FK × tool and the pose of the `robot:tcp` frame.
     for name in ["track", "handoff"] {
         let cell = Arc::new(load(&root().join(format!("workcells/{name}/cell.toml"))).unwrap());
         let (r, bytes) = run_logged(&cell, 1, Some(20_000_000_000), &format!("fk-{name}"));
@@ -557,13 +558,16 @@ fn frame_transforms_are_the_forward_kinematics_of_the_logged_joints() {
                 }
                 let tcp = robot.base.mul(&fk[robot.model.tool_link]).mul(&robot.tool);
                 let logged = iso(*tcp_p, *tcp_q);
-                for (w, g) in tcp
-                    .t
-                    .iter()
-                    .chain(tcp.r.iter().flatten())
-                    .zip(logged.t.iter().chain(logged.r.iter().flatten()))
-                {
-                    assert!((w - g).abs() < 1e-9, "{name} {} TCP at {t}", robot.name);
+                let framed = world(&latest, &vworks_se::mcaplog::tcp_frame(&robot.name));
+                for got in [logged, framed] {
+                    for (w, g) in tcp
+                        .t
+                        .iter()
+                        .chain(tcp.r.iter().flatten())
+                        .zip(got.t.iter().chain(got.r.iter().flatten()))
+                    {
+                        assert!((w - g).abs() < 1e-9, "{name} {} TCP at {t}", robot.name);
+                    }
                 }
             }
         }

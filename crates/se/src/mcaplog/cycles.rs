@@ -9,8 +9,9 @@
 //! rotations, quaternions and encoding run beside it.
 //!
 //! The `/tf` tree: `world` → each robot's root link (its base pose) → each link through
-//! its joint (parent link → child link, the joint's own transform); devices and parts
-//! under `world`. Between keyframes a joint's transform is sent only when its axis value
+//! its joint (parent link → child link, the joint's own transform) → the robot's TCP
+//! (`robot:tcp`, under its tool link: the workcell's tool); devices and parts under
+//! `world`. Between keyframes a joint's transform is sent only when its axis value
 //! changed, a device or part only when its pose changed; at a keyframe (t = 0, then at
 //! least every [`KEYFRAME_NS`]) every frame is sent.
 
@@ -80,10 +81,18 @@ fn take_f64(payload: &mut &[u8]) -> f64 {
     }
 }
 
+/// The `/tf` frame of robot `robot`'s TCP: `robot:tcp` (a link's frame is `robot.link`,
+/// so no link can take its name).
+pub fn tcp_frame(robot: &str) -> String {
+    format!("{robot}:tcp")
+}
+
 /// One robot as the encoder sees it.
 struct RobotFrames {
     model: Arc<RobotModel>,
     base: Iso,
+    /// The TCP in the tool link (the workcell's tool).
+    tool: Iso,
     /// Its name as `/state` writes it (JSON: quoted).
     name: String,
     /// The joints the last published link transforms are for.
@@ -119,6 +128,7 @@ impl CycleEncoder {
                     .iter()
                     .map(|j| (link(j.parent), link(j.child))),
             );
+            edges.push((link(r.model.tool_link), tcp_frame(&r.name)));
         }
         let in_world = cell.devices.iter().chain(&cell.parts);
         edges.extend(in_world.map(|b| ("world".to_string(), b.name.clone())));
@@ -135,6 +145,7 @@ impl CycleEncoder {
             .map(|r| RobotFrames {
                 model: Arc::clone(&r.model),
                 base: r.base,
+                tool: r.tool,
                 name: match encoding {
                     Encoding::Json => json::quoted(&r.name),
                     Encoding::Protobuf => r.name.clone(),
@@ -224,6 +235,11 @@ impl CycleEncoder {
                 *published = q;
             } else {
                 joint_ids.for_each(drop);
+            }
+            // The TCP in its tool link never changes either.
+            let tcp_id = ids.next().unwrap_or_default();
+            if keyframe {
+                emit(tf, tcp_id, &robot.tool);
             }
         }
         self.part_poses.clear();

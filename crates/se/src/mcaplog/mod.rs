@@ -45,6 +45,7 @@ use std::sync::{Arc, OnceLock};
 use foxglove::messages::FrameTransforms;
 use vworks_model::math::Iso;
 
+pub use cycles::tcp_frame;
 pub use poses::FrameTransform;
 pub use read::{
     LogContents, ReadOptions, read_log, read_log_bytes, read_log_bytes_with, read_log_with,
