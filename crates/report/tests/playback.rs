@@ -1,20 +1,25 @@
 //! The report's playback data from real logs: what moves is sampled at 30 frames per
 //! simulated second and at every collision's start, each sample the latest `/tf`
-//! transform at or before its time; what does not move keeps its first pose.
+//! transform at or before its time; what does not move keeps its first pose. A robot's
+//! link is one angle per sample, a held part its whole pose.
 
 #![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)] // tests fail by panicking
 
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use vworks_report::playback::{FRAMES_PER_SECOND, Playback};
+use vworks_report::playback::{FRAMES_PER_SECOND, Joint, Playback};
 use vworks_se::engine::Simulation;
 use vworks_se::mcaplog::{McapLog, ReadOptions, read_log_with};
 use vworks_se::trace::Kind;
 
 fn log_of(cell: &str) -> vworks_se::mcaplog::LogContents {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let c = Arc::new(vworks_cell::load(&root.join(format!("workcells/{cell}/cell.toml"))).unwrap());
+    log_of_cell(cell, &root.join(format!("workcells/{cell}/cell.toml")))
+}
+
+fn log_of_cell(cell: &str, file: &std::path::Path) -> vworks_se::mcaplog::LogContents {
+    let c = Arc::new(vworks_cell::load(file).unwrap());
     let path = std::env::temp_dir().join(format!(
         "vworks-playback-{cell}-{}.mcap",
         std::process::id()
@@ -40,15 +45,19 @@ fn links_are_sampled_and_the_rest_keeps_its_pose() {
         .time_ns as u64;
     assert!(p.times_ns.contains(&collision) && !collision.is_multiple_of(step));
     assert!(p.times_ns.windows(2).all(|w| w[0] < w[1]));
-    assert_eq!(p.poses.len(), p.times_ns.len() * p.moving.len() * 7);
-    // The robots' links move; the world, the robots' bases and the devices do not.
+    // The robots' links move, each about its joint's axis (one angle per sample); the
+    // world, the robots' bases, their TCPs and the devices do not.
     let name = |i: u32| p.frames[i as usize].as_str();
     assert!(
-        p.moving.iter().all(|&m| name(m).contains(".link_")),
+        p.tracks
+            .iter()
+            .all(|t| name(t.frame).contains(".link_") && matches!(t.joint, Joint::Revolute { .. })),
         "{:?}",
-        p.moving.iter().map(|&m| name(m)).collect::<Vec<_>>()
+        p.tracks
     );
-    assert!(p.moving.len() >= 6);
+    assert!(p.tracks.len() >= 6);
+    assert_eq!(p.stride(), p.tracks.len());
+    assert_eq!(p.values.len(), p.times_ns.len() * p.stride());
     // The frame tree as /tf gives it: each link under the one before it.
     let index = |n: &str| p.frames.iter().position(|f| f == n).unwrap() as u32;
     assert_eq!(
@@ -56,8 +65,9 @@ fn links_are_sampled_and_the_rest_keeps_its_pose() {
         Some(index("left.link_1"))
     );
     // Each sample is the latest transform at or before its time.
+    // (To f32 precision: the angle is encoded as f32.)
     for (k, &t) in p.times_ns.iter().enumerate().step_by(7) {
-        for &m in &p.moving {
+        for m in p.tracks.iter().map(|t| t.frame) {
             let latest = log
                 .transforms
                 .iter()
@@ -74,11 +84,88 @@ fn links_are_sampled_and_the_rest_keeps_its_pose() {
                 latest.rotation[1],
                 latest.rotation[2],
                 latest.rotation[3],
-            ]
-            .map(|x| x as f32);
-            assert_eq!(p.pose(k, m).unwrap(), want, "{} at {t}", name(m));
+            ];
+            assert!(
+                close(&p.pose(k, m).unwrap(), &want),
+                "{} at {t}: {:?} vs {want:?}",
+                name(m),
+                p.pose(k, m)
+            );
         }
     }
+}
+
+/// Poses equal to 1e-6 (a rotation and its negative quaternion are the same).
+fn close(a: &[f64; 7], b: &[f64; 7]) -> bool {
+    let same = |sign: f64| (3..7).all(|i| (a[i] - sign * b[i]).abs() < 1e-6);
+    (0..3).all(|i| (a[i] - b[i]).abs() < 1e-6) && (same(1.0) || same(-1.0))
+}
+
+/// Every track of `cell`'s playback gives back, at every sample, the latest logged
+/// transform of its frame; returns the tracks by kind (revolute, prismatic, free).
+fn every_sample_is_the_logged_pose(
+    cell: &str,
+    log: &vworks_se::mcaplog::LogContents,
+) -> [usize; 3] {
+    let p = Playback::from_log(log).unwrap();
+    let mut latest: Vec<Option<[f64; 7]>> = vec![None; p.frames.len()];
+    let mut next = 0;
+    for (k, &t) in p.times_ns.iter().enumerate() {
+        while let Some((at, ts)) = log.transforms.get(next)
+            && *at <= t
+        {
+            for tr in ts {
+                let (q, r) = (tr.translation, tr.rotation);
+                latest[tr.child as usize] = Some([q[0], q[1], q[2], r[0], r[1], r[2], r[3]]);
+            }
+            next += 1;
+        }
+        // (`world` is no frame's child.) Frames that do not move keep their first pose.
+        for (f, want) in latest.iter().enumerate() {
+            let Some(want) = want else { continue };
+            let got = p.pose(k, f as u32).unwrap();
+            assert!(
+                close(&got, want),
+                "{cell} {} at {t}: {got:?} vs {want:?}",
+                p.frames[f]
+            );
+        }
+    }
+    let mut kinds = [0; 3];
+    for t in &p.tracks {
+        kinds[match t.joint {
+            Joint::Revolute { .. } => 0,
+            Joint::Prismatic { .. } => 1,
+            Joint::Free => 2,
+        }] += 1;
+    }
+    kinds
+}
+
+#[test]
+fn joints_are_one_number_and_held_parts_a_pose() {
+    // track: a turntable and an arm; handoff: a part carried from r1 to r2, which moves
+    // freely in the world; a linear track (prismatic) written here.
+    let track = every_sample_is_the_logged_pose("track", &log_of("track"));
+    assert!(track[0] >= 7 && track[1] == 0 && track[2] == 0, "{track:?}");
+    let handoff = every_sample_is_the_logged_pose("handoff", &log_of("handoff"));
+    assert!(handoff[0] >= 12 && handoff[2] >= 1, "{handoff:?}");
+    let dir = std::env::temp_dir().join(format!("vworks-playback-rail-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("cell.toml"),
+        "name = \"rail\"\n[[robot]]\nname = \"rail\"\nmodel = \"track\"\nprogram = \"rail.wsl\"\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("rail.wsl"),
+        "proc main() { move_j joints(2m); move_j joints(0.5m); }\n",
+    )
+    .unwrap();
+    let rail =
+        every_sample_is_the_logged_pose("rail", &log_of_cell("rail", &dir.join("cell.toml")));
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(rail, [0, 1, 0]);
 }
 
 #[test]

@@ -692,9 +692,20 @@ fn bodies_turn_red_while_they_touch() {
             c["color"]["g"].as_f64().unwrap(),
         )
     };
-    // At t = 0 every body, grey.
+    // At t = 0 every body in its kind's colour: robot links amber (their frame is
+    // `robot.link`), devices slate grey.
+    let own = |frame: &str| {
+        if frame.contains('.') {
+            (0.95, 0.68)
+        } else {
+            (0.55, 0.6)
+        }
+    };
     let all = scenes[0].1["entities"].as_array().unwrap();
-    assert!(all.len() > 10 && all.iter().all(|e| colour(e) == (0.6, 0.65)));
+    assert!(all.len() > 10);
+    for e in all {
+        assert_eq!(colour(e), own(e["frame_id"].as_str().unwrap()), "{e}");
+    }
     // Then, per change, exactly the two bodies' entities, red from start to end.
     for ((t, on, a, b), (log_time, scene)) in changes.iter().zip(&scenes[1..]) {
         assert_eq!(*log_time, *t as u64);
@@ -706,7 +717,7 @@ fn bodies_turn_red_while_they_touch() {
                 frame == a || frame == b,
                 "{frame} in the update for {a} {b}"
             );
-            assert_eq!(colour(e), if *on { (0.9, 0.1) } else { (0.6, 0.65) });
+            assert_eq!(colour(e), if *on { (0.9, 0.1) } else { own(frame) });
         }
     }
     let _ = std::fs::remove_dir_all(&dir);

@@ -1,6 +1,7 @@
 //! The `/scene` topic: every collision body as Foxglove scene primitives attached to its
 //! frame (boxes as cubes, capsules as a cylinder and two spheres, meshes as their convex
-//! hull's triangles), grey, and red while it touches another body. Built on the log's
+//! hull's triangles), in its kind's colour (robots amber, devices slate grey, parts green),
+//! and red while it touches another body. Built on the log's
 //! writer thread: the convex hulls and the JSON cost the simulation nothing.
 
 use vworks_model::math::Iso;
@@ -17,7 +18,18 @@ pub(crate) struct SceneBody {
     local: Iso,
     /// For a hull: its triangles, three corners each (empty if the hull is degenerate).
     hull: Vec<[f64; 3]>,
+    /// Its colour when it touches nothing (r, g, b).
+    colour: [f64; 3],
 }
+
+/// A robot link's colour.
+const ROBOT: [f64; 3] = [0.95, 0.68, 0.22];
+/// A device's colour.
+const DEVICE: [f64; 3] = [0.55, 0.6, 0.68];
+/// A part's colour.
+const PART: [f64; 3] = [0.25, 0.65, 0.35];
+/// Any body's colour while it touches another.
+const TOUCHING: [f64; 3] = [0.9, 0.1, 0.1];
 
 /// The bodies and their colours.
 pub(crate) struct Scene {
@@ -70,16 +82,19 @@ impl Scene {
                         hull: hull_triangles(&s.geometry),
                         geometry: s.geometry.clone(),
                         local: s.origin,
+                        colour: ROBOT,
                     });
                 }
             }
         }
-        for d in cell.devices.iter().chain(&cell.parts) {
+        let devices = cell.devices.iter().map(|d| (d, DEVICE));
+        for (d, colour) in devices.chain(cell.parts.iter().map(|p| (p, PART))) {
             bodies.push(SceneBody {
                 frame: d.name.clone(),
                 hull: hull_triangles(&d.geometry),
                 geometry: d.geometry.clone(),
                 local: Iso::IDENTITY,
+                colour,
             });
         }
         let red = vec![false; bodies.len()];
@@ -103,11 +118,8 @@ impl Scene {
             if only.is_some_and(|o| !o.contains(&b.frame.as_str())) {
                 continue;
             }
-            let color = if self.red[i] {
-                serde_json::json!({"r": 0.9, "g": 0.1, "b": 0.1, "a": 1.0})
-            } else {
-                serde_json::json!({"r": 0.6, "g": 0.65, "b": 0.7, "a": 1.0})
-            };
+            let [r, g, bl] = if self.red[i] { TOUCHING } else { b.colour };
+            let color = serde_json::json!({"r": r, "g": g, "b": bl, "a": 1.0});
             let (mut cubes, mut spheres, mut cylinders) = (Vec::new(), Vec::new(), Vec::new());
             let mut triangles = Vec::new();
             let local = b.local;
