@@ -1,4 +1,5 @@
-//! MCAP bytes → `read_log_bytes_with` (poses and shapes too) → the report: never a
+//! MCAP bytes → `read_log_bytes_with` (poses and shapes too) → the report with its 3D
+//! view's data: never a
 //! panic, whatever the bytes (a log cut short, a damaged chunk or `/tf` message, another
 //! program's MCAP file).
 #![no_main]
@@ -8,7 +9,6 @@ use libfuzzer_sys::fuzz_target;
 fuzz_target!(|data: &[u8]| {
     let options = vworks_se::mcaplog::ReadOptions { poses: true };
     if let Ok(contents) = vworks_se::mcaplog::read_log_bytes_with("fuzz.mcap", data, options) {
-        let report = vworks_report::Report::from_log(&contents);
-        let _ = vworks_report::html(&report, &contents.events, "fuzz.mcap");
+        let _ = vworks_report::page(&contents, "fuzz.mcap");
     }
 });

@@ -79,14 +79,21 @@ enum Command {
         #[arg(short, long)]
         quiet: bool,
     },
-    /// Write a run's report, one self-contained HTML file: a Gantt chart per robot, cycle
-    /// times, collisions, warnings and the event table.
+    /// Write a run's report, one self-contained HTML file: the cell in 3D played back over
+    /// a timeline, a Gantt chart per robot, cycle times, collisions, warnings and the event
+    /// table.
     Report {
         /// The MCAP log of the run (`vworks run CELL --log run.mcap`).
         log: PathBuf,
         /// The HTML file to write (default: the log's name with extension .html).
         #[arg(short, long)]
         output: Option<PathBuf>,
+    },
+    /// Write a run's report to a temporary file and open it in the browser ($BROWSER, or the
+    /// system's default), or print its path where no browser can be opened.
+    View {
+        /// The MCAP log of the run (`vworks run CELL --log run.mcap`).
+        log: PathBuf,
     },
     /// Create a new workcell folder: one robot, its program and a README, ready to run.
     New {
@@ -346,31 +353,114 @@ fn new_cell(dir: &Path) -> Result<ExitCode, String> {
 }
 
 fn write_report(log: &Path, output: Option<PathBuf>) -> Result<ExitCode, String> {
-    let contents = vworks_se::mcaplog::read_log(log).map_err(|e| e.to_string())?;
-    let report = vworks_report::Report::from_log(&contents);
-    let page = vworks_report::html(&report, &contents.events, &log.display().to_string());
     let out = output.unwrap_or_else(|| log.with_extension("html"));
-    std::fs::write(&out, page).map_err(|e| {
-        format!(
-            "cannot write `{}`: {e}; check that its folder exists and is writable, or choose another with -o",
-            out.display()
-        )
+    let (_, code) = report_to(log, &out)?;
+    Ok(code)
+}
+
+/// Writes the report of `log` to `out` and says so on stderr; the exit code is a failure
+/// if the log is damaged (the report shows what was read).
+fn report_to(log: &Path, out: &Path) -> Result<(vworks_report::Written, ExitCode), String> {
+    let written = vworks_report::write_report(log, out).map_err(|e| match e {
+        vworks_report::ReportError::Write { .. } => format!("{e} with -o"),
+        e => e.to_string(),
     })?;
     eprintln!(
-        "wrote {} ({} robots, {} events, {} collisions)",
+        "wrote {} ({} robots, {} events, {} collisions{})",
         out.display(),
-        report.timelines.len(),
-        contents.events.len(),
-        report.collisions.len()
+        written.report.timelines.len(),
+        written.events,
+        written.report.collisions.len(),
+        if written.has_view {
+            ""
+        } else {
+            "; no 3D view: the log has no poses"
+        }
     );
-    if let Some((read, e)) = contents.damage {
+    if let Some((read, e)) = &written.damage {
         eprintln!(
             "warning: {} is unfinished or damaged after {read} messages ({e}); the report shows what was read",
             log.display()
         );
-        return Ok(ExitCode::FAILURE);
+        return Ok((written, ExitCode::FAILURE));
     }
-    Ok(ExitCode::SUCCESS)
+    Ok((written, ExitCode::SUCCESS))
+}
+
+/// `vworks view`: the report in a temporary file, opened in the browser (`$BROWSER`, else
+/// the system's opener where there is a display), or its path printed.
+fn view(log: &Path) -> Result<ExitCode, String> {
+    let dir = std::env::temp_dir().join("vworks-view");
+    std::fs::create_dir_all(&dir).map_err(|e| {
+        format!(
+            "cannot create `{}`: {e}; set TMPDIR to a writable folder",
+            dir.display()
+        )
+    })?;
+    let stem = log
+        .file_stem()
+        .map_or("run".into(), |s| s.to_string_lossy());
+    let out = dir.join(format!("{stem}.html"));
+    let (_, code) = report_to(log, &out)?;
+    match open_in_browser(&out) {
+        Ok(how) => eprintln!("opened {} ({how})", out.display()),
+        Err(why) => {
+            eprintln!("{why}: open it yourself");
+            out!("{}", out.display());
+        }
+    }
+    Ok(code)
+}
+
+/// Opens `page` in a browser: `$BROWSER` (its `%s` replaced by the path, else the path
+/// appended), else `open` (macOS), `cmd /c start` (Windows) or `xdg-open` (elsewhere, with
+/// a display). Returns what it ran, or why no browser could be.
+fn open_in_browser(page: &Path) -> Result<String, String> {
+    use std::process::{Command, Stdio};
+    let path = page.display().to_string();
+    let mut command = if let Some(browser) = std::env::var_os("BROWSER").filter(|b| !b.is_empty()) {
+        let browser = browser.to_string_lossy().into_owned();
+        let mut words = browser.split_whitespace().map(str::to_string);
+        let program = words.next().unwrap_or_default();
+        let mut args: Vec<String> = words.map(|w| w.replace("%s", &path)).collect();
+        if !browser.contains("%s") {
+            args.push(path.clone());
+        }
+        let mut c = Command::new(program);
+        c.args(args);
+        c
+    } else if cfg!(target_os = "macos") {
+        let mut c = Command::new("open");
+        c.arg(&path);
+        c
+    } else if cfg!(windows) {
+        let mut c = Command::new("cmd");
+        c.args(["/c", "start", "", &path]);
+        c
+    } else {
+        let display = ["DISPLAY", "WAYLAND_DISPLAY"]
+            .iter()
+            .any(|v| std::env::var_os(v).is_some_and(|x| !x.is_empty()));
+        if !display {
+            return Err("no browser: no display here (DISPLAY and WAYLAND_DISPLAY are unset) and BROWSER is not set".into());
+        }
+        let mut c = Command::new("xdg-open");
+        c.arg(&path);
+        c
+    };
+    let shown = format!("{:?}", command.get_program());
+    command
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .map(|_| format!("with {}", shown.trim_matches('"')))
+        .map_err(|e| {
+            format!(
+                "no browser: {} cannot be run ({e})",
+                shown.trim_matches('"')
+            )
+        })
 }
 
 /// Runs the simulation to its end (or `until`). With `progress` (the run's start), a bar on
@@ -674,6 +764,7 @@ fn run(cmd: Command, color: bool) -> Result<ExitCode, String> {
         ),
         Command::Log { what } => read_log(what),
         Command::Report { log, output } => write_report(&log, output),
+        Command::View { log } => view(&log),
         Command::New { name } => new_cell(&name),
         Command::Completions { shell } => {
             use clap::CommandFactory as _;

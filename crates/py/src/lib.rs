@@ -1086,22 +1086,31 @@ fn read_log(py: Python<'_>, path: PathBuf) -> PyResult<EventList> {
     })
 }
 
-/// Writes the HTML report of a run from its MCAP log: a Gantt chart per robot, cycle
-/// times, collisions, warnings and the filterable event table, in one self-contained file
-/// (what `vworks report` writes). `output` defaults to the log's path with `.html`; returns
-/// the path written. Raises `Error` for a file that is not a vworks log or an output that
-/// cannot be written.
+/// Writes the HTML report of a run from its MCAP log: the cell in 3D played back over a
+/// timeline, a Gantt chart per robot, cycle times, collisions, warnings and the filterable
+/// event table, in one self-contained file (what `vworks report` writes). `output`
+/// defaults to the log's path with `.html`; returns the path written. Raises `Error` for a
+/// file that is not a vworks log or an output that cannot be written; warns
+/// (`RuntimeWarning`) for a damaged log, whose report shows what was read.
 #[pyfunction]
 #[pyo3(signature = (log, output=None))]
 fn write_report(py: Python<'_>, log: PathBuf, output: Option<PathBuf>) -> PyResult<PathBuf> {
     let out = output.unwrap_or_else(|| log.with_extension("html"));
-    py.detach(|| {
-        let contents = vworks_se::mcaplog::read_log(&log).map_err(|e| e.to_string())?;
-        let report = vworks_report::Report::from_log(&contents);
-        let page = vworks_report::html(&report, &contents.events, &log.display().to_string());
-        std::fs::write(&out, page).map_err(|e| format!("cannot write `{}`: {e}", out.display()))
-    })
-    .map_err(Error::new_err)?;
+    let written = py
+        .detach(|| vworks_report::write_report(&log, &out).map_err(|e| e.to_string()))
+        .map_err(Error::new_err)?;
+    if let Some((read, why)) = written.damage {
+        let msg = format!(
+            "{} is unfinished or damaged after {read} messages ({why}); the report shows what was read",
+            log.display()
+        );
+        PyErr::warn(
+            py,
+            &py.get_type::<PyRuntimeWarning>(),
+            &std::ffi::CString::new(msg).unwrap_or_default(),
+            1,
+        )?;
+    }
     Ok(out)
 }
 

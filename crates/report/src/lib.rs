@@ -1,6 +1,10 @@
 //! The run report: one self-contained HTML file (no network, no external files) made from
 //! a run's MCAP log — what `vworks report run.mcap -o report.html` writes.
 //!
+//! - the cell in 3D at the top, played back from the log's `/tf` and `/scene` (three.js
+//!   inlined; see [`viewer`]), under it a timeline (play, speed, slider) that also moves a
+//!   cursor over the Gantt chart; clicking the chart or an event row jumps to its time,
+//!   and `#t=SECONDS` in the URL opens the report there;
 //! - a Gantt chart per robot over simulated time: moving, waiting, idle (the rest), with
 //!   collisions (red lines across every row) and signals (ticks on the sender's row)
 //!   marked, as an inline SVG;
@@ -11,8 +15,9 @@
 //! - the event table, filterable by text, robot and kind (a few lines of inline
 //!   JavaScript; without it the whole table shows).
 //!
-//! Everything is derived from the `/events` topic and the log's metadata, so a log thinned
-//! with `--log-every` gives the same report.
+//! Everything but the 3D view is derived from the `/events` topic and the log's metadata,
+//! so a log thinned with `--log-every` gives the same numbers. `docs/report.md` describes
+//! the page.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -24,6 +29,7 @@ use vworks_se::trace::{Data, Kind};
 pub use vworks_se::stats::Activity;
 
 pub mod playback;
+pub mod viewer;
 
 /// The README's Rust example, compiled by `cargo test --doc` so that it stays true (this
 /// crate sits at the end of the run's data flow, so it can see every crate the example
@@ -207,6 +213,58 @@ impl Report {
     }
 }
 
+/// Why a report could not be written.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ReportError {
+    /// The log cannot be read at all (missing, not MCAP, damaged before anything).
+    #[error(transparent)]
+    Log(#[from] vworks_se::mcaplog::LogError),
+    /// The page cannot be written.
+    #[error(
+        "cannot write `{file}`: {reason}; check that its folder exists and is writable, or choose another file"
+    )]
+    Write {
+        /// The HTML file.
+        file: String,
+        /// What the system said.
+        reason: String,
+    },
+}
+
+/// What [`write_report`] wrote.
+#[derive(Clone, Debug)]
+pub struct Written {
+    /// The report's numbers.
+    pub report: Report,
+    /// Events read from the log.
+    pub events: usize,
+    /// Whether the page has the 3D view (the log has poses and shapes).
+    pub has_view: bool,
+    /// If the log is unfinished or damaged: messages read before the damage, and what it
+    /// is (the report shows what was read).
+    pub damage: Option<(u64, String)>,
+}
+
+/// Reads the log at `log` (with its poses) and writes its report to `out`: what
+/// `vworks report` and Python's `write_report` do.
+pub fn write_report(log: &std::path::Path, out: &std::path::Path) -> Result<Written, ReportError> {
+    let options = vworks_se::mcaplog::ReadOptions { poses: true };
+    let contents = vworks_se::mcaplog::read_log_with(log, options)?;
+    let (report, html) = page(&contents, &log.display().to_string());
+    std::fs::write(out, html).map_err(|e| ReportError::Write {
+        file: out.display().to_string(),
+        reason: e.to_string(),
+    })?;
+    Ok(Written {
+        report,
+        events: contents.events.len(),
+        // (What `viewer::data` needs.)
+        has_view: !contents.scene.is_empty() && !contents.transforms.is_empty(),
+        damage: contents.damage,
+    })
+}
+
 /// Escapes text for HTML.
 fn esc(s: &str) -> String {
     let mut out = String::with_capacity(s.len());
@@ -251,7 +309,7 @@ fn gantt(report: &Report) -> String {
     let mut s = String::new();
     let _ = write!(
         s,
-        r#"<svg id="gantt" xmlns="http://www.w3.org/2000/svg" viewBox="0 0 {w} {height}" width="100%" role="img" aria-label="Gantt chart of every robot over simulated time">"#,
+        r#"<svg id="gantt" xmlns="http://www.w3.org/2000/svg" viewBox="0 0 {w} {height}" width="100%" role="img" aria-label="Gantt chart of every robot over simulated time (click: show that time)" data-left="{LEFT}" data-width="{WIDTH}">"#,
         w = LEFT + WIDTH + 20.0
     );
     // Time axis and grid.
@@ -338,6 +396,13 @@ fn gantt(report: &Report) -> String {
             }),
         );
     }
+    // The timeline's cursor (moved by the page's script).
+    let _ = write!(
+        s,
+        r##"<line id="gantt-cursor" x1="{LEFT}" y1="{y0}" x2="{LEFT}" y2="{y1:.1}" stroke="#111" stroke-width="1.5" stroke-dasharray="4 3" pointer-events="none"/>"##,
+        y0 = TOP - 6.0,
+        y1 = TOP + rows * ROW + 4.0,
+    );
     s.push_str("</svg>");
     s
 }
@@ -351,13 +416,14 @@ fn format_tick(t: f64, step: f64) -> String {
     }
 }
 
-/// A titled table (`id`) of `rows` (cells already escaped) under `columns` (name, whether
-/// numeric), or the `none` line when there are no rows.
+/// A titled table (`id`) of `rows` (each its time in ns, which a click shows, and its
+/// cells, already escaped) under `columns` (name, whether numeric), or the `none` line
+/// when there are no rows.
 fn list(
     s: &mut String,
     (title, id, none): (&str, &str, &str),
     columns: &[(&str, bool)],
-    rows: impl Iterator<Item = Vec<String>>,
+    rows: impl Iterator<Item = (i64, Vec<String>)>,
 ) {
     let _ = writeln!(s, "<h2>{title}</h2>");
     let num = |numeric: bool| if numeric { " class=\"num\"" } else { "" };
@@ -371,8 +437,8 @@ fn list(
         let _ = write!(s, "<th{}>{name}</th>", num(*numeric));
     }
     s.push_str("</tr>\n");
-    for row in rows {
-        s.push_str("<tr>");
+    for (t, row) in rows {
+        let _ = write!(s, "<tr data-t=\"{t}\">");
         for (cell, (_, numeric)) in row.iter().zip(columns) {
             let _ = write!(s, "<td{}>{cell}</td>", num(*numeric));
         }
@@ -381,8 +447,26 @@ fn list(
     s.push_str("</table>\n");
 }
 
-/// The report as one HTML document. `source` names the log in the heading.
+/// The report of a log read with `ReadOptions { poses: true }`, as one HTML document,
+/// with the 3D view (or the note saying why there is none). `source` names the log.
+pub fn page(log: &LogContents, source: &str) -> (Report, String) {
+    let report = Report::from_log(log);
+    let page = render(&report, &log.events, source, Some(log));
+    (report, page)
+}
+
+/// The report as one HTML document, without the 3D view (a report of events alone).
+/// `source` names the log in the heading.
 pub fn html(report: &Report, events: &[LoggedEvent], source: &str) -> String {
+    render(report, events, source, None)
+}
+
+fn render(
+    report: &Report,
+    events: &[LoggedEvent],
+    source: &str,
+    log: Option<&LogContents>,
+) -> String {
     let mut s = String::new();
     let title = format!("vworks report: {}", report.cell);
     let _ = write!(
@@ -399,10 +483,12 @@ th {{ background: #f6f6f6; position: sticky; top: 0; }} td.num, th.num {{ text-a
 .legend span {{ display: inline-block; margin-right: 16px; }} .legend i {{ display: inline-block; width: 14px; height: 10px; margin-right: 5px; vertical-align: middle; }}
 #filters input, #filters select {{ margin-right: 8px; padding: 3px 6px; }}
 #events {{ font-family: ui-monospace, monospace; font-size: 12px; }} .none {{ color: #888; }}
+.damage {{ color: #a33; }}{view_style}
 </style></head><body>
 <h1>{t}</h1>
 <div class="sub">{src} · {outcome}simulated span {span} · {n} events</div>
 "#,
+        view_style = if log.is_some() { viewer::STYLE } else { "" },
         t = esc(&title),
         src = esc(source),
         span = secs(report.end_ns),
@@ -412,6 +498,16 @@ th {{ background: #f6f6f6; position: sticky; top: 0; }} td.num, th.num {{ text-a
             .map_or(String::new(), |o| format!("{} · ", esc(o))),
         n = events.len()
     );
+    if let Some((read, why)) = log.and_then(|l| l.damage.as_ref()) {
+        let _ = writeln!(
+            s,
+            "<p class=\"damage\">The log is unfinished or damaged after {read} messages ({}): this report shows what was read.</p>",
+            esc(why)
+        );
+    }
+    if let Some(log) = log {
+        s.push_str(&viewer::section(log, report.end_ns));
+    }
     // Cycle times.
     s.push_str("<h2>Cycle time per robot</h2>\n<table id=\"cycle-times\"><tr><th>robot</th><th class=\"num\">cycle time</th><th class=\"num\">moving</th><th class=\"num\">waiting</th><th class=\"num\">idle</th><th class=\"num\">motions</th></tr>\n");
     for tl in &report.timelines {
@@ -446,12 +542,15 @@ th {{ background: #f6f6f6; position: sticky; top: 0; }} td.num, th.num {{ text-a
     s.push('\n');
     // Collisions and issues.
     let collisions = report.collisions.iter().map(|c| {
-        vec![
-            secs(c.start_ns),
-            c.end_ns.map_or("–".into(), secs),
-            esc(&format!("{} {}", c.a, c.b)),
-            esc(&c.details),
-        ]
+        (
+            c.start_ns,
+            vec![
+                secs(c.start_ns),
+                c.end_ns.map_or("–".into(), secs),
+                esc(&format!("{} {}", c.a, c.b)),
+                esc(&c.details),
+            ],
+        )
     });
     list(
         &mut s,
@@ -465,12 +564,15 @@ th {{ background: #f6f6f6; position: sticky; top: 0; }} td.num, th.num {{ text-a
         collisions,
     );
     let issues = report.issues.iter().map(|(t, kind, robot, message)| {
-        vec![
-            secs(*t),
-            esc(kind.name()),
-            esc(robot.as_deref().unwrap_or("–")),
-            esc(message),
-        ]
+        (
+            *t,
+            vec![
+                secs(*t),
+                esc(kind.name()),
+                esc(robot.as_deref().unwrap_or("–")),
+                esc(message),
+            ],
+        )
     });
     list(
         &mut s,
@@ -509,9 +611,10 @@ th {{ background: #f6f6f6; position: sticky; top: 0; }} td.num, th.num {{ text-a
         let robot = e.robot.as_deref().unwrap_or("-");
         let _ = writeln!(
             s,
-            "<tr data-robot=\"{r}\" data-kind=\"{k}\"><td class=\"num\">{t:.6}</td><td>{r}</td><td>{k}</td><td>{d}</td><td>{p}</td></tr>",
+            "<tr data-robot=\"{r}\" data-kind=\"{k}\" data-t=\"{ns}\"><td class=\"num\">{t:.6}</td><td>{r}</td><td>{k}</td><td>{d}</td><td>{p}</td></tr>",
             r = esc(robot),
             k = e.kind.name(),
+            ns = e.time_ns,
             t = e.time_ns as f64 / 1e9,
             d = esc(&e.details),
             p = esc(&pos)
@@ -545,9 +648,12 @@ th {{ background: #f6f6f6; position: sticky; top: 0; }} td.num, th.num {{ text-a
   apply();
 })();
 </script>
-</body></html>
 "##,
     );
+    if log.is_some() {
+        s.push_str(&viewer::script());
+    }
+    s.push_str("</body></html>\n");
     s
 }
 

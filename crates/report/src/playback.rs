@@ -18,6 +18,10 @@ use vworks_se::trace::Kind;
 /// Samples per simulated second the report plays back at (and more at collision starts).
 pub const FRAMES_PER_SECOND: u64 = 30;
 
+/// Regular samples at most: a run longer than 55 minutes is sampled less often, so that a
+/// report (or a damaged log claiming a time in the year 2500) stays a few megabytes.
+pub const MAX_SAMPLES: u64 = 100_000;
+
 /// How a sampled frame moves in its parent.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Joint {
@@ -122,7 +126,7 @@ impl Playback {
             .last()
             .map_or(0, |(t, _)| *t)
             .max(log.span.map_or(0, |s| s.1));
-        let step = 1_000_000_000 / FRAMES_PER_SECOND;
+        let step = (1_000_000_000 / FRAMES_PER_SECOND).max(end.div_ceil(MAX_SAMPLES));
         let mut times: Vec<u64> = (0..=end / step).map(|k| k * step).collect();
         times.extend(
             log.events

@@ -176,3 +176,91 @@ fn a_log_without_tf_has_no_playback() {
     log.frames.clear();
     assert!(Playback::from_log(&log).is_none());
 }
+
+#[test]
+fn the_page_carries_the_view_and_loads_nothing() {
+    let log = log_of("crash");
+    let (report, page) = vworks_report::page(&log, "crash.mcap");
+    assert_eq!(report.collisions.len(), 1);
+    // One data block, three.js inlined, the page's script after the tables it links to.
+    assert_eq!(page.matches("id=\"vworks-playback\"").count(), 1);
+    assert!(page.contains("var THREE="));
+    assert!(page.find("id=\"events\"") < page.rfind("window.vworksView"));
+    // Nothing from elsewhere: no script or stylesheet by URL, no external URL at all in
+    // the markup (three.js's own code is checked by loading the page in Chromium).
+    assert!(!page.contains("<script src") && !page.contains("<link"));
+    let data = vworks_report::viewer::data(&log).unwrap();
+    let bodies = data["bodies"].as_array().unwrap();
+    // Two irb120s (their capsules drawn as capsules) and the table.
+    assert!(
+        bodies
+            .iter()
+            .any(|b| b["frame"] == "table" && b["label"] == "table")
+    );
+    let kinds: Vec<&str> = bodies
+        .iter()
+        .flat_map(|b| b["shapes"].as_array().unwrap())
+        .map(|s| s["kind"].as_str().unwrap())
+        .collect();
+    assert!(
+        kinds.contains(&"capsule") && kinds.contains(&"box"),
+        "{kinds:?}"
+    );
+    // The colliding links turn red at the collision's start (from /scene).
+    let colours = data["colours"].as_array().unwrap();
+    assert!(
+        colours
+            .iter()
+            .any(|c| c[1] == "left.link_6" && c[2].as_f64() == Some(0.9))
+    );
+    assert_eq!(data["tcps"], serde_json::json!(["left:tcp", "right:tcp"]));
+    // The same log gives the same bytes.
+    assert_eq!(vworks_report::page(&log, "crash.mcap").1, page);
+}
+
+#[test]
+fn a_log_without_scene_has_a_note_instead_of_the_view() {
+    let mut log = log_of("crash");
+    log.scene.clear();
+    let (_, page) = vworks_report::page(&log, "old.mcap");
+    assert!(page.contains("No 3D view: this log has no /scene"));
+    assert!(!page.contains("var THREE=") && !page.contains("id=\"vworks-playback\""));
+    // The timeline stays (it moves the Gantt chart's cursor).
+    assert!(page.contains("id=\"timeline\"") && page.contains("id=\"gantt-cursor\""));
+}
+
+#[test]
+fn coarse_meshes_keep_the_shape_with_fewer_triangles() {
+    // A sphere's 40 × 20 triangle mesh (unit radius).
+    let (mut vertices, mut indices) = (Vec::new(), Vec::new());
+    let (n, m) = (40u32, 20u32);
+    for i in 0..=m {
+        for j in 0..n {
+            let (th, ph) = (
+                std::f32::consts::PI * i as f32 / m as f32,
+                2.0 * std::f32::consts::PI * j as f32 / n as f32,
+            );
+            vertices.extend([th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()]);
+        }
+    }
+    for i in 0..m {
+        for j in 0..n {
+            let (a, b) = (i * n + j, i * n + (j + 1) % n);
+            let (c, d) = (a + n, b + n);
+            indices.extend([a, c, b, b, c, d]);
+        }
+    }
+    let (cv, ci) = vworks_report::viewer::coarse(&vertices, &indices, 8.0);
+    assert!(
+        ci.len() * 3 < indices.len(),
+        "{} of {}",
+        ci.len() / 3,
+        indices.len() / 3
+    );
+    assert!(ci.len() >= 3 * 40 && ci.iter().all(|&i| (i as usize) < cv.len() / 3));
+    // Every coarse vertex is a mean of nearby vertices of the sphere: within a cell of it.
+    for v in cv.chunks_exact(3) {
+        let r = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        assert!((0.85..=1.0 + 1e-6).contains(&r), "{r}");
+    }
+}
