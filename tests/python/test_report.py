@@ -340,6 +340,14 @@ def test_clicking_the_gantt_chart_or_a_row_moves_the_time(browser, tmp_path):
     assert 0 < played < 2e9
     browser.frames(5)
     assert browser.eval("window.vworksView.time()") == played
+    # Keys: the right arrow steps 1/30 s, with Shift 1 s; End goes to the end.
+    browser.eval("document.activeElement.blur()")
+    for key, code in (("ArrowRight", 39), ("ArrowRight", 39)):
+        browser.send("Input.dispatchKeyEvent", type="rawKeyDown", key=key, windowsVirtualKeyCode=code)
+        browser.send("Input.dispatchKeyEvent", type="keyUp", key=key, windowsVirtualKeyCode=code)
+    assert browser.eval("window.vworksView.time()") == pytest.approx(played + 2e9 / 30)
+    browser.send("Input.dispatchKeyEvent", type="rawKeyDown", key="End", windowsVirtualKeyCode=35)
+    assert browser.eval("window.vworksView.time()") == browser.eval("window.vworksView.end")
     clean(browser, page)
 
 
@@ -384,6 +392,10 @@ def test_without_webgl_the_report_says_so_and_keeps_the_timeline(tmp_path):
         load(b, page)
         assert b.eval("document.getElementById('view-note').hidden") is False
         assert "no WebGL" in b.eval("document.getElementById('view-note').textContent")
+        # Neither the empty canvas nor its buttons take room: the note is one line.
+        assert b.eval("document.getElementById('canvas3d').offsetParent") is None
+        assert b.eval("document.getElementById('view-tools').offsetParent") is None
+        assert b.eval("document.getElementById('stage').getBoundingClientRect().height") < 80
         assert b.eval("window.vworksView.view") is None
         b.eval("window.vworksView.setTime(12e9)")
         assert clock(b) == 12.0

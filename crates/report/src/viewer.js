@@ -82,6 +82,20 @@
     if (m) { pause(); setTime(Number(m[1]) * 1e9); }
   }
   window.addEventListener("hashchange", fromHash);
+  // Keys, outside text fields: space plays or pauses, the arrows step 1/30 s (with Shift
+  // 1 s), Home and End go to the ends.
+  document.addEventListener("keydown", function (e) {
+    var t = e.target;
+    if (e.ctrlKey || e.metaKey || e.altKey || (t instanceof Element && t.closest("input, select, textarea, button"))) return;
+    var step = e.shiftKey ? 1e9 : 1e9 / 30;
+    if (e.key === " ") play.click();
+    else if (e.key === "ArrowRight") { pause(); setTime(now + step); }
+    else if (e.key === "ArrowLeft") { pause(); setTime(now - step); }
+    else if (e.key === "Home") { pause(); setTime(0); }
+    else if (e.key === "End") { pause(); setTime(END); }
+    else return;
+    e.preventDefault();
+  });
 
   var dataEl = document.getElementById("vworks-playback");
   var canvas = document.getElementById("canvas3d");
@@ -103,6 +117,7 @@
     if (!gl) {
       canvas.hidden = true;
       document.getElementById("view-tools").hidden = true;
+      document.getElementById("stage").classList.add("empty");
       note.hidden = false;
       note.textContent = "No 3D view: this browser has no WebGL 2. The timeline, the Gantt chart and the tables below are complete.";
     } else {

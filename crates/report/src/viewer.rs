@@ -336,6 +336,7 @@ pub fn script() -> String {
 
 /// The CSS of the view and the timeline.
 pub const STYLE: &str = r#"
+[hidden] { display: none !important; }
 #stage { position: relative; height: 460px; border: 1px solid #d8dde3; border-radius: 4px; background: linear-gradient(#fbfcfd, #e4e9ee); overflow: hidden; }
 #stage.empty { height: auto; min-height: 60px; display: flex; align-items: center; padding: 0 16px; }
 #canvas3d { display: block; width: 100%; height: 100%; }
