@@ -4,7 +4,13 @@
 //! Plain numbers are SI (m, rad, s); strings carry units exactly as in WSL (`"4ms"`,
 //! `"250mm/s"`, `"90deg"`). Paths are relative to the workcell file. Every problem is a
 //! [`CellError`] naming the file, the key and what to do.
+//!
+//! A workcell sets its programs' `param`s (`[params]`, `[robot.params]`: module
+//! [`params`]), and [`Loader`] loads many variants of one workcell, each with a few values
+//! changed by their dotted paths (`robot.r2.base.xyz.0`), compiling each program and
+//! loading each model once (module [`variants`]).
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -18,6 +24,12 @@ use vworks_model::{RobotModel, builtin};
 use vworks_vm::{Dim, Module};
 use vworks_wslc::link::{CellSpec, Linked, RobotSpec, link};
 use vworks_wslc::{Diagnostic, Sources};
+
+pub mod params;
+pub mod variants;
+
+use variants::{Cache, Compiled};
+pub use variants::{Loader, Override};
 
 /// Why a workcell could not be loaded.
 #[derive(Debug, thiserror::Error)]
@@ -86,6 +98,9 @@ struct RobotFile {
     default_zone: Option<toml::Value>,
     jerk: Option<toml::Value>,
     home: Option<Vec<toml::Value>>,
+    /// Values of its program's `param`s (`[robot.params]`).
+    #[serde(default)]
+    params: BTreeMap<String, toml::Value>,
     /// Allowed pairs may follow any table (TOML puts a key after `[[robot]]` into it).
     #[serde(default)]
     allow_collision: Vec<Vec<String>>,
@@ -121,6 +136,9 @@ struct CellFile {
     part: Vec<BodyFile>,
     #[serde(default)]
     allow_collision: Vec<Vec<String>>,
+    /// Values of the programs' `param`s (`[params]`), for every program that declares them.
+    #[serde(default)]
+    params: BTreeMap<String, toml::Value>,
 }
 
 /// A robot of the cell.
@@ -194,6 +212,9 @@ pub struct Cell {
     /// warnings: `vworks run` prints them as `vworks check` does, and every run's result
     /// lists them (`vworks_se::engine::RunResult::warnings`).
     pub warnings: Vec<Diagnostic>,
+    /// The values a [`Loader`] changed from the workcell file: (path, value as TOML), in
+    /// order (empty for the file as written).
+    pub overrides: Vec<(String, String)>,
 }
 
 impl Cell {
@@ -526,6 +547,12 @@ pub fn load(path: &Path) -> Result<Cell, CellError> {
 /// Loads a workcell, reading it and every file it names (programs, URDFs, meshes) from
 /// `files`: the disk, or memory ([`MemoryFiles`]).
 pub fn load_with(path: &Path, fs: &dyn Files) -> Result<Cell, CellError> {
+    let (text, cf) = read_cell_file(path, fs)?;
+    load_parsed(path, &text, cf, fs, &Cache::default())
+}
+
+/// The workcell file's text and its parsed form (errors with line and column).
+fn read_cell_file(path: &Path, fs: &dyn Files) -> Result<(String, CellFile), CellError> {
     let file = path.display().to_string();
     let bytes = fs.read(path).map_err(|e| CellError::Read {
         file: file.clone(),
@@ -557,6 +584,23 @@ pub fn load_with(path: &Path, fs: &dyn Files) -> Result<Cell, CellError> {
             format!("{msg}; the workcell format, key by key, is in docs/engine.md"),
         )
     })?;
+    Ok((text, cf))
+}
+
+/// Loads a parsed workcell: `text` is the file's text (kept in [`Cell::sources`]);
+/// programs and models come from `cache` when it has them.
+fn load_parsed(
+    path: &Path,
+    text: &str,
+    cf: CellFile,
+    fs: &dyn Files,
+    cache: &Cache,
+) -> Result<Cell, CellError> {
+    let file = path.display().to_string();
+    let cx = Ctx {
+        file: &file,
+        files: fs,
+    };
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let cycle = match &cf.cycle {
         Some(v) => cx.quantity(v, Dim::TIME, "cycle")?,
@@ -607,16 +651,25 @@ pub fn load_with(path: &Path, fs: &dyn Files) -> Result<Cell, CellError> {
         names.push(n);
     }
 
-    let mut sources = vec![(file.clone(), text.clone())];
+    let mut sources = vec![(file.clone(), text.to_string())];
     let mut files: Vec<(String, Vec<u8>)> = Vec::new();
     let mut robots = Vec::new();
     let mut modules: Vec<(String, Arc<Module>)> = Vec::new();
     let mut diagnostics = Vec::new();
     let mut warnings = Vec::new();
     let mut render_sources = Sources::new();
+    let mut param_copies = Vec::new();
     for (i, r) in cf.robot.iter().enumerate() {
         let key = format!("robot[{i}] `{}`", r.name);
-        let mut model = match (&r.model, &r.urdf) {
+        let model_key = format!(
+            "{:?}|{:?}|{:?}|{:?}|{:?}",
+            r.model, r.urdf, r.tool_link, r.package_path, r.jerk
+        );
+        let model = if let Some((m, urdf)) = cache.model(&model_key) {
+            files.extend(urdf);
+            m
+        } else {
+            let mut model = match (&r.model, &r.urdf) {
             (Some(m), None) => {
                 builtin::load(m).map_err(|e| cx.bad(&format!("{key}.model"), e.to_string()))?
             }
@@ -645,9 +698,15 @@ pub fn load_with(path: &Path, fs: &dyn Files) -> Result<Cell, CellError> {
                 "give either `model` (a built-in robot) or `urdf` (a file), not both or neither",
             )),
         };
-        if let Some(jerk) = &r.jerk {
-            cx.override_jerk(&mut model, jerk, &format!("{key}.jerk"))?;
-        }
+            if let Some(jerk) = &r.jerk {
+                cx.override_jerk(&mut model, jerk, &format!("{key}.jerk"))?;
+            }
+            let urdf = r.urdf.as_ref().and_then(|u| {
+                let upath = dir.join(u).display().to_string();
+                files.iter().find(|(f, _)| *f == upath).cloned()
+            });
+            cache.keep_model(model_key, Arc::new(model), urdf)
+        };
         let serve_only = r.serve_only.unwrap_or(false);
         let Some(program) = &r.program else {
             return Err(cx.bad(
@@ -660,30 +719,54 @@ pub fn load_with(path: &Path, fs: &dyn Files) -> Result<Cell, CellError> {
         let module = match modules.iter().find(|(p, _)| *p == pname) {
             Some((_, m)) => Arc::clone(m),
             None => {
-                let bytes = fs.read(&ppath).map_err(|e| {
-                    cx.bad(
-                        &format!("{key}.program"),
-                        format!("cannot read `{pname}`: {e}{}", read_hint(&e)),
-                    )
-                })?;
-                let src = vworks_wslc::source_text(bytes)
-                    .map_err(|e| cx.bad(&format!("{key}.program"), format!("{pname}: {e}")))?;
-                render_sources.add(&pname, &src);
-                sources.push((pname.clone(), src.clone()));
-                match vworks_wslc::compile(&pname, &src) {
-                    Ok(out) => {
-                        warnings.extend(out.warnings);
-                        let m = Arc::new(out.module);
-                        modules.push((pname.clone(), Arc::clone(&m)));
-                        m
+                let compiled = match cache.program(&pname) {
+                    Some(c) => c,
+                    None => {
+                        let bytes = fs.read(&ppath).map_err(|e| {
+                            cx.bad(
+                                &format!("{key}.program"),
+                                format!("cannot read `{pname}`: {e}{}", read_hint(&e)),
+                            )
+                        })?;
+                        let src = vworks_wslc::source_text(bytes).map_err(|e| {
+                            cx.bad(&format!("{key}.program"), format!("{pname}: {e}"))
+                        })?;
+                        let result = vworks_wslc::compile(&pname, &src)
+                            .map(|out| (Arc::new(out.module), out.warnings))
+                            .map_err(|e| e.diagnostics);
+                        cache.keep_program(
+                            &pname,
+                            Compiled {
+                                source: src,
+                                result,
+                            },
+                        )
                     }
-                    Err(e) => {
-                        diagnostics.extend(e.diagnostics);
+                };
+                render_sources.add(&pname, &compiled.source);
+                sources.push((pname.clone(), compiled.source.clone()));
+                match &compiled.result {
+                    Ok((m, w)) => {
+                        warnings.extend(w.iter().cloned());
+                        modules.push((pname.clone(), Arc::clone(m)));
+                        Arc::clone(m)
+                    }
+                    Err(d) => {
+                        diagnostics.extend(d.iter().cloned());
                         continue;
                     }
                 }
             }
         };
+        let module = params::apply(
+            &cx,
+            &key,
+            &pname,
+            module,
+            &r.params,
+            &cf.params,
+            &mut param_copies,
+        )?;
         let home = match &r.home {
             None => vec![0.0; model.dof()],
             Some(v) => {
@@ -766,7 +849,7 @@ pub fn load_with(path: &Path, fs: &dyn Files) -> Result<Cell, CellError> {
                 name: r.name.clone(),
                 base: cx.pose(r.base.as_ref(), &format!("{key}.base"))?,
                 tool: cx.pose(r.tool.as_ref(), &format!("{key}.tool"))?,
-                model: Arc::new(model),
+                model,
                 module,
                 program: pname,
                 entry,
@@ -777,6 +860,9 @@ pub fn load_with(path: &Path, fs: &dyn Files) -> Result<Cell, CellError> {
             entry_name,
             serve_only,
         ));
+    }
+    if diagnostics.is_empty() {
+        params::check_cell_params(&cx, &cf.params, &modules)?;
     }
     if !diagnostics.is_empty() {
         let rendered = vworks_wslc::render(&diagnostics, &render_sources, false);
@@ -881,5 +967,6 @@ pub fn load_with(path: &Path, fs: &dyn Files) -> Result<Cell, CellError> {
             .chain(linked.warnings.iter().cloned())
             .collect(),
         linked,
+        overrides: Vec::new(),
     })
 }

@@ -178,7 +178,7 @@ fn truncated_and_foreign_files_are_load_errors() {
         Module::decode(&v),
         Err(LoadError::Version {
             found: 9,
-            supported: 1
+            supported: vworks_vm::bytecode::FORMAT_VERSION
         })
     );
     assert_eq!(Module::decode(b"\x7fELF"), Err(LoadError::BadMagic));

@@ -75,6 +75,8 @@ codes! {
     E0070 = "not allowed in a function",
     E0080 = "initializer is not constant",
     E0081 = "global of a non-scalar type",
+    E0082 = "parameter of a non-scalar type",
+    E0083 = "parameter without a default value",
     E0100 = "global disagrees across modules",
     E0101 = "unknown robot",
     E0102 = "remote procedure missing",

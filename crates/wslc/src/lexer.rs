@@ -39,6 +39,7 @@ pub enum TokKind {
 #[allow(missing_docs)]
 pub enum Kw {
     Global,
+    Param,
     Const,
     Var,
     Proc,
@@ -81,6 +82,7 @@ pub enum Kw {
 /// Every reserved word with its spelling.
 pub const KEYWORDS: &[(&str, Kw)] = &[
     ("global", Kw::Global),
+    ("param", Kw::Param),
     ("const", Kw::Const),
     ("var", Kw::Var),
     ("proc", Kw::Proc),

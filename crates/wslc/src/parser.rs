@@ -256,7 +256,7 @@ impl Parser<'_, '_> {
                 TokKind::Eof => return,
                 TokKind::P(Punct::LBrace) => depth += 1,
                 TokKind::P(Punct::RBrace) => depth = depth.saturating_sub(1),
-                TokKind::Kw(Kw::Proc | Kw::Func | Kw::Global | Kw::Const | Kw::Var)
+                TokKind::Kw(Kw::Proc | Kw::Func | Kw::Global | Kw::Const | Kw::Var | Kw::Param)
                     if depth == 0 =>
                 {
                     return;
@@ -287,6 +287,7 @@ impl Parser<'_, '_> {
     fn item(&mut self) -> PResult<Item> {
         match self.kind() {
             TokKind::Kw(Kw::Global) => self.var_decl(Kw::Global).map(Item::Global),
+            TokKind::Kw(Kw::Param) => self.var_decl(Kw::Param).map(Item::Param),
             TokKind::Kw(Kw::Const) => self.var_decl(Kw::Const).map(Item::Const),
             TokKind::Kw(Kw::Var) => self.var_decl(Kw::Var).map(Item::Var),
             TokKind::Kw(Kw::Proc | Kw::Func) => self.proc_decl().map(Item::Proc),
@@ -296,7 +297,7 @@ impl Parser<'_, '_> {
                 let mut d = Diagnostic::error(
                     Code::E0005,
                     format!(
-                        "expected a declaration (global, const, var, proc or func), found {found}"
+                        "expected a declaration (global, const, param, var, proc or func), found {found}"
                     ),
                     t.span,
                 );
@@ -450,7 +451,7 @@ impl Parser<'_, '_> {
         };
         match kw {
             Kw::Var => Ok(StmtKind::Var(self.var_decl(Kw::Var)?)),
-            Kw::Const | Kw::Global | Kw::Proc | Kw::Func => {
+            Kw::Const | Kw::Global | Kw::Param | Kw::Proc | Kw::Func => {
                 let d = Diagnostic::error(
                     Code::E0005,
                     format!(

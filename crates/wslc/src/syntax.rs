@@ -59,13 +59,15 @@ pub enum Item {
     Global(VarDecl),
     /// `const name = value;`
     Const(VarDecl),
+    /// `param name = value;`: a constant a workcell or a sweep may override.
+    Param(VarDecl),
     /// `var name = value;`
     Var(VarDecl),
     /// `proc` or `func`.
     Proc(ProcDecl),
 }
 
-/// `var`/`const`/`global` declaration.
+/// `var`/`const`/`global`/`param` declaration.
 #[derive(Clone, Debug, PartialEq)]
 pub struct VarDecl {
     /// Name.

@@ -31,8 +31,9 @@ pub fn disassemble(m: &Module, source: Option<&str>) -> String {
         for v in &m.vars {
             let _ = writeln!(
                 o,
-                "v{:<3} var {}: {} = {}  ; {}",
+                "v{:<3} {} {}: {} = {}  ; {}",
                 v.slot,
+                if v.param { "param" } else { "var" },
                 m.str(v.name),
                 v.ty,
                 v.init.display(v.ty),

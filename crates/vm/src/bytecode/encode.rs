@@ -19,7 +19,7 @@ use crate::types::{ConstValue, Dim, MAX_AXES, Type};
 /// The first four bytes of every `.wslb` file.
 pub const MAGIC: [u8; 4] = *b"WSLB";
 /// The format version this build writes and reads.
-pub const FORMAT_VERSION: u16 = 1;
+pub const FORMAT_VERSION: u16 = 2;
 
 const SECTIONS: [&[u8; 4]; 15] = [
     b"SRC_", b"STRS", b"CNST", b"GLOB", b"VARS", b"PROC", b"CODE", b"COND", b"WHEN", b"RMTE",
@@ -148,6 +148,7 @@ impl Module {
                 w.u32(v.slot);
                 w.value(&v.init);
                 w.pos(v.pos);
+                w.u8(u8::from(v.param));
             }
         });
         w.section(SECTIONS[5], |w| {
@@ -336,13 +337,22 @@ impl Module {
                 }
                 4 => {
                     m.var_slots = s.u32()?;
-                    m.vars = s.list(19, |s| {
+                    m.vars = s.list(20, |s| {
                         Ok(VarInfo {
                             name: s.u32()?,
                             ty: s.ty()?,
                             slot: s.u32()?,
                             init: s.value()?,
                             pos: s.pos()?,
+                            param: match s.u8()? {
+                                0 => false,
+                                1 => true,
+                                other => {
+                                    return Err(s.error(format!(
+                                        "a variable's param flag is {other}, not 0 or 1"
+                                    )));
+                                }
+                            },
                         })
                     })?
                 }

@@ -181,7 +181,7 @@ pub struct GlobalInfo {
     pub pos: SrcPos,
 }
 
-/// A module-level `var`: lives for the whole run, private to the robot.
+/// A module-level `var` or `param`: lives for the whole run, private to the robot.
 #[derive(Clone, PartialEq, Debug)]
 pub struct VarInfo {
     /// Name (string index).
@@ -190,10 +190,13 @@ pub struct VarInfo {
     pub ty: Type,
     /// First slot in the module-variable area.
     pub slot: u32,
-    /// Initial value.
+    /// Initial value (for a `param`, its default, which the cell loader may replace).
     pub init: ConstValue,
     /// Declaration site.
     pub pos: SrcPos,
+    /// A `param`: read-only in the program, its initial value set by the workcell or a
+    /// sweep (`vworks_cell`).
+    pub param: bool,
 }
 
 /// A local copied into a condition or handler when it is created (by value).

@@ -443,6 +443,22 @@ impl Compiler<'_> {
                 );
                 Out::of(ty)
             }
+            Some(Sym::Param(slot, ty)) => {
+                if self.fk() == FnKind::Init {
+                    return self.not_const(n, "a parameter (a workcell may set it)", sp);
+                }
+                // Fixed for the whole run: reading it is pure (functions, conditions).
+                let w = ty.width();
+                self.emit(
+                    if w == 1 {
+                        Instr::LoadVar(slot)
+                    } else {
+                        Instr::LoadVarN(slot, w)
+                    },
+                    sp,
+                );
+                Out::of(ty)
+            }
             Some(Sym::Global(g, ty)) => {
                 if self.fk() == FnKind::Init {
                     return self.not_const(n, "a global", sp);

@@ -140,6 +140,8 @@ enum Sym {
     Global(u32, Ty),
     Const(Ty, ConstValue),
     Var(u32, Ty),
+    /// A `param`: a module variable the program only reads.
+    Param(u32, Ty),
     Proc(u32),
 }
 

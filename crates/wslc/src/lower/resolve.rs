@@ -157,6 +157,7 @@ impl Compiler<'_> {
             match item {
                 Item::Global(d) => self.global_decl(d),
                 Item::Const(d) => self.const_decl(d),
+                Item::Param(d) => self.param_decl(d),
                 Item::Var(d) => self.var_decl(d),
                 Item::Proc(_) => {}
             }
@@ -272,8 +273,47 @@ impl Compiler<'_> {
         let Some((ty, v)) = self.init_value(d, "variable") else {
             return;
         };
+        self.module_var(d, ty, v, false);
+    }
+
+    /// `param name = default;`: a module variable the program reads and the cell loader
+    /// may set (a bool, an int or a number with its unit, like a global).
+    pub(super) fn param_decl(&mut self, d: &VarDecl) {
+        if d.init.is_none() {
+            self.err(
+                Diagnostic::error(
+                    Code::E0083,
+                    format!("parameter `{}` has no default value", d.name.name),
+                    d.name.span,
+                )
+                .with_help(format!(
+                    "give the value it has when no workcell or sweep sets it: `param {}: … = …;`",
+                    d.name.name
+                )),
+            );
+            return;
+        }
+        let Some((ty, v)) = self.init_value(d, "parameter") else {
+            return;
+        };
+        if !matches!(ty, Ty::Bool | Ty::Int | Ty::Num(_)) {
+            self.err(
+                Diagnostic::error(Code::E0082, format!("parameter `{}` would be {}", d.name.name, ty.described()), d.name.span)
+                    .with_help("parameters are bool, int or a number (with any unit), so that a workcell can set them; build poses from them in the program"),
+            );
+        }
+        // (Declared even when wrong, so that its uses do not add `unknown name` errors.)
+        self.module_var(d, ty, v, true);
+    }
+
+    fn module_var(&mut self, d: &VarDecl, ty: Ty, v: ConstValue, param: bool) {
         let slot = self.m.var_slots;
-        if self.declare(&d.name, Sym::Var(slot, ty)) {
+        let sym = if param {
+            Sym::Param(slot, ty)
+        } else {
+            Sym::Var(slot, ty)
+        };
+        if self.declare(&d.name, sym) {
             self.m.var_slots += u32::from(ty.width());
             let name = self.str(&d.name.name);
             let pos = self.pos(d.name.span);
@@ -283,6 +323,7 @@ impl Compiler<'_> {
                 slot,
                 init: v,
                 pos,
+                param,
             });
         }
     }

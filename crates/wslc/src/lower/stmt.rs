@@ -476,6 +476,13 @@ impl Compiler<'_> {
                     self.not_assignable(base_span, &format!("the constant `{base_name}`"));
                     return;
                 }
+                Some(Sym::Param(..)) => {
+                    self.not_assignable(
+                        base_span,
+                        &format!("the parameter `{base_name}` (the workcell or a sweep sets it)"),
+                    );
+                    return;
+                }
                 Some(Sym::Proc(_)) => {
                     self.not_assignable(base_span, &format!("the procedure `{base_name}`"));
                     return;
