@@ -30,6 +30,8 @@ pub mod variants;
 
 use variants::{Cache, Compiled};
 pub use variants::{Loader, Override};
+/// Quantities as a workcell reads them (`"250mm"`, `0.25`), with WSL's units.
+pub use vworks_wslc::units::{Quantity, parse_quantity};
 
 /// Why a workcell could not be loaded.
 #[derive(Debug, thiserror::Error)]
@@ -337,7 +339,7 @@ impl Ctx<'_> {
         match v {
             toml::Value::Integer(i) => Ok(*i as f64),
             toml::Value::Float(x) if x.is_finite() => Ok(*x),
-            toml::Value::String(s) => match vworks_wslc::units::parse_quantity(s) {
+            toml::Value::String(s) => match parse_quantity(s) {
                 Some(q) => q.si(dim).map_err(|d| {
                     self.bad(
                         key,
