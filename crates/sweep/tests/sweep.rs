@@ -1,0 +1,204 @@
+//! Sweeps: the file's variants, running them (the same table whatever the threads), and
+//! each row equal to a plain run of the workcell written out with that variant's values.
+
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use vworks_cell::{Disk, Loader, MemoryFiles, Override};
+use vworks_sweep::run::{RunOptions, run_one};
+use vworks_sweep::{Combine, Sweep, Table, run_variants};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn sweep_of(text: &str) -> Result<Sweep, String> {
+    let mut files = MemoryFiles::default();
+    files.insert("s/sweep.toml", text.as_bytes().to_vec());
+    Sweep::read(Path::new("s/sweep.toml"), &files).map_err(|e| e.to_string())
+}
+
+#[test]
+fn a_product_varies_the_last_variable_fastest_and_zip_pairs_them() {
+    let s = sweep_of(
+        "cell = \"cell.toml\"\n[[variable]]\npath = \"cycle\"\nvalues = [\"2ms\", \"4ms\"]\n[[variable]]\npath = [\"params.a\", \"params.b\"]\nrange = { from = 1, to = 3, steps = 3 }\n",
+    )
+    .unwrap();
+    assert_eq!(s.cell, Path::new("s/cell.toml"));
+    assert_eq!(s.combine, Combine::Product);
+    let v = s.variants();
+    assert_eq!(v.len(), 6);
+    let show = |o: &[Override]| {
+        o.iter()
+            .map(|o| format!("{}={}", o.path, o.value))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    assert_eq!(show(&v[0]), "cycle=\"2ms\" params.a=1 params.b=1");
+    assert_eq!(show(&v[1]), "cycle=\"2ms\" params.a=2 params.b=2");
+    assert_eq!(show(&v[5]), "cycle=\"4ms\" params.a=3 params.b=3");
+    let z = sweep_of(
+        "cell = \"c.toml\"\ncombine = \"zip\"\n[[variable]]\npath = \"cycle\"\nvalues = [\"2ms\", \"4ms\"]\n[[variable]]\npath = \"clearance\"\nrange = { from = \"1mm\", to = \"3mm\", steps = 2 }\n",
+    )
+    .unwrap();
+    let v = z.variants();
+    assert_eq!(v.len(), 2);
+    assert_eq!(show(&v[1]), "cycle=\"4ms\" clearance=0.003");
+}
+
+#[test]
+fn random_samples_depend_on_the_seed_only() {
+    let text = |seed: u64| {
+        format!(
+            "cell = \"c.toml\"\nseed = {seed}\n[[variable]]\npath = \"clearance\"\nrandom = {{ from = \"1mm\", to = \"5mm\", count = 50 }}\n"
+        )
+    };
+    let a = sweep_of(&text(7)).unwrap().variants();
+    assert_eq!(a, sweep_of(&text(7)).unwrap().variants());
+    assert_ne!(a, sweep_of(&text(8)).unwrap().variants());
+    let xs: Vec<f64> = a.iter().map(|o| o[0].value.as_float().unwrap()).collect();
+    assert!(xs.iter().all(|x| (0.001..0.005).contains(x)), "{xs:?}");
+    // Spread over the interval, not stuck: both halves are hit.
+    assert!(xs.iter().any(|x| *x < 0.003) && xs.iter().any(|x| *x > 0.003));
+}
+
+#[test]
+fn wrong_sweep_files_say_what_to_write() {
+    let cases = [
+        ("cell = \"c.toml\"\n", "at least one [[variable]]"),
+        (
+            "cell = \"c.toml\"\n[[variable]]\npath = \"cycle\"\nvalues = [1]\nrange = { from = 1, to = 2, steps = 2 }\n",
+            "exactly one of",
+        ),
+        (
+            "cell = \"c.toml\"\ncombine = \"zip\"\n[[variable]]\npath = \"cycle\"\nvalues = [1, 2]\n[[variable]]\npath = \"clearance\"\nvalues = [1]\n",
+            "as many values",
+        ),
+        (
+            "cell = \"c.toml\"\ncombine = \"cross\"\n[[variable]]\npath = \"cycle\"\nvalues = [1]\n",
+            "\"product\" or \"zip\"",
+        ),
+        (
+            "cell = \"c.toml\"\n[[variable]]\npath = \"cycle\"\nrange = { from = \"1mm\", to = \"2s\", steps = 2 }\n",
+            "same unit",
+        ),
+        (
+            "cell = \"c.toml\"\n[[variable]]\npath = 3\nvalues = [1]\n",
+            "a path is a string",
+        ),
+        ("cell = \"c.toml\"\nvariabel = 1\n", "docs/sweep.md"),
+    ];
+    for (text, want) in cases {
+        let e = sweep_of(text).unwrap_err();
+        assert!(e.contains(want), "{text}: {e}");
+        assert!(e.starts_with("s/sweep.toml: "), "{e}");
+    }
+}
+
+#[test]
+fn the_table_is_the_same_whatever_the_threads() {
+    let sweep = Sweep::read(&root().join("workcells/handoff/sweep.toml"), &Disk).unwrap();
+    let loader = Loader::new(&sweep.cell, &Disk).unwrap();
+    // Every 4th variant of the 121 (a product of 11 × 11), plus one that cannot load.
+    let mut variants: Vec<Vec<Override>> = sweep.variants().into_iter().step_by(4).collect();
+    variants.push(vec![Override::new("robot.r2.base.xyz.0", "tall")]);
+    let robots = vec!["r1".to_string(), "r2".to_string()];
+    let names = vec![
+        "robot.r2.base.xyz.0".to_string(),
+        "robot.r2.base.xyz.1".to_string(),
+    ];
+    let mut tables = Vec::new();
+    for jobs in [1, 2, 3] {
+        let options = RunOptions {
+            jobs,
+            ..RunOptions::default()
+        };
+        let rows = run_variants(&loader, &variants, &options, &|_| {}, None);
+        assert_eq!(rows.len(), variants.len());
+        assert!(rows.iter().enumerate().all(|(i, r)| r.index == i));
+        tables.push(Table::new(&names, &robots, &rows).csv());
+    }
+    assert_eq!(tables[0], tables[1]);
+    assert_eq!(tables[0], tables[2]);
+    let last = tables[0].lines().last().unwrap();
+    assert!(
+        last.contains(",invalid,") && last.contains("tall"),
+        "{last}"
+    );
+    // Outcomes of all kinds: completed, collision, error (unreachable).
+    for o in [",completed,", ",collision,", ",error,"] {
+        assert!(tables[0].contains(o), "{o}");
+    }
+}
+
+#[test]
+fn a_row_is_the_run_of_the_workcell_written_with_its_values() {
+    // The variant r2 at x 500 mm, y 600 mm, against the cell file edited by hand to say so.
+    let loader = Loader::new(&root().join("workcells/handoff/cell.toml"), &Disk).unwrap();
+    let variant = [
+        Override::new("robot.r2.base.xyz.0", "500mm"),
+        Override::new("robot.r2.params.base_x", "500mm"),
+        Override::new("robot.r2.base.xyz.1", "600mm"),
+        Override::new("robot.r2.params.base_y", "600mm"),
+    ];
+    let row = run_one(&loader, 0, &variant, &RunOptions::default());
+    let dir = std::env::temp_dir().join(format!("vworks-sweep-edit-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for f in ["r1.wsl", "r2.wsl"] {
+        std::fs::copy(root().join("workcells/handoff").join(f), dir.join(f)).unwrap();
+    }
+    let text = std::fs::read_to_string(root().join("workcells/handoff/cell.toml")).unwrap();
+    let edited = text.replacen(
+        "base = { xyz = [\"600mm\", \"600mm\", \"0mm\"]",
+        "params = { base_x = \"500mm\", base_y = \"600mm\" }\nbase = { xyz = [\"500mm\", \"600mm\", \"0mm\"]",
+        1,
+    );
+    assert_ne!(edited, text);
+    std::fs::write(dir.join("cell.toml"), edited).unwrap();
+    let cell = Arc::new(vworks_cell::load(&dir.join("cell.toml")).unwrap());
+    let plain = vworks_se::engine::Simulation::new(cell).run(None);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(row.outcome, plain.outcome.name());
+    assert_eq!(row.end_time, plain.end_time_ns as f64 / 1e9);
+    assert_eq!(row.end_time, 62.916117313);
+    assert_eq!(
+        row.cycle_times,
+        plain
+            .robots
+            .iter()
+            .map(|r| (r.name.clone(), Some(r.end_time_ns as f64 / 1e9)))
+            .collect::<Vec<_>>()
+    );
+}
+
+#[test]
+fn the_best_are_completed_without_collision_smallest_first() {
+    let sweep = Sweep::read(&root().join("workcells/handoff/sweep.toml"), &Disk).unwrap();
+    let loader = Loader::new(&sweep.cell, &Disk).unwrap();
+    let variants: Vec<Vec<Override>> = sweep.variants().into_iter().step_by(3).collect();
+    let rows = run_variants(&loader, &variants, &RunOptions::default(), &|_| {}, None);
+    let names = vec!["robot.r2.base.xyz.0".to_string()];
+    let table = Table::new(&names, &["r1".into(), "r2".into()], &rows);
+    let feasible: Vec<bool> = rows.iter().map(vworks_sweep::Row::feasible).collect();
+    let best = table.best("end_time", 3, &feasible).unwrap();
+    assert_eq!(best.len(), 3);
+    let k = table.column("end_time").unwrap();
+    let t = |i: usize| table.rows[i][k].number().unwrap();
+    assert!(t(best[0]) <= t(best[1]) && t(best[1]) <= t(best[2]));
+    for (i, r) in rows.iter().enumerate() {
+        if r.feasible() {
+            assert!(t(i) >= t(best[0]));
+        }
+    }
+    assert!(
+        best.iter()
+            .all(|i| rows[*i].outcome == "completed" && rows[*i].collisions == 0)
+    );
+    let e = table.best("speed", 3, &feasible).unwrap_err();
+    assert!(e.contains("end_time") && e.contains("cycle_time.r1"), "{e}");
+    // The page charts the objective over the one variable named (a scatter).
+    let page = vworks_sweep::html::page("t", &table, &names, "end_time", &feasible, &best);
+    assert!(page.contains("<svg id=\"chart\"") && page.contains("class=\"feasible\""));
+}
