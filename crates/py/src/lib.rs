@@ -22,6 +22,8 @@ use vworks_se::engine::{Issue, Outcome, RunResult, TraceEvent, Value};
 use vworks_se::mcaplog::{LoggedEvent, McapLog};
 use vworks_wslc::Diagnostic as WslDiagnostic;
 
+mod sweep;
+
 create_exception!(
     vworks,
     Error,
@@ -1123,6 +1125,8 @@ fn _vworks(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(load_cell, m)?)?;
     m.add_function(wrap_pyfunction!(read_log, m)?)?;
     m.add_function(wrap_pyfunction!(write_report, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep::run_variants, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep::cell_files, m)?)?;
     m.add_class::<Module>()?;
     m.add_class::<Diagnostic>()?;
     m.add_class::<Cell>()?;

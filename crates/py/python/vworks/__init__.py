@@ -35,6 +35,7 @@ from ._vworks import (
     read_log,
     write_report,
 )
+from ._sweep import sweep
 
 __all__ = [
     "Cell",
@@ -57,5 +58,6 @@ __all__ = [
     "compile",
     "load_cell",
     "read_log",
+    "sweep",
     "write_report",
 ]

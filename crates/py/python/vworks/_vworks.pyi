@@ -103,6 +103,20 @@ def load_cell(path: Union[str, os.PathLike[str]]) -> Cell:
 def read_log(path: Union[str, os.PathLike[str]]) -> EventList:
     """The events of an MCAP log written by vworks."""
 
+def run_variants(
+    cell: Union[str, os.PathLike[str]],
+    variants: list[list[tuple[str, Union[float, int, str, bool]]]],
+    variables: list[str],
+    jobs: Optional[int] = None,
+    until: Optional[float] = None,
+    files: Optional[dict[str, bytes]] = None,
+    offset: int = 0,
+) -> tuple[list[str], list[list[Any]]]:
+    """Runs variants of a workcell; the sweep table's columns and rows (see vworks.sweep)."""
+
+def cell_files(cell: Union[str, os.PathLike[str]]) -> dict[str, bytes]:
+    """Every file the workcell reads, by the paths the loader uses."""
+
 def write_report(
     log: Union[str, os.PathLike[str]], output: Optional[Union[str, os.PathLike[str]]] = None
 ) -> pathlib.Path:
