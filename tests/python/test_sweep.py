@@ -133,3 +133,22 @@ def test_the_package_imports_without_ray_or_dask():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
     assert "pip install 'vworks[ray]'" in out.stdout
+
+
+def test_keep_logs_writes_each_variants_log_with_its_values(tmp_path):
+    from mcap.reader import make_reader
+
+    sweep = tmp_path / "sweep.toml"
+    sweep.write_text(
+        f'cell = "{CELL}"\nuntil = "2s"\n[[variable]]\npath = "robot.r2.base.xyz.0"\nvalues = ["600mm", 0.65]\n'
+    )
+    logs = tmp_path / "logs"
+    out = subprocess.run([VWORKS, "sweep", str(sweep), "--keep-logs", str(logs), "-o", str(tmp_path / "t.jsonl")],
+                         capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    assert sorted(p.name for p in logs.iterdir()) == ["variant-00000.mcap", "variant-00001.mcap"]
+    with open(logs / "variant-00001.mcap", "rb") as f:
+        (meta,) = [m for m in make_reader(f).iter_metadata() if m.name == "vworks"]
+    assert meta.metadata["overrides"] == "robot.r2.base.xyz.0 = 0.65"
+    lines = (tmp_path / "t.jsonl").read_text().splitlines()
+    assert len(lines) == 2 and lines[1].startswith('{"variant":1,"robot.r2.base.xyz.0":0.65,"outcome":"until"')

@@ -296,6 +296,16 @@ fn open(
     meta.insert("seed".to_string(), "none (deterministic)".to_string());
     let robots: Vec<&str> = cell.robots.iter().map(|r| r.name.as_str()).collect();
     meta.insert("robots".to_string(), robots.join(","));
+    // A sweep's variant: the values changed from the attached workcell file, one
+    // `path = value` per line (TOML values).
+    if !cell.overrides.is_empty() {
+        let lines: Vec<String> = cell
+            .overrides
+            .iter()
+            .map(|(p, v)| format!("{p} = {v}"))
+            .collect();
+        meta.insert("overrides".to_string(), lines.join("\n"));
+    }
     w.write_metadata(&mcap::records::Metadata {
         name: "vworks".into(),
         metadata: meta,
