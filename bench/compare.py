@@ -22,9 +22,11 @@ cargo. `--profile` needs `perf`.
 """
 
 import argparse
+import json
 import os
 import platform
 import re
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -326,6 +328,22 @@ def profile(bench, filt):
 # --- the report ----------------------------------------------------------------------
 
 
+def whole_process(cell, runs=7):
+    """`vworks run CELL` as a whole process (load included), release build: the median wall
+    time of `runs` runs and the simulated span, as (seconds, simulated seconds)."""
+    exe = os.path.join(ROOT, "target", "release", "vworks")
+    subprocess.run(["cargo", "build", "--release", "--locked", "-q", "-p", "vworks-cli"], cwd=ROOT,
+                   check=True)
+    out = subprocess.run([exe, "run", cell, "--json"], capture_output=True, text=True, check=True)
+    simulated = json.loads(out.stdout)["end_time_ns"] / 1e9
+    times = []
+    for _ in range(runs):
+        start = time.perf_counter()
+        subprocess.run([exe, "run", cell, "-q"], capture_output=True, check=True)
+        times.append(time.perf_counter() - start)
+    return statistics.median(times), simulated
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--profile", action="store_true", help="also profile (b) and (c) with perf")
@@ -341,6 +359,10 @@ def main():
     pb_s = pybullet(qs, bases)
     print("(c) SimPy...", file=sys.stderr)
     simpy = simpy_rates()
+    print("(e) whole processes...", file=sys.stderr)
+    shared = os.path.join(ROOT, "bench", "cells", "shared4", "cell.toml")
+    e_s, e_sim = whole_process(shared)
+    g_s, g_sim = whole_process(CELL)
     shares = None
     if args.profile:
         print("profiles (perf)...", file=sys.stderr)
@@ -389,6 +411,10 @@ def main():
       f"{max(vs.values()):.1f}× | {yes(min(vs.values()) >= 50)} |")
     r64 = d[64][0] / d[4][0]
     w(f"| (d) 64 robots ≤ 20× the per-cycle cost of 4 | {r64:.1f}× | {yes(r64 <= 20)} |")
+    e_x = e_sim / e_s
+    w(f"| (e) 60 s, 4 robots around one shared table (`bench/cells/shared4`), `vworks run` as a "
+      f"whole process: ≥ 1000× real time | {e_x:.0f}× ({e_s * 1e3:.0f} ms for {e_sim:.1f} s; "
+      f"grid4 the same way: {g_sim / g_s:.0f}×) | {yes(e_x >= 1000)} |")
     w("")
     w("## (a) Per-cycle FK + collision checks: vworks, Pinocchio + coal, PyBullet")
     w("")
