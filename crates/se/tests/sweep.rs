@@ -268,6 +268,69 @@ fn adaptive_checking_finds_what_the_exhaustive_check_finds() {
 
 use proptest::prelude::Strategy as _;
 
+/// The collider's horizon (skipping boundaries no pair can come near before it) changes
+/// nothing the run reports: four arms working over one shared table, as it is, with the
+/// table raised into their way (they touch it) and with a clearance that makes near misses,
+/// give the trace the exhaustive check gives, with fewer queries.
+#[test]
+fn the_horizon_skips_only_what_cannot_matter() {
+    let dir = root().join("bench/cells/shared4");
+    let toml = std::fs::read_to_string(dir.join("cell.toml")).unwrap();
+    let side = std::fs::read_to_string(dir.join("side.wsl")).unwrap();
+    let variants = [
+        ("as-is", toml.clone()),
+        (
+            "raised",
+            toml.replace(
+                "box = [\"500mm\", \"500mm\", \"220mm\"]",
+                "box = [\"500mm\", \"500mm\", \"500mm\"]",
+            )
+            .replace(
+                "clearance = \"5mm\"",
+                "clearance = \"5mm\"\non_collision = \"continue\"",
+            ),
+        ),
+        (
+            "near",
+            toml.replace("clearance = \"5mm\"", "clearance = \"90mm\""),
+        ),
+    ];
+    for (name, text) in variants {
+        assert!(name == "as-is" || text != toml, "{name}");
+        let path = write_cell(
+            &format!("horizon-{name}"),
+            &[("cell.toml", &text), ("side.wsl", &side)],
+        );
+        let cell = Arc::new(load(&path).unwrap());
+        let run = |adaptive: bool| {
+            Simulation::new(Arc::clone(&cell))
+                .with_adaptive(adaptive)
+                .run(Some(12_000_000_000))
+        };
+        let (fast, all) = (run(true), run(false));
+        let lines = |r: &RunResult| r.trace.iter().map(|e| e.line(&cell)).collect::<Vec<_>>();
+        assert_eq!(lines(&fast), lines(&all), "{name}");
+        assert_eq!(fast.cycles, all.cycles, "{name}");
+        assert!(
+            fast.queries < all.queries,
+            "{name}: {} against {}",
+            fast.queries,
+            all.queries
+        );
+        let collisions = fast.collisions.len();
+        let near = fast
+            .warnings
+            .iter()
+            .filter(|w| w.kind == "near_miss")
+            .count();
+        match name {
+            "raised" => assert!(collisions > 0, "{name}"),
+            "near" => assert!(near > 0, "{name}"),
+            _ => assert_eq!((collisions, near), (0, 0)),
+        }
+    }
+}
+
 proptest::proptest! {
     #![proptest_config(proptest::prelude::ProptestConfig { cases: 16, ..Default::default() })]
 

@@ -124,6 +124,11 @@ pub const SWEEP_MIN_STEP_NS: i64 = 1_000;
 /// which the VM checks a Cartesian motion's axis speeds; the sweep's speed bounds include it.
 const SPEED_MARGIN: f64 = 1.25;
 
+/// How far ahead a boundary check proves that no two bodies come within the clearance
+/// ([`Collider::horizon`]): 0.1 s, 25 cycles of 4 ms. Longer proves more cycles at once
+/// but grows the boxes of the look-ahead broadphase (more pairs to bound).
+pub const HORIZON_NS: i64 = 100_000_000;
+
 /// Per moving joint on the path from the root to `link`: (joint index, the farthest any
 /// point within `extent` of the link's origin can be from the joint's axis).
 fn reach_of(
@@ -200,6 +205,16 @@ pub struct Collider {
     /// motions cannot bring it within the clearance, so its query can be skipped.
     /// Cleared whenever a motion starts or a part is gripped or released.
     safe_until: Vec<i64>,
+    /// No two bodies can come within the clearance before this time under the current
+    /// motions (`i64::MIN`: no such promise): the engine skips the sweeps and boundary
+    /// checks before it. See [`Collider::horizon`].
+    horizon: i64,
+    /// Scratch for the horizon: each body's speed bound, the boxes grown by the
+    /// look-ahead, their overlapping pairs.
+    body_speed: Vec<f64>,
+    ahead_boxes: Vec<Aabb>,
+    ahead: SweepAndPrune,
+    ahead_pairs: Vec<(usize, usize)>,
     /// Whether to skip queries by `safe_until` (see [`Collider::set_adaptive`]).
     adaptive: bool,
 }
@@ -363,6 +378,11 @@ impl Collider {
             sweep_scratch: SweepScratch::default(),
             checked_at: None,
             safe_until: vec![i64::MIN; n * n],
+            horizon: i64::MIN,
+            body_speed: Vec::new(),
+            ahead_boxes: Vec::new(),
+            ahead: SweepAndPrune::default(),
+            ahead_pairs: Vec::new(),
             adaptive: true,
             bodies,
         }
@@ -378,12 +398,31 @@ impl Collider {
     /// skipped queries no longer hold.
     pub fn motions_changed(&mut self) {
         self.safe_until.fill(i64::MIN);
+        self.horizon = i64::MIN;
+    }
+
+    /// Until when no two bodies can come within the clearance, as the last boundary check
+    /// proved it under the motions of that time (`i64::MIN` if it could not, or a motion,
+    /// grip or release has changed them since). Before it, a sweep finds no contact and a
+    /// boundary check no contact, near miss or parting: the engine skips them (and so the
+    /// joints, FK and boxes they need), which is what makes a cell whose robots work near
+    /// each other and near shared devices cheap between its close calls.
+    ///
+    /// The proof, at a check at `t` (adaptive checking on, no pair touching, near,
+    /// exempt, and no part held): every body's speed is at most `v_i` (its joints' speed
+    /// bounds × their lever arms); the pairs the check's broadphase kept have their
+    /// promises (`safe_until`); a pair whose boxes are apart but within the look-ahead's
+    /// reach closes at most at `v_i + v_j` from its boxes' distance; a pair farther apart
+    /// than that cannot close before the look-ahead ([`HORIZON_NS`]) ends.
+    pub fn horizon(&self) -> i64 {
+        self.horizon
     }
 
     /// Robot `r` starts a motion: the promises of the pairs with one of its bodies (its
     /// links, a part it holds) no longer hold; the others' still do. (Clearing all of them
     /// cost a memset of n² entries per motion start: 1.6 MB with 64 robots.)
     pub fn motion_started(&mut self, r: usize) {
+        self.horizon = i64::MIN;
         let n = self.bodies.len();
         for i in 0..n {
             let mine = match self.bodies[i].owner {
@@ -671,8 +710,90 @@ impl Collider {
         }
         self.touching = touching;
         self.near = near_now;
+        self.horizon = if self.adaptive {
+            self.prove_horizon(cell, t, &joint_speed)
+        } else {
+            i64::MIN
+        };
         self.sweep_scratch.disp = joint_speed;
         events
+    }
+
+    /// The horizon at a check at `t` (see [`Collider::horizon`]).
+    fn prove_horizon(&mut self, cell: &Cell, t: i64, joint_speed: &[Vec<f64>]) -> i64 {
+        if !self.touching.is_empty()
+            || !self.near.is_empty()
+            || !self.exempt.is_empty()
+            || self.world.held.iter().any(Option::is_some)
+        {
+            return i64::MIN;
+        }
+        let n = self.bodies.len();
+        self.body_speed.clear();
+        let mut fastest = 0.0f64;
+        for b in &self.bodies {
+            let v = match b.owner {
+                Owner::Link { robot, .. } => b
+                    .reach
+                    .iter()
+                    .map(|(j, arm)| joint_speed[robot][*j] * arm)
+                    .sum(),
+                _ => 0.0,
+            };
+            fastest = fastest.max(v);
+            self.body_speed.push(v);
+        }
+        if !fastest.is_finite() {
+            return i64::MIN;
+        }
+        let mut h = t.saturating_add(HORIZON_NS);
+        // The pairs the check's broadphase kept: their promises.
+        for &(i, j) in &self.pairs {
+            if self.skip_dense[i * n + j] || self.static_pair((i, j)) {
+                continue;
+            }
+            h = h.min(self.safe_until[i * n + j]);
+        }
+        if h <= t {
+            return i64::MIN;
+        }
+        if fastest <= 0.0 {
+            return h;
+        }
+        // Pairs apart but within reach of each other in the look-ahead: from their boxes.
+        let reach = fastest * HORIZON_NS as f64 / 1e9;
+        let margin = cell.clearance;
+        self.ahead_boxes.clear();
+        self.ahead_boxes
+            .extend(self.aabbs.iter().map(|b| b.loosened(reach)));
+        let mut pairs = std::mem::take(&mut self.ahead_pairs);
+        self.ahead.overlapping(&self.ahead_boxes, &mut pairs);
+        for &(i, j) in &pairs {
+            let (a, b) = (&self.aabbs[i], &self.aabbs[j]);
+            if self.skip_dense[i * n + j] || self.static_pair((i, j)) || a.intersects(b) {
+                continue; // (boxes within the clearance: a pair the check kept, above)
+            }
+            let v = self.body_speed[i] + self.body_speed[j];
+            if v <= 0.0 {
+                continue;
+            }
+            // The distance of the boxes themselves (not grown by the clearance).
+            let mut d2 = 0.0;
+            for k in 0..3 {
+                let g = (b.mins[k] - a.maxs[k]).max(a.mins[k] - b.maxs[k]) + 2.0 * margin;
+                if g > 0.0 {
+                    d2 += g * g;
+                }
+            }
+            let gap = d2.sqrt() - cell.clearance;
+            if gap <= 0.0 {
+                h = i64::MIN;
+                break;
+            }
+            h = h.min(t.saturating_add((gap / v * 1e9) as i64));
+        }
+        self.ahead_pairs = pairs;
+        h
     }
 
     /// Robot `r`'s link frames in the cell at time `t`, into `out`.

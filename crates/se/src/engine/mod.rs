@@ -607,6 +607,11 @@ impl Simulation {
         if !self.sweep || t <= self.swept {
             return false;
         }
+        // Nothing can touch before the collider's horizon: no sweep to do.
+        if t <= self.collider.horizon() {
+            self.swept = t;
+            return false;
+        }
         let contacts = self.collider.sweep(&self.cell, &self.vms, self.swept, t);
         self.swept = t;
         for contact in contacts {
@@ -622,6 +627,14 @@ impl Simulation {
         let c = self.cell.cycle_ns;
         while self.next_boundary <= t {
             let b = self.next_boundary;
+            // Before the collider's horizon no pair can come within the clearance: the
+            // boundary has nothing to check (unless a log records every boundary's state).
+            if b < self.collider.horizon() && self.sinks.is_empty() {
+                self.swept = self.swept.max(b);
+                self.next_boundary += c;
+                self.cycles += 1;
+                continue;
+            }
             // A contact before the boundary may end the run before it is reached.
             if self.sweep_until(b) {
                 return;
