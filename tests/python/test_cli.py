@@ -50,13 +50,13 @@ def on_terminal(args):
 
 def test_a_long_run_shows_its_progress_on_a_terminal(tmp_path):
     cell = long_cell(tmp_path)
-    code, err = on_terminal([VWORKS, "run", str(cell), "--until", "90s"])
+    code, err = on_terminal([VWORKS, "run", str(cell), "--until", "300s"])
     assert code == 0
     assert "simulated" in err and "x real time" in err, err
     # --quiet, or stderr not a terminal: no bar.
-    code, err = on_terminal([VWORKS, "run", str(cell), "--until", "90s", "--quiet"])
+    code, err = on_terminal([VWORKS, "run", str(cell), "--until", "300s", "--quiet"])
     assert code == 0 and "real time" not in err, err
-    piped = subprocess.run([VWORKS, "run", str(cell), "--until", "90s"], capture_output=True, text=True)
+    piped = subprocess.run([VWORKS, "run", str(cell), "--until", "300s"], capture_output=True, text=True)
     assert piped.returncode == 0 and piped.stderr == "", piped.stderr
 
 

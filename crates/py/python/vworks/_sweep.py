@@ -123,12 +123,13 @@ def sweep(
             raise ImportError("backend='ray' needs Ray: pip install 'vworks[ray]'") from e
         if not ray.is_initialized():
             ray.init()
-        workers = max(1, int(ray.cluster_resources().get("CPU", 1)))
+        cpus: Any = ray.cluster_resources()  # type: ignore[no-untyped-call, unused-ignore]
+        workers = max(1, int(cpus.get("CPU", 1)))
         size = batch or max(1, -(-len(variants) // (4 * workers)))
-        task = ray.remote(_run_batch)
+        task: Any = ray.remote(_run_batch)
         files_ref = ray.put(files)
-        futures = [task.remote(cell, files_ref, b, names, until, i) for i, b in _batches(variants, size)]
-        results = ray.get(futures)
+        refs: List[Any] = [task.remote(cell, files_ref, b, names, until, i) for i, b in _batches(variants, size)]
+        results: List[Tuple[List[str], List[List[Any]]]] = ray.get(refs)
     elif backend == "dask":
         try:
             from dask.distributed import get_client  # type: ignore[import-untyped, import-not-found, unused-ignore]
@@ -141,14 +142,15 @@ def sweep(
                 "backend='dask' runs on the current dask.distributed client: start one first, "
                 "e.g. Client(LocalCluster()) or Client('tcp://scheduler:8786')"
             ) from e
-        workers = max(1, sum(client.nthreads().values()))
+        dask_client: Any = client
+        workers = max(1, sum(dask_client.nthreads().values()))
         size = batch or max(1, -(-len(variants) // (4 * workers)))
-        files_future = client.scatter(files, broadcast=True)
-        futures = [
-            client.submit(_run_batch, cell, files_future, b, names, until, i, pure=False)
+        files_future = dask_client.scatter(files, broadcast=True)
+        futures: List[Any] = [
+            dask_client.submit(_run_batch, cell, files_future, b, names, until, i, pure=False)
             for i, b in _batches(variants, size)
         ]
-        results = client.gather(futures)
+        results = dask_client.gather(futures)
     else:
         raise ValueError(f"backend is 'local', 'ray' or 'dask', not {backend!r}")
     columns = results[0][0] if results else ["variant", *names]
