@@ -3,7 +3,7 @@
 //! into the workcell — `cycle`, `params.speed`, `robot.r2.params.speed`,
 //! `robot.r2.base.xyz.0` (an index into an array), `device.table.pose.xyz.2`. Robots,
 //! devices and parts are found by name. Every program is compiled once and every model
-//! loaded once for all variants (the [`Cache`]); a variant costs a copy of the parsed file,
+//! loaded once for all variants (a cache the loader keeps); a variant costs a copy of the parsed file,
 //! the overrides, and the rest of loading (params, bodies, link).
 
 use std::collections::BTreeMap;

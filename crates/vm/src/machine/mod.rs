@@ -360,6 +360,9 @@ enum Source {
 /// The VM of one robot.
 #[derive(Debug)]
 pub struct Vm {
+    /// Cartesian paths sampled, by the bits of their joints, poses and speed
+    /// (`plan::PathSamples`): a program repeating its moves samples each once.
+    path_memo: Vec<([u64; plan::PATH_KEY], plan::PathSamples)>,
     m: Arc<Module>,
     model: Arc<RobotModel>,
     cfg: VmConfig,
@@ -549,6 +552,7 @@ impl Vm {
             },
             globals,
             warnings: Vec::new(),
+            path_memo: Vec::with_capacity(plan::PATH_MEMO),
             instant: -1,
             instant_budget: 0,
             instant_events: 0,

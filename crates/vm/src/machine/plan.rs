@@ -5,6 +5,25 @@
 
 use super::*;
 
+/// Points a Cartesian path is checked at (reachability and axis speeds).
+pub(super) const PATH_SAMPLES: usize = 64;
+/// Sampled paths a VM remembers (the oldest goes first).
+pub(super) const PATH_MEMO: usize = 32;
+/// A sampled path's key: the bits of the start joints, the start and goal poses (rotation,
+/// translation), the via point (NaN for a line) and the path speed.
+pub(super) const PATH_KEY: usize = MAX_AXES + 12 + 12 + 3 + 1;
+
+/// What sampling a Cartesian path found: the slowest ratio of an axis's speed limit to its
+/// speed (1 if none is exceeded) and that axis, each axis's largest speed, the joints at
+/// the end.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct PathSamples {
+    pub(super) worst: f64,
+    pub(super) worst_axis: usize,
+    pub(super) rates: [f64; MAX_AXES],
+    pub(super) end: [f64; MAX_AXES],
+}
+
 /// Up to 12 slots of a pose (6) or joints (12) operand, without allocating.
 #[derive(Clone, Copy)]
 pub(super) struct Slots {
@@ -337,6 +356,49 @@ impl Vm {
         self.model.tcp(&q, &self.cfg.tool)
     }
 
+    /// Samples a Cartesian path at [`PATH_SAMPLES`] points from joints `from`: every point
+    /// reachable (or the error, naming where), each axis's largest speed at path speed `vs`
+    /// (1/s), and the slowest ratio of an axis's limit to its speed, if one is exceeded.
+    fn sample_path(
+        &self,
+        path: &Path,
+        start: &Iso,
+        goal: &Iso,
+        from: &[f64; MAX_AXES],
+        vs: f64,
+    ) -> Result<PathSamples, String> {
+        let n = self.model.dof();
+        let mut prev = *from;
+        let mut worst = 1.0f64;
+        let mut worst_axis = 0;
+        let mut rates = [0.0f64; MAX_AXES];
+        for k in 1..=PATH_SAMPLES {
+            let s = k as f64 / PATH_SAMPLES as f64;
+            let pose = cartesian_at(path, start, goal, s);
+            let q = self
+                .ik_tcp(&pose, &prev)
+                .map_err(|e| format!("{e} (at {:.0}% of the path)", s * 100.0))?;
+            for i in 0..n {
+                // ds/dt at most vs: axis speed ≈ |Δq/Δs|·vs.
+                let rate = (q[i] - prev[i]).abs() * PATH_SAMPLES as f64 * vs;
+                rates[i] = rates[i].max(rate);
+                let j = self.model.axis(i);
+                // (A relative 1e-9 over the limit is rounding, not a faster axis.)
+                if rate > j.max_velocity * (1.0 + 1e-9) && j.max_velocity / rate < worst {
+                    worst = j.max_velocity / rate;
+                    worst_axis = i;
+                }
+            }
+            prev = q;
+        }
+        Ok(PathSamples {
+            worst,
+            worst_axis,
+            rates,
+            end: prev,
+        })
+    }
+
     pub(super) fn ik_tcp(&self, tcp: &Iso, near: &[f64]) -> Result<[f64; MAX_AXES], String> {
         let n = self.model.dof();
         let mut q = [0.0; MAX_AXES];
@@ -434,14 +496,14 @@ impl Vm {
             None => self.tcp_at(self.time),
         };
         let goal = self.operand_pose(target);
-        let path = match &via {
+        let via_t = via.as_ref().map(|v| self.operand_pose(v.get()).t);
+        let path = match via_t {
             None => Path::Line {
                 from: start.t,
                 to: goal.t,
             },
-            Some(v) => {
-                let via_pose = self.operand_pose(v.get());
-                Path::arc(start.t, via_pose.t, goal.t).ok_or_else(|| "move_c: the via point lies on the line from start to target; give a point off that line".to_string())?
+            Some(via_t) => {
+                Path::arc(start.t, via_t, goal.t).ok_or_else(|| "move_c: the via point lies on the line from start to target; give a point off that line".to_string())?
             }
         };
         let v = speed.unwrap_or(self.cfg.default_speed);
@@ -489,30 +551,39 @@ impl Vm {
             return Ok((traj, 0));
         }
         // Joints along the path: reachable, and within every axis's speed at this speed.
-        const SAMPLES: usize = 64;
-        let mut prev = from;
-        let mut worst = 1.0f64;
-        let mut worst_axis = 0;
-        let mut rates = [0.0f64; MAX_AXES];
-        for k in 1..=SAMPLES {
-            let s = k as f64 / SAMPLES as f64;
-            let pose = cartesian_at(&path, &start, &goal, s);
-            let q = self
-                .ik_tcp(&pose, &prev)
-                .map_err(|e| format!("{e} (at {:.0}% of the path)", s * 100.0))?;
-            for i in 0..n {
-                // ds/dt at most vs: axis speed ≈ |Δq/Δs|·vs.
-                let rate = (q[i] - prev[i]).abs() * SAMPLES as f64 * vs;
-                rates[i] = rates[i].max(rate);
-                let j = self.model.axis(i);
-                // (A relative 1e-9 over the limit is rounding, not a faster axis.)
-                if rate > j.max_velocity * (1.0 + 1e-9) && j.max_velocity / rate < worst {
-                    worst = j.max_velocity / rate;
-                    worst_axis = i;
-                }
-            }
-            prev = q;
+        // The same path from the same joints at the same speed samples the same: a program
+        // repeating its moves samples each once (`path_memo`, exact: keyed by the bits).
+        let mut key = [0u64; PATH_KEY];
+        let via_or_none = via_t.unwrap_or([f64::NAN; 3]);
+        for (k, x) in from
+            .iter()
+            .chain(start.r.iter().flatten())
+            .chain(&start.t)
+            .chain(goal.r.iter().flatten())
+            .chain(&goal.t)
+            .chain(&via_or_none)
+            .chain([&vs])
+            .enumerate()
+        {
+            key[k] = x.to_bits();
         }
+        let sampled = match self.path_memo.iter().find(|(k, _)| *k == key) {
+            Some((_, s)) => *s,
+            None => {
+                let s = self.sample_path(&path, &start, &goal, &from, vs)?;
+                if self.path_memo.len() >= PATH_MEMO {
+                    self.path_memo.remove(0);
+                }
+                self.path_memo.push((key, s));
+                s
+            }
+        };
+        let PathSamples {
+            worst,
+            worst_axis,
+            mut rates,
+            end: prev,
+        } = sampled;
         if worst < 1.0 {
             vs *= worst;
             as_ *= worst;
