@@ -80,6 +80,11 @@ enum Command {
         /// No progress bar (it shows on a terminal for runs longer than a second).
         #[arg(short, long)]
         quiet: bool,
+        /// Change a value of the workcell for this run, by its dotted path as a sweep names
+        /// it: `--set robot.r2.base.xyz.0=650mm` (repeatable; `vworks sweep --variables
+        /// CELL` lists them).
+        #[arg(long = "set", value_name = "PATH=VALUE")]
+        set: Vec<String>,
     },
     /// Write a run's report, one self-contained HTML file: the cell in 3D played back over
     /// a timeline, a Gantt chart per robot, cycle times, collisions, warnings and the event
@@ -550,6 +555,8 @@ fn simulate(
 
 /// How `vworks run` was asked to run a cell.
 struct RunOptions<'a> {
+    /// `PATH=VALUE` overrides (`--set`).
+    set: &'a [String],
     until: Option<&'a str>,
     json: bool,
     trace: bool,
@@ -560,8 +567,26 @@ struct RunOptions<'a> {
     color: bool,
 }
 
+/// `PATH=VALUE`: the value as TOML (`0.65`, `3`, `true`, `"650mm"`) or, if it is not,
+/// as text (`650mm`).
+fn parse_override(s: &str) -> Result<vworks_cell::Override, String> {
+    let Some((path, value)) = s.split_once('=') else {
+        return Err(format!(
+            "--set `{s}`: write PATH=VALUE, e.g. --set robot.r2.base.xyz.0=650mm"
+        ));
+    };
+    let value = value.trim();
+    let parsed = format!("v = {value}")
+        .parse::<toml::Table>()
+        .ok()
+        .and_then(|mut t| t.remove("v"))
+        .unwrap_or_else(|| toml::Value::String(value.to_string()));
+    Ok(vworks_cell::Override::new(path.trim(), parsed))
+}
+
 fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
     let RunOptions {
+        set,
         until,
         json,
         trace,
@@ -583,7 +608,20 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
         Ok(u) => u,
         Err(e) => return cannot_start(vec![json_issue("usage", &e, None, None, 0, 0)], e),
     };
-    let cell = match vworks_cell::load(path) {
+    let overrides = match set
+        .iter()
+        .map(|s| parse_override(s))
+        .collect::<Result<Vec<_>, _>>()
+    {
+        Ok(o) => o,
+        Err(e) => return cannot_start(vec![json_issue("usage", &e, None, None, 0, 0)], e),
+    };
+    let loaded = if overrides.is_empty() {
+        vworks_cell::load(path)
+    } else {
+        vworks_cell::Loader::new(path, &vworks_cell::Disk).and_then(|l| l.load(&overrides))
+    };
+    let cell = match loaded {
         Ok(c) => std::sync::Arc::new(c),
         Err(vworks_cell::CellError::Program {
             rendered,
@@ -786,9 +824,11 @@ fn run(cmd: Command, color: bool) -> Result<ExitCode, String> {
             log,
             log_every,
             quiet,
+            set,
         } => run_cell(
             &cell,
             RunOptions {
+                set: &set,
                 until: until.as_deref(),
                 json,
                 trace,
