@@ -27,9 +27,11 @@ __all__ = [
     "Simulation",
     "SimulationError",
     "__version__",
+    "cell_files",
     "compile",
     "load_cell",
     "read_log",
+    "run_variants",
     "write_report",
 ]
 
