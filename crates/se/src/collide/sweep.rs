@@ -136,7 +136,10 @@ impl Collider {
             sw.frames.clone_from(&self.world.frames);
             sw.frames_ready = true;
             for r in 0..n {
-                if sw.moving[r] {
+                // Moving now, or moved since the last check's frames (boundaries skipped
+                // before the collider's horizon leave them behind a robot that has
+                // stopped since).
+                if sw.moving[r] || vms[r].joints_at(from) != self.world.joints[r] {
                     self.robot_frame_at(cell, vms, r, from, &mut sw.frames[r]);
                 }
             }
