@@ -105,36 +105,7 @@ enum Command {
     /// Run every variant of a sweep file (a workcell with values varied) on all cores, and
     /// write the table (CSV or JSON lines) and a page with the objective charted; prints the
     /// best variants. `--variables CELL` lists what a sweep may vary.
-    Sweep {
-        /// The sweep file (sweep.toml; see docs/sweep.md), or with --variables the workcell.
-        file: PathBuf,
-        /// Threads (default: one per core).
-        #[arg(short, long, default_value_t = 0)]
-        jobs: usize,
-        /// The table to write: .csv, or .jsonl for JSON lines (default: beside the sweep
-        /// file, SWEEP.csv).
-        #[arg(short, long)]
-        out: Option<PathBuf>,
-        /// The page to write (default: SWEEP.html beside the sweep file).
-        #[arg(long)]
-        html: Option<PathBuf>,
-        /// Write each variant's MCAP log into this folder (variant-00000.mcap, …).
-        #[arg(long)]
-        keep_logs: Option<PathBuf>,
-        /// The column to minimize among completed runs without collision (default: the
-        /// sweep file's `minimize`, else end_time).
-        #[arg(long)]
-        minimize: Option<String>,
-        /// How many best variants to print.
-        #[arg(long, default_value_t = 5)]
-        best: usize,
-        /// No progress bar.
-        #[arg(short, long)]
-        quiet: bool,
-        /// List every value of the workcell FILE a sweep may vary, and stop.
-        #[arg(long)]
-        variables: bool,
-    },
+    Sweep(sweep::Args),
     /// Create a new workcell folder: one robot, its program and a README, ready to run.
     New {
         /// The folder to create (its name becomes the cell's name).
@@ -841,27 +812,7 @@ fn run(cmd: Command, color: bool) -> Result<ExitCode, String> {
         Command::Log { what } => read_log(what),
         Command::Report { log, output } => write_report(&log, output),
         Command::View { log } => view(&log),
-        Command::Sweep {
-            file,
-            jobs,
-            out,
-            html,
-            keep_logs,
-            minimize,
-            best,
-            quiet,
-            variables,
-        } => sweep::sweep(sweep::Args {
-            file,
-            jobs,
-            out,
-            html,
-            keep_logs,
-            minimize,
-            best,
-            quiet,
-            variables,
-        }),
+        Command::Sweep(args) => sweep::sweep(args),
         Command::New { name } => new_cell(&name),
         Command::Completions { shell } => {
             use clap::CommandFactory as _;

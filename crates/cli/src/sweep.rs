@@ -14,16 +14,35 @@ use vworks_sweep::run::RunOptions;
 use vworks_sweep::{Sweep, Table, run_variants};
 
 /// What `vworks sweep` was asked.
-#[derive(Debug)]
+#[derive(clap::Args, Debug)]
 pub(crate) struct Args {
+    /// The sweep file (sweep.toml; see docs/sweep.md), or with --variables the workcell.
     pub(crate) file: PathBuf,
+    /// Threads (default: one per core).
+    #[arg(short, long, default_value_t = 0)]
     pub(crate) jobs: usize,
+    /// The table to write: .csv, or .jsonl for JSON lines (default: beside the sweep
+    /// file, SWEEP.csv).
+    #[arg(short, long)]
     pub(crate) out: Option<PathBuf>,
+    /// The page to write (default: SWEEP.html beside the sweep file).
+    #[arg(long)]
     pub(crate) html: Option<PathBuf>,
+    /// Write each variant's MCAP log into this folder (variant-00000.mcap, …).
+    #[arg(long)]
     pub(crate) keep_logs: Option<PathBuf>,
+    /// The column to minimize among completed runs without collision (default: the
+    /// sweep file's `minimize`, else end_time).
+    #[arg(long)]
     pub(crate) minimize: Option<String>,
+    /// How many best variants to print.
+    #[arg(long, default_value_t = 5)]
     pub(crate) best: usize,
+    /// No progress bar.
+    #[arg(short, long)]
     pub(crate) quiet: bool,
+    /// List every value of the workcell FILE a sweep may vary, and stop.
+    #[arg(long)]
     pub(crate) variables: bool,
 }
 
@@ -91,13 +110,7 @@ pub(crate) fn sweep(a: Args) -> Result<ExitCode, String> {
         b.finish_and_clear();
     }
     let names: Vec<String> = sweep.variables.iter().map(|v| v.path.clone()).collect();
-    let robots: Vec<String> = loader
-        .base()
-        .robots
-        .iter()
-        .map(|r| r.name.clone())
-        .collect();
-    let table = Table::new(&names, &robots, &rows);
+    let table = Table::of_cell(&names, loader.base(), &rows);
     let feasible: Vec<bool> = rows.iter().map(vworks_sweep::Row::feasible).collect();
     let objective = a.minimize.clone().unwrap_or(sweep.minimize.clone());
     let best = table.best(&objective, a.best, &feasible)?;

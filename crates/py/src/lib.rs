@@ -1076,16 +1076,21 @@ fn read_log(py: Python<'_>, path: PathBuf) -> PyResult<EventList> {
             "{} is unfinished or damaged after {read} messages ({damage}); the events before that were read",
             path.display()
         );
-        PyErr::warn(
-            py,
-            &py.get_type::<PyRuntimeWarning>(),
-            &std::ffi::CString::new(msg).unwrap_or_default(),
-            1,
-        )?;
+        warn_runtime(py, msg)?;
     }
     Ok(EventList {
         events: log.events.into_iter().map(|e| Event { e }).collect(),
     })
+}
+
+/// Issues a Python `RuntimeWarning` with `msg` (a damaged log: what was read is returned).
+fn warn_runtime(py: Python<'_>, msg: String) -> PyResult<()> {
+    PyErr::warn(
+        py,
+        &py.get_type::<PyRuntimeWarning>(),
+        &std::ffi::CString::new(msg).unwrap_or_default(),
+        1,
+    )
 }
 
 /// Writes the HTML report of a run from its MCAP log: the cell in 3D played back over a
@@ -1106,12 +1111,7 @@ fn write_report(py: Python<'_>, log: PathBuf, output: Option<PathBuf>) -> PyResu
             "{} is unfinished or damaged after {read} messages ({why}); the report shows what was read",
             log.display()
         );
-        PyErr::warn(
-            py,
-            &py.get_type::<PyRuntimeWarning>(),
-            &std::ffi::CString::new(msg).unwrap_or_default(),
-            1,
-        )?;
+        warn_runtime(py, msg)?;
     }
     Ok(out)
 }

@@ -104,13 +104,7 @@ pub(crate) fn run_variants<'py>(
         for r in &mut rows {
             r.index += offset;
         }
-        let robots: Vec<String> = loader
-            .base()
-            .robots
-            .iter()
-            .map(|r| r.name.clone())
-            .collect();
-        Ok::<_, String>(Table::new(&variables, &robots, &rows))
+        Ok::<_, String>(Table::of_cell(&variables, loader.base(), &rows))
     });
     let table = outcome.map_err(CellError::new_err)?;
     let rows = PyList::empty(py);

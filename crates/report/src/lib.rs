@@ -259,8 +259,7 @@ pub fn write_report(log: &std::path::Path, out: &std::path::Path) -> Result<Writ
     Ok(Written {
         report,
         events: contents.events.len(),
-        // (What `viewer::data` needs.)
-        has_view: !contents.scene.is_empty() && !contents.transforms.is_empty(),
+        has_view: viewer::missing(&contents).is_none(),
         damage: contents.damage,
     })
 }

@@ -32,10 +32,10 @@ const SCRIPT: &str = include_str!("viewer.js");
 
 /// The playback data of `log` as the page reads it, or why there is none.
 pub fn data(log: &LogContents) -> Result<Value, &'static str> {
-    let Some(first_scene) = log.scene.first() else {
-        return Err("this log has no /scene (the bodies' shapes)");
-    };
-    let Some(p) = Playback::from_log(log) else {
+    if let Some(why) = missing(log) {
+        return Err(why);
+    }
+    let (Some(first_scene), Some(p)) = (log.scene.first(), Playback::from_log(log)) else {
         return Err("this log has no /tf (the frames' poses)");
     };
     let parents: Vec<i64> = p.parents.iter().map(|q| q.map_or(-1, i64::from)).collect();
@@ -82,6 +82,18 @@ pub fn data(log: &LogContents) -> Result<Value, &'static str> {
         "tracks": tracks, "times": p.times_ns, "stride": p.stride(),
         "values": f32_base64(&p.values), "bodies": bodies, "colours": colours, "tcps": tcps,
     }))
+}
+
+/// Why `log` gives no 3D view, if it does not: it lacks the shapes (`/scene`) or the
+/// poses (`/tf`).
+pub fn missing(log: &LogContents) -> Option<&'static str> {
+    if log.scene.is_empty() {
+        Some("this log has no /scene (the bodies' shapes)")
+    } else if log.frames.is_empty() || log.transforms.is_empty() {
+        Some("this log has no /tf (the frames' poses)")
+    } else {
+        None
+    }
 }
 
 /// Numbers of `v` (a JSON object) under `keys`, in order (`None` if one is missing).

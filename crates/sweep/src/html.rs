@@ -116,6 +116,19 @@ fn span(values: impl Iterator<Item = f64>) -> (f64, f64) {
     }
 }
 
+/// The titles of the chart's axes: `x` under it, `y` turned along its left side.
+fn axis_titles(s: &mut String, x: &str, y: &str) {
+    let _ = write!(
+        s,
+        r##"<text x="{cx:.1}" y="{ty:.1}" font-size="13" text-anchor="middle">{x}</text><text x="14" y="{cy:.1}" font-size="13" transform="rotate(-90 14 {cy:.1})" text-anchor="middle">{y}</text>"##,
+        cx = (L + W - 20.0) / 2.0,
+        ty = H - 12.0,
+        cy = (H - B) / 2.0,
+        x = esc(x),
+        y = esc(y),
+    );
+}
+
 fn scatter(table: &Table, x: usize, o: usize, feasible: &[bool]) -> String {
     let pts: Vec<(f64, Option<f64>, usize)> = table
         .rows
@@ -146,15 +159,7 @@ fn scatter(table: &Table, x: usize, o: usize, feasible: &[bool]) -> String {
             x = L - 6.0
         );
     }
-    let _ = write!(
-        s,
-        r##"<text x="{cx:.1}" y="{y:.1}" font-size="13" text-anchor="middle">{xn}</text><text x="14" y="{cy:.1}" font-size="13" transform="rotate(-90 14 {cy:.1})" text-anchor="middle">{on}</text>"##,
-        cx = (L + W - 20.0) / 2.0,
-        y = H - 12.0,
-        cy = (H - B) / 2.0,
-        xn = esc(&table.columns[x]),
-        on = esc(&table.columns[o])
-    );
+    axis_titles(&mut s, &table.columns[x], &table.columns[o]);
     let collided = table.column("collisions");
     for (xv, yv, i) in pts {
         let Some(yv) = yv else { continue };
@@ -244,18 +249,17 @@ fn heatmap(table: &Table, x: usize, y: usize, o: usize, feasible: &[bool]) -> St
             );
         }
     }
-    let _ = write!(
-        s,
-        r##"<text x="{cx:.1}" y="{ty:.1}" font-size="13" text-anchor="middle">{xn} ({x0} … {x1})</text><text x="14" y="{cy:.1}" font-size="13" transform="rotate(-90 14 {cy:.1})" text-anchor="middle">{yn} ({y0} … {y1})</text>"##,
-        cx = (L + W - 20.0) / 2.0,
-        ty = H - 12.0,
-        cy = (H - B) / 2.0,
-        xn = esc(&table.columns[x]),
-        yn = esc(&table.columns[y]),
-        x0 = xs.first().copied().unwrap_or(0.0),
-        x1 = xs.last().copied().unwrap_or(0.0),
-        y0 = ys.first().copied().unwrap_or(0.0),
-        y1 = ys.last().copied().unwrap_or(0.0),
+    let range = |name: &str, v: &[f64]| {
+        let (a, b) = (
+            v.first().copied().unwrap_or(0.0),
+            v.last().copied().unwrap_or(0.0),
+        );
+        format!("{name} ({a} … {b})")
+    };
+    axis_titles(
+        &mut s,
+        &range(&table.columns[x], &xs),
+        &range(&table.columns[y], &ys),
     );
     s.push_str("</svg>\n");
     s

@@ -124,6 +124,12 @@ impl Table {
         Table { columns, rows }
     }
 
+    /// The table of `rows` of a sweep of `cell`: a column per variable and per robot.
+    pub fn of_cell(variables: &[String], cell: &vworks_cell::Cell, rows: &[Row]) -> Table {
+        let robots: Vec<String> = cell.robots.iter().map(|r| r.name.clone()).collect();
+        Table::new(variables, &robots, rows)
+    }
+
     /// The column named `name`.
     pub fn column(&self, name: &str) -> Option<usize> {
         self.columns.iter().position(|c| c == name)

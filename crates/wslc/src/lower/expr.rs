@@ -427,27 +427,21 @@ impl Compiler<'_> {
                     bare: false,
                 }
             }
-            Some(Sym::Var(slot, ty)) => {
+            Some(sym @ (Sym::Var(slot, ty) | Sym::Param(slot, ty))) => {
+                let param = matches!(sym, Sym::Param(..));
                 if self.fk() == FnKind::Init {
-                    return self.not_const(n, "a module variable", sp);
-                }
-                self.note_impure(&format!("the module variable `{n}`"), sp);
-                let w = ty.width();
-                self.emit(
-                    if w == 1 {
-                        Instr::LoadVar(slot)
+                    let what = if param {
+                        "a parameter (a workcell may set it)"
                     } else {
-                        Instr::LoadVarN(slot, w)
-                    },
-                    sp,
-                );
-                Out::of(ty)
-            }
-            Some(Sym::Param(slot, ty)) => {
-                if self.fk() == FnKind::Init {
-                    return self.not_const(n, "a parameter (a workcell may set it)", sp);
+                        "a module variable"
+                    };
+                    return self.not_const(n, what, sp);
                 }
-                // Fixed for the whole run: reading it is pure (functions, conditions).
+                // A parameter is fixed for the whole run: reading it is pure (functions,
+                // conditions); a module variable is not.
+                if !param {
+                    self.note_impure(&format!("the module variable `{n}`"), sp);
+                }
                 let w = ty.width();
                 self.emit(
                     if w == 1 {
