@@ -733,9 +733,13 @@ fn load_parsed(
                         let src = vworks_wslc::source_text(bytes).map_err(|e| {
                             cx.bad(&format!("{key}.program"), format!("{pname}: {e}"))
                         })?;
-                        let result = vworks_wslc::compile(&pname, &src)
-                            .map(|out| (Arc::new(out.module), out.warnings))
-                            .map_err(|e| e.diagnostics);
+                        let result = vworks_wslc::compile_as(
+                            vworks_wslc::Language::of_path(&pname),
+                            &pname,
+                            &src,
+                        )
+                        .map(|out| (Arc::new(out.module), out.warnings))
+                        .map_err(|e| e.diagnostics);
                         cache.keep_program(
                             &pname,
                             Compiled {

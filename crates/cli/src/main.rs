@@ -21,7 +21,7 @@ mod sweep;
 use vworks_se::result::issue_json as json_issue;
 use vworks_vm::Module;
 use vworks_vm::bytecode::disassemble;
-use vworks_wslc::{Sources, compile, render};
+use vworks_wslc::{Language, Sources, compile_as, render};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -203,7 +203,7 @@ fn compile_file(path: &Path, color: bool) -> Result<(Option<Module>, usize, usiz
     let name = display(path);
     let mut sources = Sources::new();
     sources.add(&name, &src);
-    match compile(&name, &src) {
+    match compile_as(Language::of_path(&name), &name, &src) {
         Ok(out) => {
             eprint!("{}", render(&out.warnings, &sources, color));
             Ok((Some(out.module), 0, out.warnings.len()))

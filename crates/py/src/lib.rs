@@ -200,14 +200,35 @@ impl Module {
     }
 }
 
-/// Compiles WSL `source`; `path` names the file in diagnostics. Raises `CompileError`
-/// (with `.diagnostics`) if it does not compile.
+/// Compiles `source`, WSL or ABB RAPID; `path` names the file in diagnostics. The
+/// language is `language` (`"wsl"` or `"rapid"`), or else `path`'s extension decides
+/// (`.mod`, `.modx`, `.sys`, `.sysx`, `.prg` are RAPID). Raises `CompileError` (with
+/// `.diagnostics`) if it does not compile, `ValueError` for an unknown language.
 #[pyfunction]
-#[pyo3(signature = (source, path = "x.wsl"))]
-fn compile(py: Python<'_>, source: &str, path: &str) -> PyResult<Module> {
+#[pyo3(signature = (source, path = None, language = None))]
+fn compile(
+    py: Python<'_>,
+    source: &str,
+    path: Option<&str>,
+    language: Option<&str>,
+) -> PyResult<Module> {
+    let lang = match language.map(str::to_ascii_lowercase).as_deref() {
+        None => path.map_or(vworks_wslc::Language::Wsl, vworks_wslc::Language::of_path),
+        Some("wsl") => vworks_wslc::Language::Wsl,
+        Some("rapid") => vworks_wslc::Language::Rapid,
+        Some(other) => {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "unknown language {other:?}: use \"wsl\" or \"rapid\""
+            )));
+        }
+    };
+    let path = path.unwrap_or(match lang {
+        vworks_wslc::Language::Rapid => "x.mod",
+        vworks_wslc::Language::Wsl => "x.wsl",
+    });
     let mut sources = vworks_wslc::Sources::new();
     sources.add(path, source);
-    match vworks_wslc::compile(path, source) {
+    match vworks_wslc::compile_as(lang, path, source) {
         Ok(c) => Ok(Module {
             warnings: c.warnings.iter().map(|d| diagnostic(d, &sources)).collect(),
             module: c.module,

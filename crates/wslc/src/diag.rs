@@ -84,6 +84,8 @@ codes! {
     E0104 = "unknown part",
     E0105 = "joint count does not match the robot",
     E0106 = "entry procedure missing",
+    E0300 = "RAPID construct not supported",
+    E0301 = "RAPID optional argument not accepted",
     E0900 = "internal compiler error",
     W0001 = "local shadows a global",
     W0002 = "`disable` of a handler never enabled",

@@ -24,6 +24,7 @@ pub mod lexer;
 pub mod link;
 mod lower;
 pub mod parser;
+pub mod rapid;
 pub mod syntax;
 pub mod units;
 
@@ -118,8 +119,50 @@ pub fn compile(path: &str, source: &str) -> Result<Compiled, CompileError> {
     let toks = lexer::lex(source, &mut diags);
     let ast = parser::parse(source, toks, &mut diags);
     let syntax_ok = !diags.iter().any(Diagnostic::is_error);
-    let mut module = if syntax_ok {
-        Some(lower::lower(path, source, &ast, &mut diags))
+    finish(path, source, syntax_ok.then_some(&ast), diags)
+}
+
+/// The language of a program file, from its extension: RAPID for `.mod`, `.modx`, `.sys`,
+/// `.sysx` and `.prg`, WSL for anything else.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Language {
+    /// WSL, vworks's own language.
+    Wsl,
+    /// ABB RAPID.
+    Rapid,
+}
+
+impl Language {
+    /// The language of a file by its extension.
+    pub fn of_path(path: &str) -> Language {
+        if rapid::is_rapid_path(path) {
+            Language::Rapid
+        } else {
+            Language::Wsl
+        }
+    }
+}
+
+/// Compiles a program in the given language.
+pub fn compile_as(language: Language, path: &str, source: &str) -> Result<Compiled, CompileError> {
+    match language {
+        Language::Wsl => compile(path, source),
+        Language::Rapid => rapid::compile(path, source),
+    }
+}
+
+/// Checks and generates code for a syntax tree (if the front-end produced one), verifies
+/// the module, and resolves and sorts the diagnostics.
+pub(crate) fn finish(
+    path: &str,
+    source: &str,
+    ast: Option<&syntax::SourceModule>,
+    mut diags: Vec<Diagnostic>,
+) -> Result<Compiled, CompileError> {
+    let mut module = if !diags.iter().any(Diagnostic::is_error)
+        && let Some(ast) = ast
+    {
+        Some(lower::lower(path, source, ast, &mut diags))
     } else {
         None
     };

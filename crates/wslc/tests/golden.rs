@@ -1,10 +1,13 @@
 //! Data-driven golden tests, in the style of rust-analyzer's and ruff's fixtures.
 //!
-//! - `test_data/ok/NAME.wsl` must compile; its disassembly (with the source beside it) is
+//! Programs are WSL (`.wsl`) or ABB RAPID (`.mod`), compiled by the front-end their
+//! extension names.
+//!
+//! - `test_data/ok/NAME.wsl` (or `.mod`) must compile; its disassembly (with the source beside it) is
 //!   compared with `NAME.disasm`, and its `.wslb` encoding must decode to the same module.
-//! - `test_data/err/NAME.wsl` must fail (or warn); the rendered diagnostics are compared
-//!   with `NAME.stderr`. Each file's first line says which code it is about
-//!   (`// E0021: …`) and that code must be among its diagnostics.
+//! - `test_data/err/NAME.wsl` (or `.mod`) must fail (or warn); the rendered diagnostics
+//!   are compared with `NAME.stderr`. Each file's first line says which code it is about
+//!   (`// E0021: …`, in RAPID `! E0300: …`) and that code must be among its diagnostics.
 //! - `test_data/link/NAME/` holds modules and a `cell.txt`; the link diagnostics are
 //!   compared with `expected.txt`.
 //!
@@ -20,12 +23,24 @@ use expect_test::expect_file;
 use vworks_vm::Module;
 use vworks_vm::bytecode::disassemble;
 use vworks_wslc::link::{CellSpec, RobotSpec, link};
-use vworks_wslc::{Code, Sources, compile, render};
+use vworks_wslc::{Code, Language, Sources, compile_as, render};
 
 fn dir(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("test_data")
         .join(name)
+}
+
+/// The programs of a fixture directory, WSL and RAPID.
+fn programs(name: &str) -> Vec<PathBuf> {
+    let mut v = files(name, "wsl");
+    v.extend(files(name, "mod"));
+    v.sort();
+    v
+}
+
+fn compile(name: &str, src: &str) -> Result<vworks_wslc::Compiled, vworks_wslc::CompileError> {
+    compile_as(Language::of_path(name), name, src)
 }
 
 fn files(name: &str, ext: &str) -> Vec<PathBuf> {
@@ -55,7 +70,7 @@ fn rel(p: &Path) -> String {
 
 #[test]
 fn ok_programs_compile_to_the_expected_bytecode() {
-    let all = files("ok", "wsl");
+    let all = programs("ok");
     assert!(all.len() >= 8, "the ok/ corpus is too small");
     for p in all {
         let src = read(&p);
@@ -85,6 +100,7 @@ fn code_of_header(src: &str, name: &str) -> String {
     let first = src.lines().next().unwrap_or("");
     let code = first
         .trim_start_matches("//")
+        .trim_start_matches('!')
         .trim()
         .split(':')
         .next()
@@ -93,7 +109,7 @@ fn code_of_header(src: &str, name: &str) -> String {
         .to_string();
     assert!(
         code.len() == 5 && (code.starts_with('E') || code.starts_with('W')),
-        "{name}: the first line must be `// E0000: what this tests`"
+        "{name}: the first line must be `// E0000: what this tests` (`! E0000: …` in RAPID)"
     );
     code
 }
@@ -101,7 +117,7 @@ fn code_of_header(src: &str, name: &str) -> String {
 #[test]
 fn bad_programs_give_the_expected_diagnostics() {
     let mut covered = BTreeSet::new();
-    for p in files("err", "wsl") {
+    for p in programs("err") {
         let src = read(&p);
         let name = rel(&p);
         let want = code_of_header(&src, &name);

@@ -3,7 +3,7 @@
 import os
 import pathlib
 from collections.abc import Iterator, Mapping
-from typing import Any, Optional, Union, final, overload
+from typing import Any, Literal, Optional, Union, final, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -96,8 +96,14 @@ class Module:
     def disasm(self) -> str: ...
     def to_bytes(self) -> bytes: ...
 
-def compile(source: str, path: str = "x.wsl") -> Module:
-    """Compiles WSL `source`; raises `CompileError` if it does not compile."""
+def compile(
+    source: str,
+    path: Optional[str] = None,
+    language: Optional[Literal["wsl", "rapid"]] = None,
+) -> Module:
+    """Compiles WSL or ABB RAPID `source` (`language`, else `path`'s extension: `.mod`,
+    `.modx`, `.sys`, `.sysx`, `.prg` are RAPID); raises `CompileError` if it does not
+    compile."""
 
 def load_cell(path: Union[str, os.PathLike[str]]) -> Cell:
     """Loads a workcell file; raises `CellError`, `CompileError` or `LinkError`."""

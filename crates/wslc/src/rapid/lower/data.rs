@@ -1,0 +1,328 @@
+//! RAPID's data types and how each is held in WSL values: the type table, the predefined
+//! data (`v100`, `z10`, `fine`, `tool0`, `wobj0`, …), the unit conversions (RAPID's
+//! millimetres, degrees and seconds to WSL's SI quantities) and the WSL expressions the
+//! front-end builds.
+//!
+//! A RAPID value is held as zero or more WSL values, its **leaves**: a `num` is one WSL
+//! `num`, a `robtarget` one `pose`, a `speeddata` a `speed` and an `angspeed`. Data that
+//! only a real controller uses (`loaddata`, `confdata`, external axes) has no leaves: it is
+//! type-checked and dropped, as docs/rapid.md says.
+
+use vworks_vm::Dim;
+
+use crate::syntax::{self as w, Span};
+
+/// A RAPID data type the front-end knows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Ty {
+    Num,
+    Bool,
+    Str,
+    Pos,
+    Orient,
+    Pose,
+    Robtarget,
+    Jointtarget,
+    Speed,
+    Zone,
+    Tool,
+    Wobj,
+    Load,
+    Conf,
+    Extax,
+    Intnum,
+}
+
+impl Ty {
+    /// The type of a RAPID type name (any case).
+    pub(crate) fn from_name(name: &str) -> Option<Ty> {
+        Some(match name.to_ascii_lowercase().as_str() {
+            "num" | "dnum" => Ty::Num,
+            "bool" => Ty::Bool,
+            "string" => Ty::Str,
+            "pos" => Ty::Pos,
+            "orient" => Ty::Orient,
+            "pose" => Ty::Pose,
+            "robtarget" => Ty::Robtarget,
+            "jointtarget" => Ty::Jointtarget,
+            "speeddata" => Ty::Speed,
+            "zonedata" => Ty::Zone,
+            "tooldata" => Ty::Tool,
+            "wobjdata" => Ty::Wobj,
+            "loaddata" => Ty::Load,
+            "confdata" => Ty::Conf,
+            "extjoint" => Ty::Extax,
+            "intnum" => Ty::Intnum,
+            _ => return None,
+        })
+    }
+
+    /// The name as RAPID writes it.
+    pub(crate) fn name(self) -> &'static str {
+        match self {
+            Ty::Num => "num",
+            Ty::Bool => "bool",
+            Ty::Str => "string",
+            Ty::Pos => "pos",
+            Ty::Orient => "orient",
+            Ty::Pose => "pose",
+            Ty::Robtarget => "robtarget",
+            Ty::Jointtarget => "jointtarget",
+            Ty::Speed => "speeddata",
+            Ty::Zone => "zonedata",
+            Ty::Tool => "tooldata",
+            Ty::Wobj => "wobjdata",
+            Ty::Load => "loaddata",
+            Ty::Conf => "confdata",
+            Ty::Extax => "extjoint",
+            Ty::Intnum => "intnum",
+        }
+    }
+
+    /// Its WSL leaves: (suffix of the WSL name, WSL type name).
+    pub(crate) fn leaves(self) -> &'static [(&'static str, &'static str)] {
+        match self {
+            Ty::Num | Ty::Intnum => &[("", "num")],
+            Ty::Bool => &[("", "bool")],
+            Ty::Pos | Ty::Orient | Ty::Pose | Ty::Robtarget => &[("", "pose")],
+            Ty::Jointtarget => &[("", "joints")],
+            Ty::Speed => &[(".v_tcp", "speed"), (".v_ori", "angspeed")],
+            Ty::Zone => &[(".pzone_tcp", "length")],
+            Ty::Tool => &[(".tframe", "pose")],
+            Ty::Wobj => &[(".uframe", "pose"), (".oframe", "pose")],
+            Ty::Str | Ty::Load | Ty::Conf | Ty::Extax => &[],
+        }
+    }
+
+    /// Held in one WSL pose.
+    pub(crate) fn is_posed(self) -> bool {
+        matches!(self, Ty::Pos | Ty::Orient | Ty::Pose | Ty::Robtarget)
+    }
+}
+
+/// Predefined `speeddata`: (name, v_tcp mm/s, v_ori deg/s), as the RAPID reference lists
+/// them (`vmax` is 5000 mm/s, as on most arms).
+pub(crate) const SPEEDS: &[(&str, f64, f64)] = &[
+    ("v5", 5.0, 500.0),
+    ("v10", 10.0, 500.0),
+    ("v20", 20.0, 500.0),
+    ("v30", 30.0, 500.0),
+    ("v40", 40.0, 500.0),
+    ("v50", 50.0, 500.0),
+    ("v60", 60.0, 500.0),
+    ("v80", 80.0, 500.0),
+    ("v100", 100.0, 500.0),
+    ("v150", 150.0, 500.0),
+    ("v200", 200.0, 500.0),
+    ("v300", 300.0, 500.0),
+    ("v400", 400.0, 500.0),
+    ("v500", 500.0, 500.0),
+    ("v600", 600.0, 500.0),
+    ("v800", 800.0, 500.0),
+    ("v1000", 1000.0, 500.0),
+    ("v1500", 1500.0, 500.0),
+    ("v2000", 2000.0, 500.0),
+    ("v2500", 2500.0, 500.0),
+    ("v3000", 3000.0, 500.0),
+    ("v4000", 4000.0, 500.0),
+    ("v5000", 5000.0, 500.0),
+    ("v6000", 6000.0, 500.0),
+    ("v7000", 7000.0, 500.0),
+    ("vmax", 5000.0, 500.0),
+];
+
+/// Predefined `zonedata`: (name, pzone_tcp mm); `fine` stops at the point.
+pub(crate) const ZONES: &[(&str, f64)] = &[
+    ("fine", 0.0),
+    ("z0", 0.3),
+    ("z1", 1.0),
+    ("z5", 5.0),
+    ("z10", 10.0),
+    ("z15", 15.0),
+    ("z20", 20.0),
+    ("z30", 30.0),
+    ("z40", 40.0),
+    ("z50", 50.0),
+    ("z60", 60.0),
+    ("z80", 80.0),
+    ("z100", 100.0),
+    ("z150", 150.0),
+    ("z200", 200.0),
+];
+
+/// RAPID's unit of a dimension, as an SI factor: mm, degrees, seconds.
+pub(crate) fn unit(dim: Dim) -> f64 {
+    let mm = 0.001_f64;
+    let deg = std::f64::consts::PI / 180.0;
+    mm.powi(i32::from(dim.length)) * deg.powi(i32::from(dim.angle))
+}
+
+/// WSL expression builders; every node gets the span of the RAPID construct it comes from.
+pub(crate) mod build {
+    use super::*;
+
+    pub(crate) fn expr(kind: w::ExprKind, span: Span) -> w::Expr {
+        w::Expr { kind, span }
+    }
+    pub(crate) fn num(x: f64, span: Span) -> w::Expr {
+        expr(w::ExprKind::Num(x), span)
+    }
+    pub(crate) fn quantity(x: f64, dim: Dim, span: Span) -> w::Expr {
+        expr(w::ExprKind::Quantity(x, dim), span)
+    }
+    pub(crate) fn name(n: &str, span: Span) -> w::Expr {
+        expr(w::ExprKind::Name(n.to_string()), span)
+    }
+    pub(crate) fn ident(n: &str, span: Span) -> w::Ident {
+        w::Ident {
+            name: n.to_string(),
+            span,
+        }
+    }
+    pub(crate) fn call(f: &str, args: Vec<w::Expr>, span: Span) -> w::Expr {
+        expr(w::ExprKind::Call(ident(f, span), args), span)
+    }
+    pub(crate) fn bin(op: w::BinOp, a: w::Expr, b: w::Expr) -> w::Expr {
+        let span = a.span.to(b.span);
+        expr(w::ExprKind::Binary(op, Box::new(a), Box::new(b)), span)
+    }
+    pub(crate) fn field(e: w::Expr, f: &str) -> w::Expr {
+        let span = e.span;
+        expr(w::ExprKind::Field(Box::new(e), ident(f, span)), span)
+    }
+    pub(crate) fn not(e: w::Expr) -> w::Expr {
+        let span = e.span;
+        expr(w::ExprKind::Unary(w::UnOp::Not, Box::new(e)), span)
+    }
+    pub(crate) fn neg(e: w::Expr) -> w::Expr {
+        let span = e.span;
+        match e.kind {
+            w::ExprKind::Num(x) => num(-x, span),
+            w::ExprKind::Quantity(x, d) => quantity(-x, d, span),
+            kind => expr(
+                w::ExprKind::Unary(w::UnOp::Neg, Box::new(expr(kind, span))),
+                span,
+            ),
+        }
+    }
+
+    /// A RAPID number (plain, in RAPID's unit) as a WSL quantity of `dim`: a literal is
+    /// converted here, anything else is multiplied by one unit.
+    pub(crate) fn with_unit(e: w::Expr, dim: Dim) -> w::Expr {
+        let u = unit(dim);
+        match e.kind {
+            w::ExprKind::Num(x) => quantity(x * u, dim, e.span),
+            w::ExprKind::Int(i) => quantity(i as f64 * u, dim, e.span),
+            _ => {
+                let span = e.span;
+                bin(w::BinOp::Mul, e, quantity(u, dim, span))
+            }
+        }
+    }
+
+    /// A WSL quantity of `dim` as a RAPID number in RAPID's unit.
+    pub(crate) fn without_unit(e: w::Expr, dim: Dim) -> w::Expr {
+        let u = unit(dim);
+        match e.kind {
+            w::ExprKind::Quantity(x, d) if d == dim => num(x / u, e.span),
+            _ => {
+                let span = e.span;
+                bin(w::BinOp::Div, e, quantity(u, dim, span))
+            }
+        }
+    }
+
+    /// The literal number of a WSL expression, if it is one.
+    pub(crate) fn literal(e: &w::Expr) -> Option<f64> {
+        match e.kind {
+            w::ExprKind::Num(x) => Some(x),
+            w::ExprKind::Int(i) => Some(i as f64),
+            w::ExprKind::Quantity(x, _) => Some(x),
+            _ => None,
+        }
+    }
+
+    /// `pose(x, y, z, rx, ry, rz)` from six WSL expressions.
+    pub(crate) fn pose(parts: [w::Expr; 6], span: Span) -> w::Expr {
+        call("pose", parts.into(), span)
+    }
+
+    /// The identity pose.
+    pub(crate) fn identity(span: Span) -> w::Expr {
+        let l = |_| quantity(0.0, Dim::LENGTH, span);
+        let a = |_| quantity(0.0, Dim::ANGLE, span);
+        let [x, y, z] = [0, 1, 2].map(l);
+        let [rx, ry, rz] = [0, 1, 2].map(a);
+        pose([x, y, z, rx, ry, rz], span)
+    }
+}
+
+/// Roll, pitch and yaw (WSL's `pose` angles, R = Rz·Ry·Rx) of a RAPID quaternion
+/// `[q1, q2, q3, q4]` (q1 the scalar part), normalised; `None` for a zero quaternion.
+pub(crate) fn quat_rpy(q: [f64; 4]) -> Option<[f64; 3]> {
+    let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if n.is_nan() || n <= 1e-9 || !n.is_finite() {
+        return None;
+    }
+    let [w, x, y, z] = q.map(|v| v / n);
+    let r = [
+        [
+            1.0 - 2.0 * (y * y + z * z),
+            2.0 * (x * y - w * z),
+            2.0 * (x * z + w * y),
+        ],
+        [
+            2.0 * (x * y + w * z),
+            1.0 - 2.0 * (x * x + z * z),
+            2.0 * (y * z - w * x),
+        ],
+        [
+            2.0 * (x * z - w * y),
+            2.0 * (y * z + w * x),
+            1.0 - 2.0 * (x * x + y * y),
+        ],
+    ];
+    // As `vworks_model::math::Iso::rpy`: the angles the robot models read back.
+    let pitch = (-r[2][0]).clamp(-1.0, 1.0).asin();
+    Some(if r[2][0].abs() < 1.0 - 1e-12 {
+        [r[2][1].atan2(r[2][2]), pitch, r[1][0].atan2(r[0][0])]
+    } else {
+        [0.0, pitch, (-r[0][1]).atan2(r[1][1])]
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quaternions_give_roll_pitch_yaw() {
+        let deg = |v: [f64; 3]| v.map(f64::to_degrees);
+        let near = |a: [f64; 3], b: [f64; 3]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-9);
+        // Tool pointing down: 180° about x (RAPID's [0,1,0,0]).
+        assert!(near(
+            deg(quat_rpy([0.0, 1.0, 0.0, 0.0]).unwrap_or_default()),
+            [180.0, 0.0, 0.0]
+        ));
+        // 90° about z.
+        let h = 0.5_f64.sqrt();
+        assert!(near(
+            deg(quat_rpy([h, 0.0, 0.0, h]).unwrap_or_default()),
+            [0.0, 0.0, 90.0]
+        ));
+        // Not normalised: the same rotation.
+        assert!(near(
+            deg(quat_rpy([2.0, 0.0, 0.0, 2.0]).unwrap_or_default()),
+            [0.0, 0.0, 90.0]
+        ));
+        assert_eq!(quat_rpy([0.0; 4]), None);
+    }
+
+    #[test]
+    fn units_are_millimetres_degrees_seconds() {
+        assert_eq!(unit(Dim::LENGTH), 0.001);
+        assert_eq!(unit(Dim::SPEED), 0.001);
+        assert!((unit(Dim::ANGSPEED) - 1f64.to_radians()).abs() < 1e-15);
+        assert_eq!(unit(Dim::TIME), 1.0);
+    }
+}

@@ -1,0 +1,1043 @@
+//! RAPID expressions: their types, and the WSL expressions that compute their leaves.
+//! Aggregates (`[500, 0, 400]`) take their type from where they stand.
+
+use vworks_vm::Dim;
+
+use super::data::{Ty, build as b, quat_rpy};
+use super::{Data, Sym, Tr, Val};
+use crate::diag::Code;
+use crate::rapid::syntax::{self as r, Arg};
+use crate::syntax::{self as w, Span};
+
+impl Tr<'_> {
+    /// An expression that must have type `want` (aggregates are read as `want`).
+    pub(crate) fn value(&mut self, e: &r::Expr, want: Ty) -> Option<Val> {
+        if let r::ExprKind::Aggregate(items) = &e.kind {
+            return self.aggregate(items, want, e.span);
+        }
+        let v = self.expr(e)?;
+        if v.ty == want || (v.ty == Ty::Intnum && want == Ty::Num) {
+            return Some(Val { ty: want, ..v });
+        }
+        // A pose-like value where another pose-like one is wanted: RAPID converts none of
+        // them, and neither does vworks.
+        self.error(
+            Code::E0020,
+            format!("expected {} here, found {}", article(want), article(v.ty)),
+            e.span,
+        );
+        None
+    }
+
+    /// An expression of any type.
+    pub(crate) fn expr(&mut self, e: &r::Expr) -> Option<Val> {
+        let span = e.span;
+        match &e.kind {
+            r::ExprKind::Num(x) => Some(Val::one(Ty::Num, b::num(*x, span))),
+            r::ExprKind::Bool(v) => Some(Val::one(Ty::Bool, b::expr(w::ExprKind::Bool(*v), span))),
+            r::ExprKind::Str(s) => Some(Val {
+                ty: Ty::Str,
+                parts: Vec::new(),
+                text: Some(s.clone()),
+            }),
+            r::ExprKind::Name(n) => self.name_value(n),
+            r::ExprKind::Aggregate(_) => {
+                self.error(
+                    Code::E0020,
+                    "the type of this `[…]` is not known here",
+                    span,
+                )
+                .help = Some("declare the value as data of a named type, and use its name".into());
+                None
+            }
+            r::ExprKind::Unary(op, x) => {
+                let v = self.expr(x)?;
+                match (op, v.ty) {
+                    (r::UnOp::Neg, Ty::Num) => Some(Val::one(Ty::Num, b::neg(v.leaf()))),
+                    (r::UnOp::Plus, Ty::Num) => Some(v),
+                    (r::UnOp::Not, Ty::Bool) => Some(Val::one(Ty::Bool, b::not(v.leaf()))),
+                    (_, t) => {
+                        let sym = match op {
+                            r::UnOp::Neg => "-",
+                            r::UnOp::Plus => "+",
+                            r::UnOp::Not => "NOT",
+                        };
+                        self.error(
+                            Code::E0022,
+                            format!("`{sym}` does not apply to {}", article(t)),
+                            span,
+                        );
+                        None
+                    }
+                }
+            }
+            r::ExprKind::Binary(op, l, rr) => self.binary(*op, l, rr, span),
+            r::ExprKind::Call(f, args) => self.function(f, args, span),
+            r::ExprKind::Field(x, f) => self.field_value(x, f, span),
+            r::ExprKind::Index(x, idx) => self.element(x, idx, span),
+            r::ExprKind::Error => None,
+        }
+    }
+
+    fn name_value(&mut self, n: &r::Name) -> Option<Val> {
+        match self.lookup(&n.key()) {
+            Some(Sym::Data(d)) => {
+                if d.len.is_some() {
+                    self.error(
+                        Code::E0020,
+                        format!(
+                            "`{}` is an array; give an element, `{}{{1}}`",
+                            n.text, n.text
+                        ),
+                        n.span,
+                    );
+                    return None;
+                }
+                Some(self.data_value(&d, None, n.span))
+            }
+            Some(Sym::Routine(_)) => {
+                self.error(
+                    Code::E0033,
+                    format!("`{}` is a routine, not data", n.text),
+                    n.span,
+                );
+                None
+            }
+            None => {
+                self.unknown_name(n);
+                None
+            }
+        }
+    }
+
+    pub(crate) fn unknown_name(&mut self, n: &r::Name) {
+        let key = n.key();
+        let names: Vec<String> = self
+            .locals
+            .iter()
+            .flat_map(|s| s.keys().cloned())
+            .chain(self.scope.keys().cloned())
+            .collect();
+        let near = crate::nearest(&key, names.iter().map(String::as_str)).map(|m| {
+            self.spelled
+                .get(m)
+                .cloned()
+                .unwrap_or_else(|| m.to_string())
+        });
+        let d = self.error(Code::E0010, format!("unknown name `{}`", n.text), n.span);
+        if let Some(m) = near {
+            d.help = Some(format!("did you mean `{m}`?"));
+        } else {
+            d.help = Some("declare it with VAR, PERS or CONST".into());
+        }
+    }
+
+    /// The leaves of data `d` (element `index` of an array, 1-based).
+    pub(crate) fn data_value(&mut self, d: &Data, index: Option<u32>, span: Span) -> Val {
+        if let Some(parts) = &d.inline {
+            return Val {
+                ty: d.ty,
+                parts: parts
+                    .iter()
+                    .map(|p| w::Expr {
+                        kind: p.kind.clone(),
+                        span,
+                    })
+                    .collect(),
+                text: None,
+            };
+        }
+        Val {
+            ty: d.ty,
+            parts: Tr::leaf_names(d, index)
+                .iter()
+                .map(|n| b::name(n, span))
+                .collect(),
+            text: d.text.clone(),
+        }
+    }
+
+    /// `a{i}`.
+    fn element(&mut self, x: &r::Expr, idx: &[r::Expr], span: Span) -> Option<Val> {
+        let r::ExprKind::Name(n) = &x.kind else {
+            self.unsupported(
+                "indexing anything but an array's name",
+                span,
+                "index the array by its name",
+            );
+            return None;
+        };
+        let d = match self.lookup(&n.key()) {
+            Some(Sym::Data(d)) if d.len.is_some() => d,
+            Some(_) => {
+                self.error(Code::E0022, format!("`{}` is not an array", n.text), n.span);
+                return None;
+            }
+            None => {
+                self.unknown_name(n);
+                return None;
+            }
+        };
+        let [i] = idx else {
+            self.unsupported(
+                "an index of more than one dimension",
+                span,
+                "use one-dimensional arrays",
+            );
+            return None;
+        };
+        let len = d.len.unwrap_or(0);
+        if let Some(k) = self.const_num(i) {
+            if k.fract() != 0.0 || k < 1.0 || k > f64::from(len) {
+                self.error(
+                    Code::E0025,
+                    format!("index {k} is outside `{}`'s elements 1 to {len}", n.text),
+                    i.span,
+                );
+                return None;
+            }
+            return Some(self.data_value(&d, Some(k as u32), span));
+        }
+        if d.local {
+            self.unsupported(
+                "a routine's local array indexed by a variable",
+                span,
+                "declare the array at module level (VAR, PERS or CONST), where vworks generates its accessor",
+            );
+            return None;
+        }
+        let iv = self.value(i, Ty::Num)?.leaf();
+        let index = b::call("int", vec![iv], i.span);
+        let parts =
+            d.ty.leaves()
+                .iter()
+                .map(|(suffix, _)| {
+                    b::call(
+                        &format!("{}{{}}{suffix}", d.base),
+                        vec![index.clone()],
+                        span,
+                    )
+                })
+                .collect();
+        Some(Val {
+            ty: d.ty,
+            parts,
+            text: None,
+        })
+    }
+
+    fn binary(&mut self, op: r::BinOp, l: &r::Expr, rr: &r::Expr, span: Span) -> Option<Val> {
+        use r::BinOp as O;
+        let a = self.expr(l)?;
+        let c = self.expr(rr)?;
+        let wop = |op: O| match op {
+            O::Add => w::BinOp::Add,
+            O::Sub => w::BinOp::Sub,
+            O::Mul => w::BinOp::Mul,
+            O::Div => w::BinOp::Div,
+            O::Eq => w::BinOp::Eq,
+            O::Ne => w::BinOp::Ne,
+            O::Lt => w::BinOp::Lt,
+            O::Le => w::BinOp::Le,
+            O::Gt => w::BinOp::Gt,
+            O::Ge => w::BinOp::Ge,
+            O::And => w::BinOp::And,
+            O::Or => w::BinOp::Or,
+            O::IntDiv | O::Mod | O::Xor => w::BinOp::Mod,
+        };
+        match (a.ty, c.ty, op) {
+            (Ty::Str, Ty::Str, O::Add) => Some(Val {
+                ty: Ty::Str,
+                parts: Vec::new(),
+                text: Some(format!(
+                    "{}{}",
+                    a.text.unwrap_or_default(),
+                    c.text.unwrap_or_default()
+                )),
+            }),
+            (Ty::Str, Ty::Str, O::Eq | O::Ne) => {
+                let same = a.text == c.text;
+                Some(Val::one(
+                    Ty::Bool,
+                    b::expr(w::ExprKind::Bool(same == (op == O::Eq)), span),
+                ))
+            }
+            (Ty::Num, Ty::Num, O::Add | O::Sub | O::Mul | O::Div) => {
+                Some(Val::one(Ty::Num, b::bin(wop(op), a.leaf(), c.leaf())))
+            }
+            (Ty::Num, Ty::Num, O::IntDiv | O::Mod) => {
+                // Integer division and remainder of the operands (RAPID requires whole
+                // numbers), as a num again.
+                let ai = b::call("int", vec![a.leaf()], l.span);
+                let ci = b::call("int", vec![c.leaf()], rr.span);
+                let o = if op == O::Mod {
+                    w::BinOp::Mod
+                } else {
+                    w::BinOp::Div
+                };
+                Some(Val::one(
+                    Ty::Num,
+                    b::call("num", vec![b::bin(o, ai, ci)], span),
+                ))
+            }
+            (Ty::Num, Ty::Num, O::Eq | O::Ne | O::Lt | O::Le | O::Gt | O::Ge)
+            | (Ty::Bool, Ty::Bool, O::Eq | O::Ne) => {
+                Some(Val::one(Ty::Bool, b::bin(wop(op), a.leaf(), c.leaf())))
+            }
+            (Ty::Bool, Ty::Bool, O::And | O::Or) => {
+                Some(Val::one(Ty::Bool, b::bin(wop(op), a.leaf(), c.leaf())))
+            }
+            (Ty::Bool, Ty::Bool, O::Xor) => {
+                let (x, y) = (a.leaf(), c.leaf());
+                let either = b::bin(w::BinOp::Or, x.clone(), y.clone());
+                let both = b::bin(w::BinOp::And, x, y);
+                Some(Val::one(
+                    Ty::Bool,
+                    b::bin(w::BinOp::And, either, b::not(both)),
+                ))
+            }
+            (Ty::Pos, Ty::Pos, O::Add | O::Sub) => {
+                let (p, q) = (a.leaf(), c.leaf());
+                let d = |f: &str| {
+                    let e = b::field(q.clone(), f);
+                    if op == O::Sub { b::neg(e) } else { e }
+                };
+                Some(Val::one(
+                    Ty::Pos,
+                    b::call("offset", vec![p, d("x"), d("y"), d("z")], span),
+                ))
+            }
+            (Ty::Pos, Ty::Num, O::Mul) | (Ty::Num, Ty::Pos, O::Mul) => {
+                let (p, k) = if a.ty == Ty::Pos {
+                    (a.leaf(), c.leaf())
+                } else {
+                    (c.leaf(), a.leaf())
+                };
+                Some(Val::one(
+                    Ty::Pos,
+                    self.pos_of(p, span, |e| b::bin(w::BinOp::Mul, e, k.clone())),
+                ))
+            }
+            (x, y, _) => {
+                self.error(
+                    Code::E0022,
+                    format!("`{}` does not apply to {} and {}", op.symbol(), article(x), article(y)),
+                    span,
+                )
+                .help = Some(
+                    "RAPID's arithmetic is on num (and + - on pos, * of pos by num); comparisons on num, = and <> on bool".into(),
+                );
+                None
+            }
+        }
+    }
+
+    /// A pos (a pose without rotation) from a pose's x, y, z mapped by `f`.
+    pub(crate) fn pos_of(&self, p: w::Expr, span: Span, f: impl Fn(w::Expr) -> w::Expr) -> w::Expr {
+        let zero = b::quantity(0.0, Dim::ANGLE, span);
+        b::pose(
+            [
+                f(b::field(p.clone(), "x")),
+                f(b::field(p.clone(), "y")),
+                f(b::field(p, "z")),
+                zero.clone(),
+                zero.clone(),
+                zero,
+            ],
+            span,
+        )
+    }
+
+    /// `e.field` read.
+    fn field_value(&mut self, x: &r::Expr, f: &r::Name, span: Span) -> Option<Val> {
+        let v = self.expr(x)?;
+        let key = f.key();
+        let num_of = |e: w::Expr, dim: Dim| Some(Val::one(Ty::Num, b::without_unit(e, dim)));
+        match (v.ty, key.as_str()) {
+            (Ty::Robtarget | Ty::Pose, "trans") => {
+                let p = v.leaf();
+                Some(Val::one(Ty::Pos, self.pos_of(p, span, |e| e)))
+            }
+            (Ty::Robtarget | Ty::Pose, "rot") => {
+                let p = v.leaf();
+                let zero = b::quantity(0.0, Dim::LENGTH, span);
+                Some(Val::one(
+                    Ty::Orient,
+                    b::pose(
+                        [
+                            zero.clone(),
+                            zero.clone(),
+                            zero,
+                            b::field(p.clone(), "rx"),
+                            b::field(p.clone(), "ry"),
+                            b::field(p, "rz"),
+                        ],
+                        span,
+                    ),
+                ))
+            }
+            (Ty::Pos, "x" | "y" | "z") => num_of(b::field(v.leaf(), &key), Dim::LENGTH),
+            (Ty::Speed, "v_tcp") => num_of(v.parts[0].clone(), Dim::SPEED),
+            (Ty::Speed, "v_ori") => num_of(v.parts[1].clone(), Dim::ANGSPEED),
+            (Ty::Zone, "pzone_tcp") => num_of(v.leaf(), Dim::LENGTH),
+            (Ty::Tool, "tframe") => Some(Val::one(Ty::Pose, v.leaf())),
+            (Ty::Wobj, "uframe") => Some(Val::one(Ty::Pose, v.parts[0].clone())),
+            (Ty::Wobj, "oframe") => Some(Val::one(Ty::Pose, v.parts[1].clone())),
+            (Ty::Jointtarget, "robax") => Some(v),
+            _ => {
+                // `jt.robax.rax_3`
+                if let (Ty::Jointtarget, Some(n)) = (v.ty, key.strip_prefix("rax_"))
+                    && let Ok(k @ 1..=6) = n.parse::<i64>()
+                    && matches!(&x.kind, r::ExprKind::Field(_, g) if g.key() == "robax")
+                {
+                    let j = b::expr(
+                        w::ExprKind::Index(
+                            Box::new(v.leaf()),
+                            Box::new(b::expr(w::ExprKind::Int(k - 1), f.span)),
+                        ),
+                        span,
+                    );
+                    return num_of(j, Dim::ANGLE);
+                }
+                self.unsupported(
+                    &format!("the component `{}` of {}", f.text, article(v.ty)),
+                    f.span,
+                    "docs/rapid.md lists the components vworks reads: trans, rot, x, y, z, robax.rax_1…6, v_tcp, v_ori, pzone_tcp, tframe, uframe, oframe",
+                );
+                None
+            }
+        }
+    }
+
+    /// An aggregate read as type `want`.
+    fn aggregate(&mut self, items: &[r::Expr], want: Ty, span: Span) -> Option<Val> {
+        let need = |n: usize| -> Result<(), String> {
+            if items.len() == n {
+                Ok(())
+            } else {
+                Err(format!(
+                    "{} is written with {n} values in `[…]`, not {}",
+                    article(want),
+                    items.len()
+                ))
+            }
+        };
+        let count = match want {
+            Ty::Pos => 3,
+            Ty::Orient | Ty::Conf => 4,
+            Ty::Pose => 2,
+            Ty::Robtarget => 4,
+            Ty::Jointtarget => 2,
+            Ty::Speed => 4,
+            Ty::Zone => 7,
+            Ty::Tool => 3,
+            Ty::Wobj => 5,
+            Ty::Load => 6,
+            Ty::Extax => 6,
+            Ty::Num | Ty::Bool | Ty::Str | Ty::Intnum => {
+                self.error(
+                    Code::E0020,
+                    format!("expected {}, found `[…]`", article(want)),
+                    span,
+                );
+                return None;
+            }
+        };
+        if let Err(m) = need(count) {
+            self.error(Code::E0013, m, span);
+            return None;
+        }
+        let nums = |t: &mut Self, from: usize, n: usize| -> Option<Vec<w::Expr>> {
+            items[from..from + n]
+                .iter()
+                .map(|e| t.value(e, Ty::Num).map(Val::leaf))
+                .collect()
+        };
+        match want {
+            Ty::Pos => {
+                let v = nums(self, 0, 3)?;
+                let [x, y, z] = <[w::Expr; 3]>::try_from(v).ok()?;
+                let zero = b::quantity(0.0, Dim::ANGLE, span);
+                Some(Val::one(
+                    Ty::Pos,
+                    b::pose(
+                        [
+                            b::with_unit(x, Dim::LENGTH),
+                            b::with_unit(y, Dim::LENGTH),
+                            b::with_unit(z, Dim::LENGTH),
+                            zero.clone(),
+                            zero.clone(),
+                            zero,
+                        ],
+                        span,
+                    ),
+                ))
+            }
+            Ty::Orient => {
+                let v = nums(self, 0, 4)?;
+                let q: Option<Vec<f64>> = v.iter().map(b::literal).collect();
+                let Some(q) = q else {
+                    self.unsupported(
+                        "an orient computed at run time from quaternion components",
+                        span,
+                        "write the quaternion's four numbers, or use OrientZYX",
+                    );
+                    return None;
+                };
+                let Some(rpy) = quat_rpy([q[0], q[1], q[2], q[3]]) else {
+                    self.error(
+                        Code::E0025,
+                        "the quaternion [0, 0, 0, 0] is no orientation",
+                        span,
+                    )
+                    .help = Some(
+                        "an orient is a unit quaternion [q1, q2, q3, q4], e.g. [1, 0, 0, 0]".into(),
+                    );
+                    return None;
+                };
+                let zero = b::quantity(0.0, Dim::LENGTH, span);
+                let [rx, ry, rz] = rpy.map(|a| b::quantity(a, Dim::ANGLE, span));
+                Some(Val::one(
+                    Ty::Orient,
+                    b::pose([zero.clone(), zero.clone(), zero, rx, ry, rz], span),
+                ))
+            }
+            Ty::Pose | Ty::Robtarget => {
+                let t = self.value(&items[0], Ty::Pos)?.leaf();
+                let o = self.value(&items[1], Ty::Orient)?.leaf();
+                if want == Ty::Robtarget {
+                    self.value(&items[2], Ty::Conf)?;
+                    self.value(&items[3], Ty::Extax)?;
+                }
+                Some(Val::one(want, merge_pose(t, o, span)))
+            }
+            Ty::Jointtarget => {
+                let r::ExprKind::Aggregate(ax) = &items[0].kind else {
+                    self.error(
+                        Code::E0020,
+                        "robax is written `[a1, a2, a3, a4, a5, a6]` (degrees)",
+                        items[0].span,
+                    );
+                    return None;
+                };
+                if ax.len() != 6 {
+                    self.error(
+                        Code::E0013,
+                        format!("robax has 6 values, not {}", ax.len()),
+                        items[0].span,
+                    );
+                    return None;
+                }
+                self.value(&items[1], Ty::Extax)?;
+                let mut vals = Vec::new();
+                for e in ax {
+                    vals.push(self.value(e, Ty::Num)?.leaf());
+                }
+                // Unused axes are 9E9: an arm with fewer axes than six ends there.
+                while vals.last().and_then(b::literal).is_some_and(|x| x >= 9e8) {
+                    vals.pop();
+                }
+                let vals = vals
+                    .into_iter()
+                    .map(|e| b::with_unit(e, Dim::ANGLE))
+                    .collect();
+                Some(Val::one(Ty::Jointtarget, b::call("joints", vals, span)))
+            }
+            Ty::Speed => {
+                let v = nums(self, 0, 4)?;
+                Some(Val {
+                    ty: Ty::Speed,
+                    parts: vec![
+                        b::with_unit(v[0].clone(), Dim::SPEED),
+                        b::with_unit(v[1].clone(), Dim::ANGSPEED),
+                    ],
+                    text: None,
+                })
+            }
+            Ty::Zone => {
+                let finep = self.value(&items[0], Ty::Bool)?.leaf();
+                let v = nums(self, 1, 6)?;
+                let radius = match finep.kind {
+                    w::ExprKind::Bool(true) => b::quantity(0.0, Dim::LENGTH, span),
+                    w::ExprKind::Bool(false) => b::with_unit(v[0].clone(), Dim::LENGTH),
+                    _ => {
+                        self.unsupported(
+                            "a zonedata whose finep is not TRUE or FALSE",
+                            items[0].span,
+                            "write TRUE or FALSE",
+                        );
+                        return None;
+                    }
+                };
+                Some(Val::one(Ty::Zone, radius))
+            }
+            Ty::Tool => {
+                let robhold = self.value(&items[0], Ty::Bool)?.leaf();
+                if !matches!(robhold.kind, w::ExprKind::Bool(true)) {
+                    self.unsupported(
+                        "a stationary tool (robhold FALSE)",
+                        items[0].span,
+                        "hold the tool on the robot (robhold TRUE)",
+                    );
+                    return None;
+                }
+                let frame = self.value(&items[1], Ty::Pose)?.leaf();
+                self.value(&items[2], Ty::Load)?;
+                Some(Val::one(Ty::Tool, frame))
+            }
+            Ty::Wobj => {
+                let robhold = self.value(&items[0], Ty::Bool)?.leaf();
+                if !matches!(robhold.kind, w::ExprKind::Bool(false)) {
+                    self.unsupported(
+                        "a work object held by the robot (robhold TRUE)",
+                        items[0].span,
+                        "use a fixed work object (robhold FALSE)",
+                    );
+                    return None;
+                }
+                self.value(&items[1], Ty::Bool)?;
+                let mech = self.expr(&items[2])?;
+                if mech.ty != Ty::Str {
+                    self.error(
+                        Code::E0020,
+                        "ufmec is a string (\"\" for a fixed frame)",
+                        items[2].span,
+                    );
+                    return None;
+                }
+                let u = self.value(&items[3], Ty::Pose)?.leaf();
+                let o = self.value(&items[4], Ty::Pose)?.leaf();
+                Some(Val {
+                    ty: Ty::Wobj,
+                    parts: vec![u, o],
+                    text: None,
+                })
+            }
+            Ty::Load => {
+                self.value(&items[0], Ty::Num)?;
+                self.value(&items[1], Ty::Pos)?;
+                self.value(&items[2], Ty::Orient)?;
+                nums(self, 3, 3)?;
+                Some(Val {
+                    ty: Ty::Load,
+                    parts: Vec::new(),
+                    text: None,
+                })
+            }
+            Ty::Conf | Ty::Extax => {
+                nums(self, 0, count)?;
+                Some(Val {
+                    ty: want,
+                    parts: Vec::new(),
+                    text: None,
+                })
+            }
+            Ty::Num | Ty::Bool | Ty::Str | Ty::Intnum => None,
+        }
+    }
+
+    /// A function call in an expression: RAPID's built-in functions, or a FUNC.
+    fn function(&mut self, f: &r::Name, args: &[Arg], span: Span) -> Option<Val> {
+        let key = f.key();
+        if let Some(v) = self.builtin_function(&key, f, args, span) {
+            return v;
+        }
+        match self.lookup(&key) {
+            Some(Sym::Routine(sig)) if sig.kind == r::RoutineKind::Func => {
+                let wargs = self.call_args(f, &sig.params, args, span)?;
+                let ret = sig.ret.unwrap_or(Ty::Num);
+                Some(Val::one(ret, b::call(&sig.wsl, wargs, span)))
+            }
+            Some(Sym::Routine(_)) => {
+                self.error(
+                    Code::E0033,
+                    format!(
+                        "`{}` is a PROC or TRAP, not a FUNC: it has no value",
+                        f.text
+                    ),
+                    f.span,
+                );
+                None
+            }
+            Some(Sym::Data(_)) => {
+                self.error(
+                    Code::E0011,
+                    format!("`{}` is data, not a function", f.text),
+                    f.span,
+                );
+                None
+            }
+            None => {
+                self.error(
+                    Code::E0011,
+                    format!("unknown function `{}`", f.text),
+                    f.span,
+                )
+                .help = Some("docs/rapid.md lists RAPID's functions that vworks runs".into());
+                None
+            }
+        }
+    }
+
+    /// The WSL arguments of a call of a PROC or FUNC with parameter types `params`.
+    pub(crate) fn call_args(
+        &mut self,
+        f: &r::Name,
+        params: &[Ty],
+        args: &[Arg],
+        span: Span,
+    ) -> Option<Vec<w::Expr>> {
+        let mut pos = Vec::new();
+        for a in args {
+            match a {
+                Arg::Pos(e) => pos.push(e),
+                Arg::Opt(n, _) => {
+                    self.unsupported(
+                        &format!("the optional argument `\\{}` of a user routine", n.text),
+                        n.span,
+                        "make the parameter required",
+                    );
+                    return None;
+                }
+            }
+        }
+        if pos.len() != params.len() {
+            self.error(
+                Code::E0013,
+                format!(
+                    "`{}` takes {} argument{}, {} given",
+                    f.text,
+                    params.len(),
+                    if params.len() == 1 { "" } else { "s" },
+                    pos.len()
+                ),
+                span,
+            );
+            return None;
+        }
+        let mut out = Vec::new();
+        for (e, t) in pos.into_iter().zip(params) {
+            out.extend(self.value(e, *t)?.parts);
+        }
+        Some(out)
+    }
+
+    /// The positional arguments and the optional ones of a built-in, checked against
+    /// `count` and the optional names it takes.
+    pub(crate) fn split_args<'a>(
+        &mut self,
+        f: &r::Name,
+        args: &'a [Arg],
+        count: std::ops::RangeInclusive<usize>,
+        optional: &[&str],
+        span: Span,
+    ) -> Option<SplitArgs<'a>> {
+        let mut pos = Vec::new();
+        let mut opts = Vec::new();
+        for a in args {
+            match a {
+                Arg::Pos(e) => pos.push(e),
+                Arg::Opt(n, v) => {
+                    let k = n.key();
+                    if !optional.iter().any(|o| o.eq_ignore_ascii_case(&k)) {
+                        let known = if optional.is_empty() {
+                            "none".to_string()
+                        } else {
+                            optional
+                                .iter()
+                                .map(|o| format!("\\{o}"))
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        };
+                        self.error(
+                            Code::E0301,
+                            format!(
+                                "`{}` has no optional argument `\\{}` that vworks runs",
+                                f.text, n.text
+                            ),
+                            n.span,
+                        )
+                        .help = Some(format!("the optional arguments vworks runs here: {known}"));
+                        return None;
+                    }
+                    opts.push((k, n, v.as_ref()));
+                }
+            }
+        }
+        if !count.contains(&pos.len()) {
+            let want = if count.start() == count.end() {
+                count.start().to_string()
+            } else {
+                format!("{} to {}", count.start(), count.end())
+            };
+            self.error(
+                Code::E0013,
+                format!("`{}` takes {want} arguments, {} given", f.text, pos.len()),
+                span,
+            );
+            return None;
+        }
+        Some((pos, opts))
+    }
+
+    /// RAPID's built-in functions. `None`: not a built-in (a user FUNC, or unknown).
+    fn builtin_function(
+        &mut self,
+        key: &str,
+        f: &r::Name,
+        args: &[Arg],
+        span: Span,
+    ) -> Option<Option<Val>> {
+        let nums = |t: &mut Self, es: &[&r::Expr]| -> Option<Vec<w::Expr>> {
+            es.iter()
+                .map(|e| t.value(e, Ty::Num).map(Val::leaf))
+                .collect()
+        };
+        let num = |e: w::Expr| Some(Val::one(Ty::Num, e));
+        Some(match key {
+            "offs" => (|| {
+                let (p, _) = self.split_args(f, args, 4..=4, &[], span)?;
+                let base = self.expr(p[0])?;
+                if !base.ty.is_posed() || base.ty == Ty::Orient {
+                    self.error(
+                        Code::E0020,
+                        format!("Offs moves a robtarget, not {}", article(base.ty)),
+                        p[0].span,
+                    );
+                    return None;
+                }
+                let d = nums(self, &p[1..])?;
+                let d: Vec<w::Expr> = d
+                    .into_iter()
+                    .map(|e| b::with_unit(e, Dim::LENGTH))
+                    .collect();
+                let mut a = vec![base.clone().leaf()];
+                a.extend(d);
+                Some(Val::one(base.ty, b::call("offset", a, span)))
+            })(),
+            "reltool" => (|| {
+                let (p, opts) = self.split_args(f, args, 4..=4, &["Rx", "Ry", "Rz"], span)?;
+                if let Some((_, n, _)) = opts.first() {
+                    self.unsupported(
+                        "RelTool's rotations (`\\Rx`, `\\Ry`, `\\Rz`)",
+                        n.span,
+                        "rotate with a second robtarget",
+                    );
+                    return None;
+                }
+                let base = self.value(p[0], Ty::Robtarget)?.leaf();
+                let d = nums(self, &p[1..])?;
+                let mut a = vec![base];
+                a.extend(d.into_iter().map(|e| b::with_unit(e, Dim::LENGTH)));
+                Some(Val::one(Ty::Robtarget, b::call("tool_offset", a, span)))
+            })(),
+            "crobt" => (|| {
+                self.split_args(
+                    f,
+                    args,
+                    0..=0,
+                    &["Tool", "WObj", "TaskRef", "TaskName"],
+                    span,
+                )?;
+                Some(Val::one(
+                    Ty::Robtarget,
+                    b::call("current_pose", vec![], span),
+                ))
+            })(),
+            "cjointt" => (|| {
+                self.split_args(f, args, 0..=0, &["TaskRef", "TaskName"], span)?;
+                Some(Val::one(
+                    Ty::Jointtarget,
+                    b::call("current_joints", vec![], span),
+                ))
+            })(),
+            "cpos" => (|| {
+                self.split_args(f, args, 0..=0, &["Tool", "WObj"], span)?;
+                let p = b::call("current_pose", vec![], span);
+                Some(Val::one(Ty::Pos, self.pos_of(p, span, |e| e)))
+            })(),
+            "abs" | "sqrt" => (|| {
+                let (p, _) = self.split_args(f, args, 1..=1, &[], span)?;
+                let x = nums(self, &p)?.remove(0);
+                num(b::call(key, vec![x], span))
+            })(),
+            "sin" | "cos" | "tan" => (|| {
+                let (p, _) = self.split_args(f, args, 1..=1, &[], span)?;
+                let x = b::with_unit(nums(self, &p)?.remove(0), Dim::ANGLE);
+                if key == "tan" {
+                    let s = b::call("sin", vec![x.clone()], span);
+                    let c = b::call("cos", vec![x], span);
+                    return num(b::bin(w::BinOp::Div, s, c));
+                }
+                num(b::call(key, vec![x], span))
+            })(),
+            "atan2" | "atan" | "asin" | "acos" => (|| {
+                let n = if key == "atan2" { 2 } else { 1 };
+                let (p, _) = self.split_args(f, args, n..=n, &[], span)?;
+                let v = nums(self, &p)?;
+                let one = || b::num(1.0, span);
+                let x0 = v[0].clone();
+                let root = || {
+                    // sqrt(1 - x²)
+                    b::call(
+                        "sqrt",
+                        vec![b::bin(
+                            w::BinOp::Sub,
+                            one(),
+                            b::bin(w::BinOp::Mul, x0.clone(), x0.clone()),
+                        )],
+                        span,
+                    )
+                };
+                let (y, x) = match key {
+                    "atan2" => (v[0].clone(), v[1].clone()),
+                    "atan" => (v[0].clone(), one()),
+                    "asin" => (v[0].clone(), root()),
+                    _ => (root(), v[0].clone()),
+                };
+                num(b::without_unit(
+                    b::call("atan2", vec![y, x], span),
+                    Dim::ANGLE,
+                ))
+            })(),
+            "trunc" | "round" => (|| {
+                let (p, opts) = self.split_args(f, args, 1..=1, &["Dec"], span)?;
+                if let Some((_, n, _)) = opts.first() {
+                    self.unsupported(
+                        &format!("{}'s `\\Dec`", f.text),
+                        n.span,
+                        "scale the value by a power of ten",
+                    );
+                    return None;
+                }
+                let x = nums(self, &p)?.remove(0);
+                if key == "trunc" {
+                    return num(b::call("num", vec![b::call("int", vec![x], span)], span));
+                }
+                self.round_helper(span);
+                num(b::call("round'", vec![x], span))
+            })(),
+            "orientzyx" => (|| {
+                let (p, _) = self.split_args(f, args, 3..=3, &[], span)?;
+                let v = nums(self, &p)?;
+                let zero = b::quantity(0.0, Dim::LENGTH, span);
+                let a = |e: &w::Expr| b::with_unit(e.clone(), Dim::ANGLE);
+                Some(Val::one(
+                    Ty::Orient,
+                    b::pose(
+                        [
+                            zero.clone(),
+                            zero.clone(),
+                            zero,
+                            a(&v[2]),
+                            a(&v[1]),
+                            a(&v[0]),
+                        ],
+                        span,
+                    ),
+                ))
+            })(),
+            "numtostr" | "valtostr" | "dim" | "present" | "strlen" | "strpart" | "pow" | "exp"
+            | "clktime" | "getnextsym" | "readnum" | "testdi" => {
+                self.unsupported(
+                    &format!("the function `{}` here", f.text),
+                    f.span,
+                    "NumToStr and ValToStr are read only inside TPWrite and ErrWrite; docs/rapid.md lists the functions vworks runs",
+                );
+                None
+            }
+            _ => return None,
+        })
+    }
+
+    /// `round'(x)`: RAPID's Round, half away from zero, generated once.
+    fn round_helper(&mut self, span: Span) {
+        if !self.helpers.insert("round'".into()) {
+            return;
+        }
+        let x = || b::name("x", span);
+        let half = || b::num(0.5, span);
+        let r = |e: w::Expr| b::call("num", vec![b::call("int", vec![e], span)], span);
+        let up = w::Stmt {
+            kind: w::StmtKind::Return(Some(r(b::bin(w::BinOp::Add, x(), half())))),
+            span,
+        };
+        let down = w::Stmt {
+            kind: w::StmtKind::Return(Some(b::neg(r(b::bin(w::BinOp::Sub, half(), x()))))),
+            span,
+        };
+        let cond = b::bin(w::BinOp::Ge, x(), b::num(0.0, span));
+        let body = vec![
+            w::Stmt {
+                kind: w::StmtKind::If {
+                    branches: vec![(cond, super::block(vec![up], span))],
+                    els: None,
+                },
+                span,
+            },
+            down,
+        ];
+        self.items.push(w::Item::Proc(w::ProcDecl {
+            is_func: true,
+            name: b::ident("round'", span),
+            params: vec![w::Param {
+                name: b::ident("x", span),
+                ty: b::ident("num", span),
+            }],
+            ret: Some(b::ident("num", span)),
+            body: super::block(body, span),
+            span,
+        }));
+    }
+}
+
+/// A built-in's positional arguments, and its optional ones as (lower-case name, name as
+/// written, value).
+pub(crate) type SplitArgs<'a> = (
+    Vec<&'a r::Expr>,
+    Vec<(String, &'a r::Name, Option<&'a r::Expr>)>,
+);
+
+/// A pose from a pos's translation and an orient's rotation.
+pub(crate) fn merge_pose(t: w::Expr, o: w::Expr, span: Span) -> w::Expr {
+    // Literal pos and orient fold into one `pose(…)` of literals.
+    if let (w::ExprKind::Call(tf, ta), w::ExprKind::Call(of, oa)) = (&t.kind, &o.kind)
+        && tf.name == "pose"
+        && of.name == "pose"
+        && ta.len() == 6
+        && oa.len() == 6
+    {
+        return b::pose(
+            [
+                ta[0].clone(),
+                ta[1].clone(),
+                ta[2].clone(),
+                oa[3].clone(),
+                oa[4].clone(),
+                oa[5].clone(),
+            ],
+            span,
+        );
+    }
+    b::pose(
+        [
+            b::field(t.clone(), "x"),
+            b::field(t.clone(), "y"),
+            b::field(t, "z"),
+            b::field(o.clone(), "rx"),
+            b::field(o.clone(), "ry"),
+            b::field(o, "rz"),
+        ],
+        span,
+    )
+}
+
+/// "a num", "an orient".
+pub(crate) fn article(t: Ty) -> String {
+    let n = t.name();
+    if n.starts_with(['a', 'e', 'i', 'o', 'u']) {
+        format!("an {n}")
+    } else {
+        format!("a {n}")
+    }
+}

@@ -1,0 +1,808 @@
+//! RAPID syntax trees to a WSL syntax tree, which the WSL compiler's checking and code
+//! generation then turn into bytecode: the same instructions, the same events, the same
+//! rules for conditions and handlers whichever language a robot is programmed in.
+//!
+//! This pass owns everything RAPID means that WSL does not say the same way: names are
+//! case-insensitive (the WSL names are the RAPID names in lower case), numbers carry
+//! RAPID's units (mm, degrees, seconds, mm/s) and become WSL quantities, records
+//! (`robtarget`, `speeddata`, `tooldata`, …) become their WSL leaves (see [`data`]), arrays
+//! become one WSL variable per element with generated accessors for a variable index, and
+//! RAPID's instructions (`MoveL`, `WaitUntil`, `TPWrite`, …) become WSL statements. It
+//! checks RAPID's types itself, so that the WSL it produces is well typed; a problem is a
+//! diagnostic at the RAPID text. Constructs it does not run are E0300, never skipped.
+//!
+//! Every WSL node gets the span of the RAPID construct it comes from, so the bytecode's
+//! line table, the event trace and runtime errors name RAPID lines.
+
+pub(crate) mod data;
+mod expr;
+mod stmt;
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use super::syntax::{self as r, Storage};
+use crate::diag::{Code, Diagnostic};
+use crate::syntax::{self as w, Span};
+use data::{Ty, build as b};
+
+/// Translates a task's RAPID modules into one WSL module.
+pub(crate) fn translate(
+    modules: &[r::RapidModule],
+    diags: &mut Vec<Diagnostic>,
+) -> w::SourceModule {
+    let mut t = Tr {
+        diags,
+        scope: BTreeMap::new(),
+        items: Vec::new(),
+        helpers: BTreeSet::new(),
+        locals: Vec::new(),
+        used: BTreeSet::new(),
+        temps: 0,
+        routine: None,
+        spelled: BTreeMap::new(),
+    };
+    t.collect(modules);
+    for m in modules {
+        for it in &m.items {
+            if let r::Item::Data(d) = it {
+                t.module_data(d);
+            }
+        }
+    }
+    for m in modules {
+        for it in &m.items {
+            if let r::Item::Routine(rt) = it {
+                t.routine(rt);
+            }
+        }
+    }
+    w::SourceModule { items: t.items }
+}
+
+/// Data the front-end knows by name.
+#[derive(Clone, Debug)]
+pub(crate) struct Data {
+    pub(crate) ty: Ty,
+    /// Elements of an array (1-based in RAPID), `None` for a scalar.
+    pub(crate) len: Option<u32>,
+    pub(crate) storage: Storage,
+    /// The WSL name the leaves' names start with.
+    pub(crate) base: String,
+    pub(crate) span: Span,
+    /// A `CONST string`'s text.
+    pub(crate) text: Option<String>,
+    /// Predefined data (`v100`, `fine`, `tool0`): its leaves as WSL constants.
+    pub(crate) inline: Option<Vec<w::Expr>>,
+    /// Declared inside a routine.
+    pub(crate) local: bool,
+    /// Cannot be assigned (a `CONST`, a `FOR` variable).
+    pub(crate) readonly: bool,
+}
+
+/// A routine's signature.
+#[derive(Clone, Debug)]
+pub(crate) struct Sig {
+    pub(crate) kind: r::RoutineKind,
+    pub(crate) params: Vec<Ty>,
+    pub(crate) ret: Option<Ty>,
+    pub(crate) wsl: String,
+    pub(crate) span: Span,
+}
+
+#[derive(Clone, Debug)]
+pub(crate) enum Sym {
+    Data(Data),
+    Routine(Sig),
+}
+
+/// The routine being translated.
+pub(crate) struct RoutineCx {
+    pub(crate) kind: r::RoutineKind,
+    pub(crate) ret: Option<Ty>,
+}
+
+/// A translated RAPID value: its type and its WSL leaves.
+#[derive(Clone, Debug)]
+pub(crate) struct Val {
+    pub(crate) ty: Ty,
+    pub(crate) parts: Vec<w::Expr>,
+    /// The text of a string known at compile time.
+    pub(crate) text: Option<String>,
+}
+
+impl Val {
+    pub(crate) fn one(ty: Ty, e: w::Expr) -> Val {
+        Val {
+            ty,
+            parts: vec![e],
+            text: None,
+        }
+    }
+    /// The single leaf (types of one leaf only).
+    pub(crate) fn leaf(mut self) -> w::Expr {
+        let span = self.parts.first().map(|e| e.span).unwrap_or_default();
+        self.parts
+            .pop()
+            .unwrap_or_else(|| b::expr(w::ExprKind::Error, span))
+    }
+}
+
+pub(crate) struct Tr<'d> {
+    pub(crate) diags: &'d mut Vec<Diagnostic>,
+    /// Module-level names (lower case) of every module of the task.
+    pub(crate) scope: BTreeMap<String, Sym>,
+    pub(crate) items: Vec<w::Item>,
+    /// Generated helper functions already emitted.
+    pub(crate) helpers: BTreeSet<String>,
+    /// The routine's local scopes, innermost last.
+    pub(crate) locals: Vec<BTreeMap<String, Data>>,
+    /// WSL local names used in the routine.
+    pub(crate) used: BTreeSet<String>,
+    pub(crate) temps: u32,
+    pub(crate) routine: Option<RoutineCx>,
+    /// Each declared name (lower case) as it was first written, for messages.
+    pub(crate) spelled: BTreeMap<String, String>,
+}
+
+/// Names WSL's own built-in functions take; RAPID names equal to them get a `'`.
+const WSL_BUILTINS: &[&str] = &[
+    "now",
+    "cycle",
+    "timed_out",
+    "current_joints",
+    "current_pose",
+    "offset",
+    "tool_offset",
+    "abs",
+    "min",
+    "max",
+    "sqrt",
+    "sin",
+    "cos",
+    "atan2",
+    "int",
+    "num",
+    "joints",
+    "pose",
+    "axis_length",
+];
+
+/// The WSL name of a RAPID name: lower case (RAPID is case-insensitive).
+pub(crate) fn wsl_name(n: &r::Name) -> String {
+    let k = n.key();
+    if WSL_BUILTINS.contains(&k.as_str()) {
+        format!("{k}'")
+    } else {
+        k
+    }
+}
+
+impl Tr<'_> {
+    pub(crate) fn error(
+        &mut self,
+        code: Code,
+        msg: impl Into<String>,
+        span: Span,
+    ) -> &mut Diagnostic {
+        self.diags.push(Diagnostic::error(code, msg, span));
+        let n = self.diags.len() - 1;
+        &mut self.diags[n]
+    }
+
+    /// E0300: a construct the front-end does not run.
+    pub(crate) fn unsupported(&mut self, what: &str, span: Span, help: &str) {
+        let d = Diagnostic::error(
+            Code::E0300,
+            format!("{what} is not supported by vworks's RAPID front-end"),
+            span,
+        )
+        .with_help(help.to_string())
+        .with_note("docs/rapid.md lists what RAPID vworks runs");
+        self.diags.push(d);
+    }
+
+    /// Module-level names first, so routines may be called before they are declared.
+    fn collect(&mut self, modules: &[r::RapidModule]) {
+        for m in modules {
+            for it in &m.items {
+                let (name, span) = match it {
+                    r::Item::Data(d) => (&d.name, d.span),
+                    r::Item::Routine(rt) => (&rt.name, rt.span),
+                };
+                self.spelled
+                    .entry(name.key())
+                    .or_insert_with(|| name.text.clone());
+                if let Some(prev) = self.scope.get(&name.key()) {
+                    let prev_span = match prev {
+                        Sym::Data(d) => d.span,
+                        Sym::Routine(s) => s.span,
+                    };
+                    let d = Diagnostic::error(
+                        Code::E0012,
+                        format!("`{}` is declared twice in this task", name.text),
+                        name.span,
+                    )
+                    .with_related(prev_span, "first declared here")
+                    .with_note("RAPID names are case-insensitive");
+                    self.diags.push(d);
+                    continue;
+                }
+                if let r::Item::Routine(rt) = it {
+                    let sig = self.signature(rt);
+                    self.scope.insert(name.key(), Sym::Routine(sig));
+                }
+                let _ = span;
+            }
+        }
+    }
+
+    fn signature(&mut self, rt: &r::Routine) -> Sig {
+        let mut params = Vec::new();
+        for p in &rt.params {
+            params.push(self.type_of(&p.ty).unwrap_or(Ty::Num));
+        }
+        let ret = rt.ret.as_ref().map(|t| self.type_of(t).unwrap_or(Ty::Num));
+        Sig {
+            kind: rt.kind,
+            params,
+            ret,
+            wsl: wsl_name(&rt.name),
+            span: rt.name.span,
+        }
+    }
+
+    /// The type of a type name, or E0014.
+    pub(crate) fn type_of(&mut self, n: &r::Name) -> Option<Ty> {
+        if let Some(t) = Ty::from_name(&n.text) {
+            return Some(t);
+        }
+        let known = [
+            "signaldi",
+            "signaldo",
+            "signalgi",
+            "signalgo",
+            "signalai",
+            "signalao",
+            "syncident",
+            "tasks",
+            "clock",
+            "errnum",
+            "triggdata",
+            "shapedata",
+            "wzstationary",
+        ];
+        if known.contains(&n.key().as_str()) {
+            self.unsupported(
+                &format!("the data type `{}`", n.text),
+                n.span,
+                "I/O signals, sync identifiers and task lists come with the I/O and MultiMove support; see docs/rapid.md",
+            );
+        } else {
+            self.error(Code::E0014, format!("unknown data type `{}`", n.text), n.span)
+                .help = Some(
+                "the types vworks knows are num, dnum, bool, string, pos, orient, pose, robtarget, jointtarget, speeddata, zonedata, tooldata, wobjdata, loaddata, confdata, extjoint, intnum".into(),
+            );
+        }
+        None
+    }
+
+    /// The array length of a declaration, if any: a constant of at least 1.
+    fn dims(&mut self, d: &r::DataDecl) -> Result<Option<u32>, ()> {
+        match d.dims.as_slice() {
+            [] => Ok(None),
+            [n] => match self.const_num(n) {
+                Some(x) if (1.0..=100_000.0).contains(&x) && x.fract() == 0.0 => Ok(Some(x as u32)),
+                Some(x) => {
+                    self.error(
+                        Code::E0025,
+                        format!("an array's size must be a whole number from 1 to 100000, not {x}"),
+                        n.span,
+                    );
+                    Err(())
+                }
+                None => {
+                    self.error(Code::E0080, "an array's size must be a constant", n.span);
+                    Err(())
+                }
+            },
+            [first, ..] => {
+                self.unsupported(
+                    "an array of more than one dimension",
+                    first.span,
+                    "use a one-dimensional array",
+                );
+                Err(())
+            }
+        }
+    }
+
+    /// A numeric constant expression's value (literals, `CONST num`s, arithmetic).
+    pub(crate) fn const_num(&mut self, e: &r::Expr) -> Option<f64> {
+        match &e.kind {
+            r::ExprKind::Num(x) => Some(*x),
+            r::ExprKind::Unary(r::UnOp::Neg, x) => self.const_num(x).map(|v| -v),
+            r::ExprKind::Unary(r::UnOp::Plus, x) => self.const_num(x),
+            r::ExprKind::Binary(op, a, bb) => {
+                let (a, bb) = (self.const_num(a)?, self.const_num(bb)?);
+                let v = match op {
+                    r::BinOp::Add => a + bb,
+                    r::BinOp::Sub => a - bb,
+                    r::BinOp::Mul => a * bb,
+                    r::BinOp::Div if bb != 0.0 => a / bb,
+                    _ => return None,
+                };
+                v.is_finite().then_some(v)
+            }
+            r::ExprKind::Name(n) => match self.lookup(&n.key()) {
+                Some(Sym::Data(d)) if d.storage == Storage::Const && d.len.is_none() => d
+                    .inline
+                    .as_ref()
+                    .and_then(|p| p.first())
+                    .and_then(b::literal),
+                _ => None,
+            },
+            _ => None,
+        }
+    }
+
+    /// Looks a name up: locals (innermost first), the task's modules, predefined data.
+    pub(crate) fn lookup(&self, key: &str) -> Option<Sym> {
+        for s in self.locals.iter().rev() {
+            if let Some(d) = s.get(key) {
+                return Some(Sym::Data(d.clone()));
+            }
+        }
+        if let Some(s) = self.scope.get(key) {
+            return Some(s.clone());
+        }
+        predefined(key).map(Sym::Data)
+    }
+
+    /// A fresh WSL local name for `want` within the routine.
+    pub(crate) fn fresh_local(&mut self, want: &str) -> String {
+        let mut name = want.to_string();
+        let mut k = 2;
+        while self.used.contains(&name) || self.scope.contains_key(&name) {
+            name = format!("{want}'{k}");
+            k += 1;
+        }
+        self.used.insert(name.clone());
+        name
+    }
+
+    /// A hidden temporary's name.
+    pub(crate) fn temp(&mut self, what: &str) -> String {
+        self.temps += 1;
+        let n = format!("{what}#{}", self.temps);
+        self.used.insert(n.clone());
+        n
+    }
+
+    /// The WSL names of the leaves of element `index` (1-based, arrays) of data `d`.
+    pub(crate) fn leaf_names(d: &Data, index: Option<u32>) -> Vec<String> {
+        let base = match index {
+            Some(i) => format!("{}{{{i}}}", d.base),
+            None => d.base.clone(),
+        };
+        d.ty.leaves()
+            .iter()
+            .map(|(suffix, _)| format!("{base}{suffix}"))
+            .collect()
+    }
+
+    fn module_data(&mut self, d: &r::DataDecl) {
+        let Some(ty) = self.type_of(&d.ty) else {
+            return;
+        };
+        let Ok(len) = self.dims(d) else { return };
+        let key = d.name.key();
+        if matches!(self.scope.get(&key), Some(Sym::Routine(_))) {
+            return; // Reported as a duplicate.
+        }
+        let mut data = Data {
+            ty,
+            len,
+            storage: d.storage,
+            base: wsl_name(&d.name),
+            span: d.name.span,
+            text: None,
+            inline: None,
+            local: false,
+            readonly: d.storage == Storage::Const,
+        };
+        if ty == Ty::Str {
+            self.string_data(d, &mut data);
+            self.scope.insert(key, Sym::Data(data));
+            return;
+        }
+        let inits = self.initial_values(d, ty, len);
+        // A CONST scalar of literal leaves is folded where it is used (array sizes, …).
+        if d.storage == Storage::Const
+            && len.is_none()
+            && let Some(v) = inits.as_ref().and_then(|v| v.first())
+            && v.parts.iter().all(|p| b::literal(p).is_some())
+            && !v.parts.is_empty()
+        {
+            data.inline = Some(v.parts.clone());
+        }
+        let scalar_global =
+            d.storage == Storage::Pers && len.is_none() && matches!(ty, Ty::Num | Ty::Bool);
+        for (decl, _) in Self::leaf_decls(d, &data, inits.as_deref()) {
+            self.items.push(match d.storage {
+                Storage::Const => w::Item::Const(decl),
+                Storage::Pers if scalar_global => w::Item::Global(decl),
+                _ => w::Item::Var(decl),
+            });
+        }
+        if len.is_some() && !ty.leaves().is_empty() {
+            self.array_accessors(&data);
+        }
+        self.scope.insert(key, Sym::Data(data));
+    }
+
+    /// One WSL declaration per element and leaf of `data` (declared by `d`), with the
+    /// initial values `inits` (one per element), and each declaration's name.
+    fn leaf_decls(
+        d: &r::DataDecl,
+        data: &Data,
+        inits: Option<&[Val]>,
+    ) -> Vec<(w::VarDecl, String)> {
+        let elements: Vec<Option<u32>> = match data.len {
+            None => vec![None],
+            Some(n) => (1..=n).map(Some).collect(),
+        };
+        let mut out = Vec::new();
+        for (k, idx) in elements.iter().enumerate() {
+            let names = Self::leaf_names(data, *idx);
+            for (j, (name, (_, wty))) in names.into_iter().zip(data.ty.leaves()).enumerate() {
+                let init = inits
+                    .and_then(|v| v.get(k))
+                    .and_then(|v| v.parts.get(j))
+                    .cloned();
+                let decl = w::VarDecl {
+                    name: b::ident(&name, d.name.span),
+                    ty: Some(b::ident(wty, d.ty.span)),
+                    init,
+                    span: d.span,
+                };
+                out.push((decl, name));
+            }
+        }
+        out
+    }
+
+    fn string_data(&mut self, d: &r::DataDecl, data: &mut Data) {
+        if d.storage != Storage::Const || !d.dims.is_empty() {
+            self.unsupported(
+                &format!("`{} string` data", d.storage.keyword()),
+                d.span,
+                "declare texts as `CONST string`; vworks prints them with TPWrite and ErrWrite",
+            );
+            return;
+        }
+        match &d.init {
+            Some(e) => {
+                if let Some(v) = self.expr(e)
+                    && v.ty == Ty::Str
+                {
+                    data.text = v.text;
+                } else {
+                    self.error(Code::E0020, "a `CONST string` needs a text", e.span);
+                }
+            }
+            None => data.text = Some(String::new()),
+        }
+    }
+
+    /// The declaration's initial value(s), one per element, type-checked.
+    fn initial_values(&mut self, d: &r::DataDecl, ty: Ty, len: Option<u32>) -> Option<Vec<Val>> {
+        let init = d.init.as_ref()?;
+        match len {
+            None => self.value(init, ty).map(|v| vec![v]),
+            Some(n) => {
+                let r::ExprKind::Aggregate(items) = &init.kind else {
+                    self.error(
+                        Code::E0020,
+                        format!("an array of {n} needs `[…]` with {n} values"),
+                        init.span,
+                    );
+                    return None;
+                };
+                if items.len() != n as usize {
+                    self.error(
+                        Code::E0013,
+                        format!(
+                            "`{}` has {n} elements but {} values are given",
+                            d.name.text,
+                            items.len()
+                        ),
+                        init.span,
+                    );
+                    return None;
+                }
+                items.iter().map(|e| self.value(e, ty)).collect()
+            }
+        }
+    }
+
+    /// For an array `a` at module level: `a{}` (get element `i`) per leaf, generated.
+    fn array_accessors(&mut self, d: &Data) {
+        let Some(n) = d.len else { return };
+        for (j, (suffix, wty)) in d.ty.leaves().iter().enumerate() {
+            let span = d.span;
+            let fname = format!("{}{{}}{suffix}", d.base);
+            let i = b::name("i", span);
+            let mut branches = Vec::new();
+            for k in 1..=n {
+                let names = Self::leaf_names(d, Some(k));
+                let cond = b::bin(
+                    w::BinOp::Eq,
+                    i.clone(),
+                    b::expr(w::ExprKind::Int(i64::from(k)), span),
+                );
+                let ret = w::Stmt {
+                    kind: w::StmtKind::Return(Some(b::name(&names[j], span))),
+                    span,
+                };
+                branches.push((cond, block(vec![ret], span)));
+            }
+            let fail = w::Stmt {
+                kind: w::StmtKind::Fail(vec![
+                    b::expr(
+                        w::ExprKind::Str(format!(
+                            "index out of bounds (ERR_INDEX): `{}` has elements 1 to {n}, the index is ",
+                            d.base
+                        )),
+                        span,
+                    ),
+                    i.clone(),
+                ]),
+                span,
+            };
+            let body = vec![
+                w::Stmt {
+                    kind: w::StmtKind::If {
+                        branches,
+                        els: None,
+                    },
+                    span,
+                },
+                fail,
+            ];
+            self.items.push(w::Item::Proc(w::ProcDecl {
+                is_func: true,
+                name: b::ident(&fname, span),
+                params: vec![w::Param {
+                    name: b::ident("i", span),
+                    ty: b::ident("int", span),
+                }],
+                ret: Some(b::ident(wty, span)),
+                body: block(body, span),
+                span,
+            }));
+        }
+    }
+
+    fn routine(&mut self, rt: &r::Routine) {
+        let Some(Sym::Routine(sig)) = self.scope.get(&rt.name.key()).cloned() else {
+            return; // A duplicate, reported.
+        };
+        if sig.span != rt.name.span {
+            return;
+        }
+        if let Some(h) = rt.handler {
+            self.unsupported(
+                "an error handler (`ERROR`, `BACKWARD`, `UNDO`)",
+                h,
+                "remove the handler: a runtime error stops the simulation and names the line",
+            );
+        }
+        self.locals = vec![BTreeMap::new()];
+        self.used.clear();
+        self.temps = 0;
+        self.routine = Some(RoutineCx {
+            kind: rt.kind,
+            ret: sig.ret,
+        });
+        let mut params = Vec::new();
+        for (p, ty) in rt.params.iter().zip(&sig.params) {
+            if p.optional {
+                self.unsupported(
+                    &format!("the optional parameter `\\{}`", p.name.text),
+                    p.span,
+                    "make the parameter required",
+                );
+            }
+            if p.mode == r::Mode::Ref {
+                self.unsupported(
+                    &format!(
+                        "the `VAR`/`PERS`/`INOUT` parameter `{}` (by reference)",
+                        p.name.text
+                    ),
+                    p.span,
+                    "pass the value and return the result from a FUNC, or use a module variable",
+                );
+            }
+            if p.array {
+                self.unsupported(
+                    &format!("the array parameter `{}`", p.name.text),
+                    p.span,
+                    "use the module-level array directly",
+                );
+            }
+            if *ty == Ty::Str || (ty.leaves().is_empty() && *ty != Ty::Load) {
+                self.unsupported(
+                    &format!("a parameter of type `{}`", ty.name()),
+                    p.span,
+                    "pass numbers, bools, positions, joint targets, speeds, zones, tools or work objects",
+                );
+            }
+            let data = Data {
+                ty: *ty,
+                len: None,
+                storage: Storage::Var,
+                base: self.fresh_local(&wsl_name(&p.name)),
+                span: p.name.span,
+                text: None,
+                inline: None,
+                local: true,
+                readonly: false,
+            };
+            for (name, (_, wty)) in Self::leaf_names(&data, None).iter().zip(ty.leaves()) {
+                params.push(w::Param {
+                    name: b::ident(name, p.name.span),
+                    ty: b::ident(wty, p.ty.span),
+                });
+            }
+            self.spelled
+                .entry(p.name.key())
+                .or_insert_with(|| p.name.text.clone());
+            if let Some(s) = self.locals.last_mut() {
+                s.insert(p.name.key(), data);
+            }
+        }
+        let mut body = Vec::new();
+        for d in &rt.locals {
+            self.local_data(d, &mut body);
+        }
+        body.extend(self.stmts(&rt.body));
+        let ret = match (rt.kind, sig.ret) {
+            (r::RoutineKind::Func, Some(t)) => match t.leaves() {
+                [(_, wty)] => Some(b::ident(wty, rt.ret.as_ref().map_or(rt.span, |n| n.span))),
+                _ => {
+                    self.unsupported(
+                        &format!("a FUNC returning `{}`", t.name()),
+                        rt.span,
+                        "return a num, bool, pos, orient, pose, robtarget or jointtarget",
+                    );
+                    None
+                }
+            },
+            _ => None,
+        };
+        if rt.kind == r::RoutineKind::Trap {
+            self.unsupported(
+                &format!("the TRAP routine `{}`", rt.name.text),
+                rt.name.span,
+                "interrupts come with CONNECT and ISignalDI; see docs/rapid.md",
+            );
+        }
+        let is_func = rt.kind == r::RoutineKind::Func;
+        self.items.push(w::Item::Proc(w::ProcDecl {
+            is_func: is_func && ret.is_some(),
+            name: b::ident(&sig.wsl, rt.name.span),
+            params,
+            ret,
+            body: block(body, rt.span),
+            span: rt.span,
+        }));
+        self.locals.clear();
+        self.routine = None;
+    }
+
+    /// A routine's local data: WSL `var` statements at the top of its body.
+    pub(crate) fn local_data(&mut self, d: &r::DataDecl, out: &mut Vec<w::Stmt>) {
+        let Some(ty) = self.type_of(&d.ty) else {
+            return;
+        };
+        let Ok(len) = self.dims(d) else { return };
+        if self
+            .locals
+            .last()
+            .is_some_and(|s| s.contains_key(&d.name.key()))
+        {
+            self.error(
+                Code::E0012,
+                format!("`{}` is declared twice in this routine", d.name.text),
+                d.name.span,
+            );
+            return;
+        }
+        let mut data = Data {
+            ty,
+            len,
+            storage: d.storage,
+            base: self.fresh_local(&wsl_name(&d.name)),
+            span: d.name.span,
+            text: None,
+            inline: None,
+            local: true,
+            readonly: d.storage == Storage::Const,
+        };
+        if ty == Ty::Str {
+            self.string_data(d, &mut data);
+        } else {
+            if d.storage == Storage::Pers {
+                self.unsupported(
+                    "`PERS` data inside a routine",
+                    d.span,
+                    "declare PERS data at module level",
+                );
+            }
+            let inits = self.initial_values(d, ty, len);
+            for (decl, name) in Self::leaf_decls(d, &data, inits.as_deref()) {
+                self.used.insert(name);
+                out.push(w::Stmt {
+                    kind: w::StmtKind::Var(decl),
+                    span: d.span,
+                });
+            }
+        }
+        self.spelled
+            .entry(d.name.key())
+            .or_insert_with(|| d.name.text.clone());
+        if let Some(s) = self.locals.last_mut() {
+            s.insert(d.name.key(), data);
+        }
+    }
+}
+
+/// A WSL block.
+pub(crate) fn block(stmts: Vec<w::Stmt>, span: Span) -> w::Block {
+    w::Block { stmts, span }
+}
+
+/// RAPID's predefined data: speeds, zones, `tool0`, `wobj0`, `load0`.
+fn predefined(key: &str) -> Option<Data> {
+    let span = Span::default();
+    let mut d = Data {
+        ty: Ty::Num,
+        len: None,
+        storage: Storage::Const,
+        base: key.to_string(),
+        span,
+        text: None,
+        inline: None,
+        local: false,
+        readonly: true,
+    };
+    if let Some((_, v, o)) = data::SPEEDS.iter().find(|(n, _, _)| *n == key) {
+        d.ty = Ty::Speed;
+        d.inline = Some(vec![
+            b::quantity(v * 0.001, vworks_vm::Dim::SPEED, span),
+            b::quantity(o.to_radians(), vworks_vm::Dim::ANGSPEED, span),
+        ]);
+        return Some(d);
+    }
+    if let Some((_, z)) = data::ZONES.iter().find(|(n, _)| *n == key) {
+        d.ty = Ty::Zone;
+        d.inline = Some(vec![b::quantity(z * 0.001, vworks_vm::Dim::LENGTH, span)]);
+        return Some(d);
+    }
+    match key {
+        "tool0" => {
+            d.ty = Ty::Tool;
+            d.inline = Some(vec![b::identity(span)]);
+        }
+        "wobj0" => {
+            d.ty = Ty::Wobj;
+            d.inline = Some(vec![b::identity(span), b::identity(span)]);
+        }
+        "load0" => {
+            d.ty = Ty::Load;
+            d.inline = Some(Vec::new());
+        }
+        _ => return None,
+    }
+    Some(d)
+}

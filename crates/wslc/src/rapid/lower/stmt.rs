@@ -1,0 +1,984 @@
+//! RAPID statements and instructions to WSL statements: assignments (whole data, record
+//! components, array elements), flow (`IF`, `WHILE`, `FOR`, `TEST`, `RETURN`, `EXIT`), the
+//! motion instructions, waits and messages, and calls of the task's own routines.
+
+use std::collections::BTreeMap;
+
+use vworks_vm::Dim;
+
+use super::data::{Ty, build as b};
+use super::expr::article;
+use super::{Data, Sym, Tr, block};
+use crate::diag::Code;
+use crate::rapid::syntax::{self as r, Arg, Storage};
+use crate::syntax::{self as w, Span};
+
+/// Instructions vworks accepts and that change nothing in a simulation.
+const NO_OPS: &[&str] = &["confj", "confl", "singarea", "tperase", "pathresol"];
+
+/// Instructions that exist in RAPID but that vworks does not run.
+const UNSUPPORTED: &[&str] = &[
+    "syncmoveon",
+    "syncmoveoff",
+    "syncmoveundo",
+    "searchl",
+    "searchc",
+    "searchj",
+    "triggl",
+    "triggj",
+    "triggc",
+    "movelsync",
+    "movejsync",
+    "movecsync",
+    "movelddo",
+    "movejdo",
+    "movecdo",
+    "movelao",
+    "wzboxdef",
+    "wzcyldef",
+    "wzspherdef",
+    "wzlimsup",
+    "wzdosignal",
+    "wzenable",
+    "wzdisable",
+    "wzfree",
+    "accset",
+    "velset",
+    "pathaccLim",
+    "stoppmove",
+    "startmove",
+    "storepath",
+    "restopath",
+    "clearpath",
+    "open",
+    "close",
+    "write",
+    "readnum",
+    "clkstart",
+    "clkstop",
+    "clkreset",
+    "tpreadfk",
+    "tpreadnum",
+    "load",
+    "unload",
+    "erase",
+    "raisetouser",
+    "setdo",
+    "pulsedo",
+    "setgo",
+    "setao",
+    "waitdi",
+    "waitdo",
+    "waitgi",
+    "waitgo",
+    "isignaldi",
+    "isignaldo",
+    "itimer",
+    "idelete",
+    "isleep",
+    "iwatch",
+    "ienable",
+    "idisable",
+    "waitsynctask",
+];
+
+impl Tr<'_> {
+    /// A statement list in a scope of its own.
+    pub(crate) fn stmts(&mut self, ss: &[r::Stmt]) -> Vec<w::Stmt> {
+        self.locals.push(BTreeMap::new());
+        let mut out = Vec::new();
+        for s in ss {
+            self.stmt(s, &mut out);
+        }
+        self.locals.pop();
+        out
+    }
+
+    fn stmt(&mut self, s: &r::Stmt, out: &mut Vec<w::Stmt>) {
+        let span = s.span;
+        let mut push = |kind| out.push(w::Stmt { kind, span });
+        match &s.kind {
+            r::StmtKind::Assign { target, value } => {
+                for a in self.assign(target, value, span) {
+                    push(a);
+                }
+            }
+            r::StmtKind::Call { name, args } => self.call(name, args, span, out),
+            r::StmtKind::If { branches, els } => {
+                let mut wb = Vec::new();
+                for (c, body) in branches {
+                    let cond = self.condition(c);
+                    let body = self.stmts(body);
+                    wb.push((cond, block(body, span)));
+                }
+                let els = els.as_ref().map(|e| block(self.stmts(e), span));
+                push(w::StmtKind::If { branches: wb, els });
+            }
+            r::StmtKind::While { cond, body } => {
+                let cond = self.condition(cond);
+                let body = block(self.stmts(body), span);
+                push(w::StmtKind::While { cond, body });
+            }
+            r::StmtKind::For {
+                var,
+                from,
+                to,
+                step,
+                body,
+            } => {
+                let k = self.for_loop(var, from, to, step.as_ref(), body, span);
+                push(k);
+            }
+            r::StmtKind::Test {
+                value,
+                cases,
+                default,
+            } => {
+                let k = self.test(value, cases, default.as_deref(), span);
+                push(k);
+            }
+            r::StmtKind::Return(v) => {
+                let ret = self.routine.as_ref().and_then(|r| r.ret);
+                let kind = self.routine.as_ref().map(|r| r.kind);
+                match (v, ret) {
+                    (Some(e), Some(t)) => {
+                        let v = self.value(e, t).map(super::Val::leaf);
+                        push(w::StmtKind::Return(
+                            v.or(Some(b::expr(w::ExprKind::Error, span))),
+                        ));
+                    }
+                    (None, None) => push(w::StmtKind::Return(None)),
+                    (Some(e), None) => {
+                        self.error(Code::E0031, "a PROC or TRAP returns no value", e.span)
+                            .help = Some("write `RETURN;`, or make the routine a FUNC".into());
+                    }
+                    (None, Some(t)) => {
+                        let _ = kind;
+                        self.error(
+                            Code::E0031,
+                            format!("this FUNC returns {}: give `RETURN value;`", article(t)),
+                            span,
+                        );
+                    }
+                }
+            }
+            r::StmtKind::Exit => push(w::StmtKind::Stop),
+            r::StmtKind::Connect { intno, .. } => {
+                self.unsupported(
+                    "CONNECT (interrupts)",
+                    intno.span.to(span),
+                    "interrupts come with TRAP routines and ISignalDI; see docs/rapid.md",
+                );
+            }
+            r::StmtKind::Unsupported(what) => {
+                self.unsupported(what, span, "write the program without it");
+            }
+            r::StmtKind::Error => {}
+        }
+    }
+
+    /// A condition: a bool.
+    fn condition(&mut self, c: &r::Expr) -> w::Expr {
+        match self.expr(c) {
+            Some(v) if v.ty == Ty::Bool => v.leaf(),
+            Some(v) => {
+                self.error(
+                    Code::E0024,
+                    format!("a condition is a bool, not {}", article(v.ty)),
+                    c.span,
+                );
+                b::expr(w::ExprKind::Error, c.span)
+            }
+            None => b::expr(w::ExprKind::Error, c.span),
+        }
+    }
+
+    /// The data an assignment or `Incr` writes: a name, or an array element at a
+    /// constant index.
+    fn place(&mut self, e: &r::Expr) -> Option<(Data, Option<u32>)> {
+        let (n, idx) = match &e.kind {
+            r::ExprKind::Name(n) => (n, None),
+            r::ExprKind::Index(x, idx) => match (&x.kind, idx.as_slice()) {
+                (r::ExprKind::Name(n), [i]) => (n, Some(i)),
+                _ => {
+                    self.unsupported(
+                        "this assignment target",
+                        e.span,
+                        "assign a name or an array element",
+                    );
+                    return None;
+                }
+            },
+            _ => {
+                self.unsupported(
+                    "this assignment target",
+                    e.span,
+                    "assign a name, a component or an array element",
+                );
+                return None;
+            }
+        };
+        let d = match self.lookup(&n.key()) {
+            Some(Sym::Data(d)) => d,
+            Some(Sym::Routine(_)) => {
+                self.error(
+                    Code::E0023,
+                    format!("`{}` is a routine; it cannot be assigned", n.text),
+                    n.span,
+                );
+                return None;
+            }
+            None => {
+                self.unknown_name(n);
+                return None;
+            }
+        };
+        if d.readonly || d.inline.is_some() {
+            let what = if d.storage == Storage::Const || d.inline.is_some() {
+                "a constant"
+            } else {
+                "a FOR loop's variable"
+            };
+            let e = self.error(
+                Code::E0023,
+                format!("`{}` is {what}; it cannot be assigned", n.text),
+                n.span,
+            );
+            if d.span != Span::default() {
+                e.related.push(crate::diag::Note {
+                    at: crate::diag::Location {
+                        file: String::new(),
+                        span: Some(d.span),
+                        line: 0,
+                        col: 0,
+                    },
+                    message: "declared here".into(),
+                });
+            }
+            return None;
+        }
+        let index = match (idx, d.len) {
+            (None, None) => None,
+            (Some(i), Some(len)) => match self.const_num(i) {
+                Some(k) if k.fract() == 0.0 && k >= 1.0 && k <= f64::from(len) => Some(k as u32),
+                Some(k) => {
+                    self.error(
+                        Code::E0025,
+                        format!("index {k} is outside `{}`'s elements 1 to {len}", n.text),
+                        i.span,
+                    );
+                    return None;
+                }
+                None => {
+                    self.unsupported(
+                        "assigning an array element at a variable index",
+                        e.span,
+                        "assign at a constant index, or keep the values in separate data",
+                    );
+                    return None;
+                }
+            },
+            (None, Some(_)) => {
+                self.unsupported("assigning a whole array", e.span, "assign its elements");
+                return None;
+            }
+            (Some(_), None) => {
+                self.error(Code::E0022, format!("`{}` is not an array", n.text), n.span);
+                return None;
+            }
+        };
+        Some((d, index))
+    }
+
+    fn assign_kind(target: w::Expr, value: w::Expr) -> w::StmtKind {
+        w::StmtKind::Assign {
+            target,
+            op: None,
+            value,
+        }
+    }
+
+    /// `target := value;` as WSL assignments (one per leaf).
+    fn assign(&mut self, target: &r::Expr, value: &r::Expr, span: Span) -> Vec<w::StmtKind> {
+        if let r::ExprKind::Field(x, f) = &target.kind {
+            return self.assign_component(x, f, value, span).unwrap_or_default();
+        }
+        let Some((d, idx)) = self.place(target) else {
+            return Vec::new();
+        };
+        if d.ty == Ty::Str {
+            self.unsupported("assigning a string", span, "use CONST string data");
+            return Vec::new();
+        }
+        let Some(v) = self.value(value, d.ty) else {
+            return Vec::new();
+        };
+        Tr::leaf_names(&d, idx)
+            .iter()
+            .zip(v.parts)
+            .map(|(n, p)| Self::assign_kind(b::name(n, target.span), p))
+            .collect()
+    }
+
+    /// `p.trans.x := v`, `p.rot := o`, `s.v_tcp := v`, `j.robax.rax_2 := a`, …
+    fn assign_component(
+        &mut self,
+        x: &r::Expr,
+        f: &r::Name,
+        value: &r::Expr,
+        span: Span,
+    ) -> Option<Vec<w::StmtKind>> {
+        let key = f.key();
+        // The record itself, and the path of components below it.
+        let (base, path): (&r::Expr, Vec<String>) = match &x.kind {
+            r::ExprKind::Field(y, g) => (y, vec![g.key(), key.clone()]),
+            _ => (x, vec![key.clone()]),
+        };
+        let (d, idx) = self.place(base)?;
+        let names = Tr::leaf_names(&d, idx);
+        let leaf = |i: usize| b::name(&names[i], base.span);
+        let path: Vec<&str> = path.iter().map(String::as_str).collect();
+        let num = |t: &mut Self, dim: Dim| -> Option<w::Expr> {
+            Some(b::with_unit(t.value(value, Ty::Num)?.leaf(), dim))
+        };
+        let set = |target: w::Expr, v: w::Expr| vec![Self::assign_kind(target, v)];
+        Some(match (d.ty, path.as_slice()) {
+            (Ty::Robtarget | Ty::Pose, ["trans", c @ ("x" | "y" | "z")])
+            | (Ty::Pos, [c @ ("x" | "y" | "z")]) => {
+                set(b::field(leaf(0), c), num(self, Dim::LENGTH)?)
+            }
+            (Ty::Robtarget | Ty::Pose, ["trans"]) => {
+                let t = self.value(value, Ty::Pos)?.leaf();
+                let p = leaf(0);
+                let o = b::pose(
+                    [
+                        b::quantity(0.0, Dim::LENGTH, span),
+                        b::quantity(0.0, Dim::LENGTH, span),
+                        b::quantity(0.0, Dim::LENGTH, span),
+                        b::field(p.clone(), "rx"),
+                        b::field(p.clone(), "ry"),
+                        b::field(p.clone(), "rz"),
+                    ],
+                    span,
+                );
+                set(p, super::expr::merge_pose(t, o, span))
+            }
+            (Ty::Robtarget | Ty::Pose, ["rot"]) => {
+                let o = self.value(value, Ty::Orient)?.leaf();
+                let p = leaf(0);
+                set(p.clone(), super::expr::merge_pose(p, o, span))
+            }
+            (Ty::Robtarget, ["robconf" | "extax"]) => {
+                // Configurations and external axes are not simulated (docs/rapid.md).
+                let want = if path[0] == "robconf" {
+                    Ty::Conf
+                } else {
+                    Ty::Extax
+                };
+                self.value(value, want)?;
+                Vec::new()
+            }
+            (Ty::Speed, ["v_tcp"]) => set(leaf(0), num(self, Dim::SPEED)?),
+            (Ty::Speed, ["v_ori"]) => set(leaf(1), num(self, Dim::ANGSPEED)?),
+            (Ty::Speed, ["v_leax" | "v_reax"]) => {
+                self.value(value, Ty::Num)?;
+                Vec::new()
+            }
+            (Ty::Zone, ["pzone_tcp"]) => set(leaf(0), num(self, Dim::LENGTH)?),
+            (Ty::Tool, ["tframe"]) => set(leaf(0), self.value(value, Ty::Pose)?.leaf()),
+            (Ty::Wobj, ["uframe"]) => set(leaf(0), self.value(value, Ty::Pose)?.leaf()),
+            (Ty::Wobj, ["oframe"]) => set(leaf(1), self.value(value, Ty::Pose)?.leaf()),
+            (Ty::Jointtarget, ["robax", rax]) if rax.starts_with("rax_") => {
+                let Ok(k @ 1..=6) = rax[4..].parse::<i64>() else {
+                    self.unsupported(
+                        &format!("the component `{}`", f.text),
+                        f.span,
+                        "use rax_1 … rax_6",
+                    );
+                    return None;
+                };
+                let j = b::expr(
+                    w::ExprKind::Index(
+                        Box::new(leaf(0)),
+                        Box::new(b::expr(w::ExprKind::Int(k - 1), f.span)),
+                    ),
+                    span,
+                );
+                set(j, num(self, Dim::ANGLE)?)
+            }
+            _ => {
+                self.unsupported(
+                    &format!("assigning the component `{}` of {}", f.text, article(d.ty)),
+                    f.span,
+                    "assign the whole value, or trans.x/y/z, rot, v_tcp, v_ori, pzone_tcp, tframe, uframe, oframe, robax.rax_1…6",
+                );
+                return None;
+            }
+        })
+    }
+
+    fn for_loop(
+        &mut self,
+        var: &r::Name,
+        from: &r::Expr,
+        to: &r::Expr,
+        step: Option<&r::Expr>,
+        body: &[r::Stmt],
+        span: Span,
+    ) -> w::StmtKind {
+        let start = self.value(from, Ty::Num).map(super::Val::leaf);
+        let end = self.value(to, Ty::Num).map(super::Val::leaf);
+        let step_v = match step {
+            Some(s) => self.value(s, Ty::Num).map(super::Val::leaf),
+            None => Some(b::num(1.0, span)),
+        };
+        let (Some(start), Some(end), Some(step_v)) = (start, end, step_v) else {
+            return w::StmtKind::Error;
+        };
+        let i = self.fresh_local(&super::wsl_name(var));
+        let end_name = self.temp("for_end");
+        let decl = |n: &str, init: w::Expr| w::Stmt {
+            kind: w::StmtKind::Var(w::VarDecl {
+                name: b::ident(n, span),
+                ty: Some(b::ident("num", span)),
+                init: Some(init),
+                span,
+            }),
+            span,
+        };
+        let mut stmts = vec![decl(&i, start), decl(&end_name, end)];
+        let iv = || b::name(&i, var.span);
+        let ev = || b::name(&end_name, span);
+        let (cond, step_e) = match b::literal(&step_v) {
+            Some(s) => {
+                let op = if s >= 0.0 { w::BinOp::Le } else { w::BinOp::Ge };
+                (b::bin(op, iv(), ev()), step_v)
+            }
+            None => {
+                let sn = self.temp("for_step");
+                stmts.push(decl(&sn, step_v));
+                let sv = || b::name(&sn, span);
+                let zero = || b::num(0.0, span);
+                let up = b::bin(
+                    w::BinOp::And,
+                    b::bin(w::BinOp::Ge, sv(), zero()),
+                    b::bin(w::BinOp::Le, iv(), ev()),
+                );
+                let down = b::bin(
+                    w::BinOp::And,
+                    b::bin(w::BinOp::Lt, sv(), zero()),
+                    b::bin(w::BinOp::Ge, iv(), ev()),
+                );
+                (b::bin(w::BinOp::Or, up, down), sv())
+            }
+        };
+        // The loop variable is read-only in the body.
+        let mut scope = BTreeMap::new();
+        scope.insert(
+            var.key(),
+            Data {
+                ty: Ty::Num,
+                len: None,
+                storage: Storage::Var,
+                base: i.clone(),
+                span: var.span,
+                text: None,
+                inline: None,
+                local: true,
+                readonly: true,
+            },
+        );
+        self.locals.push(scope);
+        let mut inner = self.stmts(body);
+        self.locals.pop();
+        inner.push(w::Stmt {
+            kind: w::StmtKind::Assign {
+                target: iv(),
+                op: Some(w::BinOp::Add),
+                value: step_e,
+            },
+            span,
+        });
+        stmts.push(w::Stmt {
+            kind: w::StmtKind::While {
+                cond,
+                body: block(inner, span),
+            },
+            span,
+        });
+        w::StmtKind::Block(block(stmts, span))
+    }
+
+    fn test(
+        &mut self,
+        value: &r::Expr,
+        cases: &[(Vec<r::Expr>, Vec<r::Stmt>)],
+        default: Option<&[r::Stmt]>,
+        span: Span,
+    ) -> w::StmtKind {
+        let Some(v) = self.expr(value) else {
+            return w::StmtKind::Error;
+        };
+        if !matches!(v.ty, Ty::Num | Ty::Bool) {
+            self.unsupported(
+                &format!("TEST of {}", article(v.ty)),
+                value.span,
+                "TEST a num or a bool",
+            );
+            return w::StmtKind::Error;
+        }
+        let ty = v.ty;
+        let t = self.temp("test");
+        let wty = if ty == Ty::Num { "num" } else { "bool" };
+        let decl = w::Stmt {
+            kind: w::StmtKind::Var(w::VarDecl {
+                name: b::ident(&t, span),
+                ty: Some(b::ident(wty, span)),
+                init: Some(v.leaf()),
+                span,
+            }),
+            span,
+        };
+        let mut branches = Vec::new();
+        for (vals, body) in cases {
+            let mut cond: Option<w::Expr> = None;
+            for e in vals {
+                let Some(c) = self.value(e, ty) else { continue };
+                let eq = b::bin(w::BinOp::Eq, b::name(&t, e.span), c.leaf());
+                cond = Some(match cond {
+                    None => eq,
+                    Some(prev) => b::bin(w::BinOp::Or, prev, eq),
+                });
+            }
+            let body = self.stmts(body);
+            branches.push((
+                cond.unwrap_or_else(|| b::expr(w::ExprKind::Error, span)),
+                block(body, span),
+            ));
+        }
+        let els = default.map(|d| block(self.stmts(d), span));
+        let mut stmts = vec![decl];
+        if branches.is_empty() {
+            if let Some(e) = els {
+                stmts.push(w::Stmt {
+                    kind: w::StmtKind::Block(e),
+                    span,
+                });
+            }
+        } else {
+            stmts.push(w::Stmt {
+                kind: w::StmtKind::If { branches, els },
+                span,
+            });
+        }
+        w::StmtKind::Block(block(stmts, span))
+    }
+
+    /// An instruction or a call of one of the task's PROCs.
+    fn call(&mut self, name: &r::Name, args: &[Arg], span: Span, out: &mut Vec<w::Stmt>) {
+        let key = name.key();
+        let mut push = |kind| out.push(w::Stmt { kind, span });
+        match key.as_str() {
+            "movej" | "movel" | "movec" | "moveabsj" => {
+                if let Some(k) = self.motion(&key, name, args, span) {
+                    push(k);
+                }
+            }
+            "waittime" => {
+                if let Some((p, _)) = self.split_args(name, args, 1..=1, &["InPos"], span)
+                    && let Some(t) = self.value(p[0], Ty::Num)
+                {
+                    push(w::StmtKind::Delay(b::with_unit(t.leaf(), Dim::TIME)));
+                }
+            }
+            "waituntil" => self.wait_until(name, args, span, out),
+            "tpwrite" => {
+                let Some((p, opts)) = self.split_args(
+                    name,
+                    args,
+                    1..=1,
+                    &["Num", "Dnum", "Bool", "Pos", "Orient"],
+                    span,
+                ) else {
+                    return;
+                };
+                let mut parts = Vec::new();
+                self.text_parts(p[0], &mut parts);
+                for (_, _, v) in opts {
+                    if let Some(e) = v
+                        && let Some(v) = self.expr(e)
+                    {
+                        parts.extend(self.printable(v, e.span));
+                    }
+                }
+                push(w::StmtKind::Log(parts));
+            }
+            "errwrite" => {
+                let Some((p, _)) = self.split_args(name, args, 2..=6, &["W", "I"], span) else {
+                    return;
+                };
+                let mut parts = vec![b::expr(w::ExprKind::Str("ErrWrite: ".into()), span)];
+                for (k, e) in p.iter().enumerate() {
+                    if k > 0 {
+                        parts.push(b::expr(w::ExprKind::Str(" ".into()), span));
+                    }
+                    self.text_parts(e, &mut parts);
+                }
+                push(w::StmtKind::Log(parts));
+            }
+            "stop" | "break" => {
+                if self
+                    .split_args(name, args, 0..=0, &["NoRegain", "AllMoveTasks"], span)
+                    .is_some()
+                {
+                    push(w::StmtKind::Stop);
+                }
+            }
+            "incr" | "decr" | "add" => {
+                let n = if key == "add" { 2 } else { 1 };
+                let Some((p, _)) = self.split_args(name, args, n..=n, &[], span) else {
+                    return;
+                };
+                let Some((d, idx)) = self.place(p[0]) else {
+                    return;
+                };
+                if d.ty != Ty::Num {
+                    self.error(
+                        Code::E0020,
+                        format!("{} changes a num, not {}", name.text, article(d.ty)),
+                        p[0].span,
+                    );
+                    return;
+                }
+                let by = if key == "add" {
+                    match self.value(p[1], Ty::Num) {
+                        Some(v) => v.leaf(),
+                        None => return,
+                    }
+                } else {
+                    b::num(1.0, span)
+                };
+                let op = if key == "decr" {
+                    w::BinOp::Sub
+                } else {
+                    w::BinOp::Add
+                };
+                let target = b::name(&Tr::leaf_names(&d, idx)[0], p[0].span);
+                push(w::StmtKind::Assign {
+                    target,
+                    op: Some(op),
+                    value: by,
+                });
+            }
+            k if NO_OPS.contains(&k) => {}
+            k if UNSUPPORTED.contains(&k) => {
+                self.unsupported(
+                    &format!("the instruction `{}`", name.text),
+                    name.span,
+                    "write the program without it",
+                );
+            }
+            _ => {
+                match self.lookup(&key) {
+                    Some(Sym::Routine(sig)) if sig.kind == r::RoutineKind::Proc => {
+                        if let Some(wargs) = self.call_args(name, &sig.params, args, span) {
+                            push(w::StmtKind::Call {
+                                name: b::ident(&sig.wsl, name.span),
+                                args: wargs,
+                            });
+                        }
+                    }
+                    Some(Sym::Routine(sig)) if sig.kind == r::RoutineKind::Func => {
+                        self.error(
+                            Code::E0011,
+                            format!("`{}` is a FUNC: use its value", name.text),
+                            name.span,
+                        );
+                    }
+                    Some(Sym::Routine(_)) => {
+                        self.error(
+                            Code::E0011,
+                            format!(
+                                "`{}` is a TRAP: it runs on an interrupt, it is not called",
+                                name.text
+                            ),
+                            name.span,
+                        );
+                    }
+                    _ => {
+                        let names: Vec<String> = self
+                            .scope
+                            .iter()
+                            .filter(|(_, s)| matches!(s, Sym::Routine(_)))
+                            .map(|(k, _)| k.clone())
+                            .collect();
+                        let near =
+                            crate::nearest(&key, names.iter().map(String::as_str)).map(|m| {
+                                self.spelled
+                                    .get(m)
+                                    .cloned()
+                                    .unwrap_or_else(|| m.to_string())
+                            });
+                        let d = self.error(
+                            Code::E0011,
+                            format!("unknown instruction or procedure `{}`", name.text),
+                            name.span,
+                        );
+                        d.help = Some(match near {
+                        Some(n) => format!("did you mean `{n}`?"),
+                        None => "declare it with PROC; docs/rapid.md lists the instructions vworks runs".into(),
+                    });
+                    }
+                }
+            }
+        }
+    }
+
+    fn motion(&mut self, key: &str, f: &r::Name, args: &[Arg], span: Span) -> Option<w::StmtKind> {
+        let circular = key == "movec";
+        let n = if circular { 5 } else { 4 };
+        let opts_ok: &[&str] = &[
+            "Conc", "ID", "V", "T", "Z", "InPos", "WObj", "TLoad", "NoEOffs", "Corr",
+        ];
+        let (p, opts) = self.split_args(f, args, n..=n, opts_ok, span)?;
+        let mut v_override = None;
+        let mut z_override = None;
+        let mut wobj = None;
+        for (k, name, v) in &opts {
+            match k.as_str() {
+                "v" | "z" => {
+                    let Some(e) = v else {
+                        self.error(
+                            Code::E0301,
+                            format!("`\\{}` needs a value: `\\{}:=…`", name.text, name.text),
+                            name.span,
+                        );
+                        return None;
+                    };
+                    let x = self.value(e, Ty::Num)?.leaf();
+                    if k == "v" {
+                        v_override = Some(b::with_unit(x, Dim::SPEED));
+                    } else {
+                        z_override = Some(b::with_unit(x, Dim::LENGTH));
+                    }
+                }
+                "wobj" => {
+                    let Some(e) = v else {
+                        self.error(
+                            Code::E0301,
+                            "`\\WObj` needs a value: `\\WObj:=wobj1`",
+                            name.span,
+                        );
+                        return None;
+                    };
+                    wobj = Some(self.value(e, Ty::Wobj)?);
+                }
+                "t" | "inpos" | "corr" => {
+                    self.unsupported(
+                        &format!("the motion option `\\{}`", name.text),
+                        name.span,
+                        "give the motion its speed instead",
+                    );
+                    return None;
+                }
+                // \Conc, \ID, \TLoad, \NoEOffs: accepted; they change nothing vworks simulates.
+                _ => {}
+            }
+        }
+        let (via, target) = if circular {
+            (
+                Some(self.value(p[0], Ty::Robtarget)?.leaf()),
+                self.value(p[1], Ty::Robtarget)?.leaf(),
+            )
+        } else if key == "moveabsj" {
+            (None, self.value(p[0], Ty::Jointtarget)?.leaf())
+        } else {
+            (None, self.value(p[0], Ty::Robtarget)?.leaf())
+        };
+        let rest = &p[n - 3..];
+        let speed = self.value(rest[0], Ty::Speed)?;
+        let zone = self.value(rest[1], Ty::Zone)?.leaf();
+        let tool = self.value(rest[2], Ty::Tool)?;
+        if !is_identity_pose(&tool.parts[0]) {
+            self.unsupported(
+                "a tool other than tool0 (the TCP is the workcell's tool for now)",
+                rest[2].span,
+                "use tool0 and give the robot its tool in the workcell",
+            );
+            return None;
+        }
+        if let Some(w) = &wobj
+            && !(is_identity_pose(&w.parts[0]) && is_identity_pose(&w.parts[1]))
+        {
+            self.unsupported(
+                "a work object other than wobj0 (for now)",
+                span,
+                "write the targets in the robot's base frame",
+            );
+            return None;
+        }
+        let v_tcp = v_override.unwrap_or_else(|| speed.parts[0].clone());
+        let zone = z_override.unwrap_or(zone);
+        let zone = match b::literal(&zone) {
+            Some(0.0) => w::Zone::Fine,
+            _ => w::Zone::Radius(zone),
+        };
+        let kind = match key {
+            "movel" => w::MoveKind::L,
+            "movec" => w::MoveKind::C,
+            _ => w::MoveKind::J,
+        };
+        // MoveJ and MoveAbsJ: the axes move at full speed for now (docs/rapid.md).
+        let speed = (kind != w::MoveKind::J).then_some(v_tcp);
+        Some(w::StmtKind::Move {
+            kind,
+            via,
+            target,
+            speed,
+            accel: None,
+            zone: Some(zone),
+        })
+    }
+
+    fn wait_until(&mut self, f: &r::Name, args: &[Arg], span: Span, out: &mut Vec<w::Stmt>) {
+        let Some((p, opts)) = self.split_args(
+            f,
+            args,
+            1..=1,
+            &["InPos", "MaxTime", "TimeFlag", "PollRate"],
+            span,
+        ) else {
+            return;
+        };
+        let cond = self.condition(p[0]);
+        let mut timeout = None;
+        let mut flag = None;
+        for (k, name, v) in &opts {
+            match (k.as_str(), v) {
+                ("maxtime", Some(e)) => {
+                    timeout = self
+                        .value(e, Ty::Num)
+                        .map(|v| b::with_unit(v.leaf(), Dim::TIME));
+                }
+                ("timeflag", Some(e)) => flag = self.place(e),
+                ("pollrate", Some(e)) => {
+                    self.value(e, Ty::Num);
+                }
+                ("inpos", None) => {}
+                _ => {
+                    self.error(
+                        Code::E0301,
+                        format!("`\\{}` is written `\\{}:=value`", name.text, name.text),
+                        name.span,
+                    );
+                }
+            }
+        }
+        let has_timeout = timeout.is_some();
+        out.push(w::Stmt {
+            kind: w::StmtKind::WaitUntil { cond, timeout },
+            span,
+        });
+        let timed_out = || b::call("timed_out", vec![], span);
+        match flag {
+            Some((d, idx)) if d.ty == Ty::Bool => out.push(w::Stmt {
+                kind: Self::assign_kind(b::name(&Tr::leaf_names(&d, idx)[0], span), timed_out()),
+                span,
+            }),
+            Some((d, _)) => {
+                self.error(
+                    Code::E0020,
+                    format!("\\TimeFlag is a bool, not {}", article(d.ty)),
+                    span,
+                );
+            }
+            None if has_timeout => {
+                // Without \TimeFlag, an expired \MaxTime is the error ERR_WAIT_MAXTIME.
+                let fail = w::Stmt {
+                    kind: w::StmtKind::Fail(vec![b::expr(
+                        w::ExprKind::Str("WaitUntil: \\MaxTime expired (ERR_WAIT_MAXTIME)".into()),
+                        span,
+                    )]),
+                    span,
+                };
+                out.push(w::Stmt {
+                    kind: w::StmtKind::If {
+                        branches: vec![(timed_out(), block(vec![fail], span))],
+                        els: None,
+                    },
+                    span,
+                });
+            }
+            None => {}
+        }
+    }
+
+    /// The pieces of a text for TPWrite and ErrWrite: literal text, and NumToStr/ValToStr
+    /// of values.
+    fn text_parts(&mut self, e: &r::Expr, out: &mut Vec<w::Expr>) {
+        match &e.kind {
+            r::ExprKind::Binary(r::BinOp::Add, a, c) => {
+                self.text_parts(a, out);
+                self.text_parts(c, out);
+            }
+            r::ExprKind::Call(f, args) if matches!(f.key().as_str(), "numtostr" | "valtostr") => {
+                let first = args.iter().find_map(|a| match a {
+                    Arg::Pos(e) => Some(e),
+                    Arg::Opt(..) => None,
+                });
+                if let Some(x) = first
+                    && let Some(v) = self.expr(x)
+                {
+                    out.extend(self.printable(v, x.span));
+                }
+            }
+            _ => match self.expr(e) {
+                Some(v) if v.ty == Ty::Str => {
+                    out.push(b::expr(
+                        w::ExprKind::Str(v.text.unwrap_or_default()),
+                        e.span,
+                    ));
+                }
+                Some(v) => {
+                    self.error(
+                        Code::E0020,
+                        format!("expected a string, found {}", article(v.ty)),
+                        e.span,
+                    )
+                    .help = Some("turn values into text with NumToStr or ValToStr".into());
+                }
+                None => {}
+            },
+        }
+    }
+
+    /// A value as `log` pieces.
+    fn printable(&mut self, v: super::Val, span: Span) -> Vec<w::Expr> {
+        match v.ty {
+            Ty::Num
+            | Ty::Bool
+            | Ty::Pos
+            | Ty::Orient
+            | Ty::Pose
+            | Ty::Robtarget
+            | Ty::Jointtarget => v.parts,
+            Ty::Str => vec![b::expr(w::ExprKind::Str(v.text.unwrap_or_default()), span)],
+            t => {
+                self.unsupported(
+                    &format!("printing {}", article(t)),
+                    span,
+                    "print its components",
+                );
+                Vec::new()
+            }
+        }
+    }
+}
+
+/// True if a WSL expression is the literal identity pose.
+fn is_identity_pose(e: &w::Expr) -> bool {
+    match &e.kind {
+        w::ExprKind::Call(f, a) if f.name == "pose" => a.iter().all(|x| b::literal(x) == Some(0.0)),
+        _ => false,
+    }
+}

@@ -1,0 +1,10 @@
+! E0300: RAPID constructs vworks does not run are errors that name them
+MODULE m
+  PROC main()
+    SearchL \Stop, diSensor, pFound, pEnd, v100, tool0;
+    GOTO done;
+    MoveL pEnd, v100 \T:=3, fine, tool0;
+  ERROR
+    RETRY;
+  ENDPROC
+ENDMODULE
