@@ -31,6 +31,10 @@ pub(crate) enum Ty {
     Conf,
     Extax,
     Intnum,
+    /// A MultiMove synchronisation point (`WaitSyncTask`).
+    Syncident,
+    /// A task name, in the task lists of `WaitSyncTask`.
+    Tasks,
 }
 
 impl Ty {
@@ -53,6 +57,8 @@ impl Ty {
             "confdata" => Ty::Conf,
             "extjoint" => Ty::Extax,
             "intnum" => Ty::Intnum,
+            "syncident" => Ty::Syncident,
+            "tasks" => Ty::Tasks,
             _ => return None,
         })
     }
@@ -76,6 +82,8 @@ impl Ty {
             Ty::Conf => "confdata",
             Ty::Extax => "extjoint",
             Ty::Intnum => "intnum",
+            Ty::Syncident => "syncident",
+            Ty::Tasks => "tasks",
         }
     }
 
@@ -90,7 +98,7 @@ impl Ty {
             Ty::Zone => &[(".pzone_tcp", "length")],
             Ty::Tool => &[(".tframe", "pose")],
             Ty::Wobj => &[(".uframe", "pose"), (".oframe", "pose")],
-            Ty::Str | Ty::Load | Ty::Conf | Ty::Extax => &[],
+            Ty::Str | Ty::Load | Ty::Conf | Ty::Extax | Ty::Syncident | Ty::Tasks => &[],
         }
     }
 

@@ -434,7 +434,8 @@ impl Tr<'_> {
             Ty::Wobj => 5,
             Ty::Load => 6,
             Ty::Extax => 6,
-            Ty::Num | Ty::Bool | Ty::Str | Ty::Intnum => {
+            Ty::Tasks => 1,
+            Ty::Num | Ty::Bool | Ty::Str | Ty::Intnum | Ty::Syncident => {
                 self.error(
                     Code::E0020,
                     format!("expected {}, found `[…]`", article(want)),
@@ -632,7 +633,23 @@ impl Tr<'_> {
                     text: None,
                 })
             }
-            Ty::Num | Ty::Bool | Ty::Str | Ty::Intnum => None,
+            Ty::Tasks => {
+                let name = self.expr(&items[0])?;
+                if name.ty != Ty::Str {
+                    self.error(
+                        Code::E0020,
+                        "a task is written `[\"T_ROB1\"]`",
+                        items[0].span,
+                    );
+                    return None;
+                }
+                Some(Val {
+                    ty: Ty::Tasks,
+                    parts: Vec::new(),
+                    text: name.text,
+                })
+            }
+            Ty::Num | Ty::Bool | Ty::Str | Ty::Intnum | Ty::Syncident => None,
         }
     }
 

@@ -415,6 +415,11 @@ impl Tr<'_> {
             self.scope.insert(key, Sym::Data(data));
             return;
         }
+        if ty == Ty::Syncident {
+            self.syncident(d, &data);
+            self.scope.insert(key, Sym::Data(data));
+            return;
+        }
         let inits = self.initial_values(d, ty, len);
         // A CONST scalar of literal leaves is folded where it is used (array sizes, …).
         if d.storage == Storage::Const
@@ -469,6 +474,29 @@ impl Tr<'_> {
             }
         }
         out
+    }
+
+    /// `VAR syncident s;`: the cell's count of arrivals at the sync point (a global shared
+    /// by every task that declares it) and this task's own count.
+    fn syncident(&mut self, d: &r::DataDecl, data: &Data) {
+        if data.len.is_some() || d.init.is_some() {
+            self.unsupported(
+                "an array or an initial value of a syncident",
+                d.span,
+                "declare `VAR syncident name;`",
+            );
+            return;
+        }
+        let int = |n: i64| b::expr(w::ExprKind::Int(n), d.span);
+        let decl = |name: &str| w::VarDecl {
+            name: b::ident(name, d.name.span),
+            ty: Some(b::ident("int", d.ty.span)),
+            init: Some(int(0)),
+            span: d.span,
+        };
+        self.items.push(w::Item::Global(decl(&data.base)));
+        self.items
+            .push(w::Item::Var(decl(&format!("{}#arrivals", data.base))));
     }
 
     fn string_data(&mut self, d: &r::DataDecl, data: &mut Data) {

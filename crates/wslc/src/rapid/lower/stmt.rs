@@ -592,6 +592,7 @@ impl Tr<'_> {
                 }
             }
             "waituntil" => self.wait_until(name, args, span, out),
+            "waitsynctask" => self.wait_sync_task(name, args, span, out),
             "tpwrite" => {
                 let Some((p, opts)) = self.split_args(
                     name,
@@ -910,6 +911,130 @@ impl Tr<'_> {
                 });
             }
             None => {}
+        }
+    }
+
+    /// `WaitSyncTask s, tasks;`: this task arrives at sync point `s` and waits until every
+    /// task of the list has arrived as many times. With n tasks, the cell's count of
+    /// arrivals at `s` reaches n·k when the k-th meeting is complete.
+    fn wait_sync_task(&mut self, f: &r::Name, args: &[Arg], span: Span, out: &mut Vec<w::Stmt>) {
+        let Some((p, opts)) = self.split_args(f, args, 2..=2, &["InPos", "TimeOut"], span) else {
+            return;
+        };
+        let sync = match &p[0].kind {
+            r::ExprKind::Name(n) => match self.lookup(&n.key()) {
+                Some(Sym::Data(d)) if d.ty == Ty::Syncident && !d.local => d,
+                Some(_) => {
+                    self.error(
+                        Code::E0020,
+                        format!("`{}` is not a syncident declared at module level", n.text),
+                        n.span,
+                    );
+                    return;
+                }
+                None => {
+                    self.unknown_name(n);
+                    return;
+                }
+            },
+            _ => {
+                self.error(
+                    Code::E0020,
+                    "WaitSyncTask's first argument is a syncident's name",
+                    p[0].span,
+                );
+                return;
+            }
+        };
+        let tasks = match &p[1].kind {
+            r::ExprKind::Name(n) => match self.lookup(&n.key()) {
+                Some(Sym::Data(d)) if d.ty == Ty::Tasks => d.len.unwrap_or(1),
+                Some(_) => {
+                    self.error(
+                        Code::E0020,
+                        format!("`{}` is not a task list (`tasks`)", n.text),
+                        n.span,
+                    );
+                    return;
+                }
+                None => {
+                    self.unknown_name(n);
+                    return;
+                }
+            },
+            _ => {
+                self.error(
+                    Code::E0020,
+                    "WaitSyncTask's second argument is a task list's name",
+                    p[1].span,
+                );
+                return;
+            }
+        };
+        let mut timeout = None;
+        for (k, n, v) in &opts {
+            if k == "timeout" {
+                match v {
+                    Some(e) => {
+                        timeout = self
+                            .value(e, Ty::Num)
+                            .map(|v| b::with_unit(v.leaf(), Dim::TIME))
+                    }
+                    None => {
+                        self.error(
+                            Code::E0301,
+                            "`\\TimeOut` is written `\\TimeOut:=seconds`",
+                            n.span,
+                        );
+                    }
+                }
+            }
+        }
+        let int = |n: i64| b::expr(w::ExprKind::Int(n), span);
+        let mine = format!("{}#arrivals", sync.base);
+        let target = self.temp("sync");
+        let mut stmt = |kind| out.push(w::Stmt { kind, span });
+        stmt(w::StmtKind::Assign {
+            target: b::name(&mine, span),
+            op: Some(w::BinOp::Add),
+            value: int(1),
+        });
+        stmt(w::StmtKind::Var(w::VarDecl {
+            name: b::ident(&target, span),
+            ty: Some(b::ident("int", span)),
+            init: Some(b::bin(
+                w::BinOp::Mul,
+                b::name(&mine, span),
+                int(i64::from(tasks)),
+            )),
+            span,
+        }));
+        stmt(w::StmtKind::Assign {
+            target: b::name(&sync.base, p[0].span),
+            op: Some(w::BinOp::Add),
+            value: int(1),
+        });
+        let has_timeout = timeout.is_some();
+        stmt(w::StmtKind::WaitUntil {
+            cond: b::bin(
+                w::BinOp::Ge,
+                b::name(&sync.base, p[0].span),
+                b::name(&target, span),
+            ),
+            timeout,
+        });
+        if has_timeout {
+            let fail = w::Stmt {
+                kind: w::StmtKind::Fail(vec![b::expr(
+                    w::ExprKind::Str("WaitSyncTask: \\TimeOut expired (ERR_WAITSYNCTASK)".into()),
+                    span,
+                )]),
+                span,
+            };
+            stmt(w::StmtKind::If {
+                branches: vec![(b::call("timed_out", vec![], span), block(vec![fail], span))],
+                els: None,
+            });
         }
     }
 
