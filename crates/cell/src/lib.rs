@@ -25,6 +25,7 @@ use vworks_vm::{Dim, Module};
 use vworks_wslc::link::{CellSpec, Linked, RobotSpec, link};
 use vworks_wslc::{Diagnostic, Sources};
 
+mod io;
 pub mod params;
 pub mod variants;
 
@@ -141,6 +142,9 @@ struct CellFile {
     /// Values of the programs' `param`s (`[params]`), for every program that declares them.
     #[serde(default)]
     params: BTreeMap<String, toml::Value>,
+    /// The I/O wiring (`[[io]]`).
+    #[serde(default)]
+    io: Vec<io::IoFile>,
 }
 
 /// A robot of the cell.
@@ -661,6 +665,8 @@ fn load_parsed(
     let mut warnings = Vec::new();
     let mut render_sources = Sources::new();
     let mut param_copies = Vec::new();
+    let robot_names: Vec<&str> = cf.robot.iter().map(|r| r.name.as_str()).collect();
+    let wiring = io::signals(&cx, &cf.io, &robot_names)?;
     for (i, r) in cf.robot.iter().enumerate() {
         let key = format!("robot[{i}] `{}`", r.name);
         let model_key = format!(
@@ -718,10 +724,21 @@ fn load_parsed(
         };
         let ppath = dir.join(program);
         let pname = ppath.display().to_string();
-        let module = match modules.iter().find(|(p, _)| *p == pname) {
+        let language = vworks_wslc::Language::of_path(&pname);
+        // A RAPID program is compiled with its robot's wired signals: robots that share a
+        // file but not their signals get a copy each.
+        let signals = match (&wiring, language) {
+            (Some(w), vworks_wslc::Language::Rapid) => w.get(i).map(Vec::as_slice),
+            _ => None,
+        };
+        let mkey = match signals {
+            Some(s) => format!("{pname}\u{0}{s:?}"),
+            None => pname.clone(),
+        };
+        let module = match modules.iter().find(|(p, _)| *p == mkey) {
             Some((_, m)) => Arc::clone(m),
             None => {
-                let compiled = match cache.program(&pname) {
+                let compiled = match cache.program(&mkey) {
                     Some(c) => c,
                     None => {
                         let bytes = fs.read(&ppath).map_err(|e| {
@@ -733,15 +750,16 @@ fn load_parsed(
                         let src = vworks_wslc::source_text(bytes).map_err(|e| {
                             cx.bad(&format!("{key}.program"), format!("{pname}: {e}"))
                         })?;
-                        let result = vworks_wslc::compile_as(
-                            vworks_wslc::Language::of_path(&pname),
-                            &pname,
-                            &src,
-                        )
+                        let result = match language {
+                            vworks_wslc::Language::Rapid => {
+                                vworks_wslc::rapid::compile_with_io(&pname, &src, signals)
+                            }
+                            vworks_wslc::Language::Wsl => vworks_wslc::compile(&pname, &src),
+                        }
                         .map(|out| (Arc::new(out.module), out.warnings))
                         .map_err(|e| e.diagnostics);
                         cache.keep_program(
-                            &pname,
+                            &mkey,
                             Compiled {
                                 source: src,
                                 result,
@@ -750,11 +768,13 @@ fn load_parsed(
                     }
                 };
                 render_sources.add(&pname, &compiled.source);
-                sources.push((pname.clone(), compiled.source.clone()));
+                if !sources.iter().any(|(p, _)| *p == pname) {
+                    sources.push((pname.clone(), compiled.source.clone()));
+                }
                 match &compiled.result {
                     Ok((m, w)) => {
                         warnings.extend(w.iter().cloned());
-                        modules.push((pname.clone(), Arc::clone(m)));
+                        modules.push((mkey.clone(), Arc::clone(m)));
                         Arc::clone(m)
                     }
                     Err(d) => {

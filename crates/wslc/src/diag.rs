@@ -86,6 +86,8 @@ codes! {
     E0106 = "entry procedure missing",
     E0300 = "RAPID construct not supported",
     E0301 = "RAPID optional argument not accepted",
+    E0302 = "unknown I/O signal",
+    E0303 = "interrupt not connected",
     E0900 = "internal compiler error",
     W0001 = "local shadows a global",
     W0002 = "`disable` of a handler never enabled",

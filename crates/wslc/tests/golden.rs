@@ -23,6 +23,7 @@ use expect_test::expect_file;
 use vworks_vm::Module;
 use vworks_vm::bytecode::disassemble;
 use vworks_wslc::link::{CellSpec, RobotSpec, link};
+use vworks_wslc::rapid::{IoSignal, SignalKind};
 use vworks_wslc::{Code, Language, Sources, compile_as, render};
 
 fn dir(name: &str) -> PathBuf {
@@ -39,7 +40,26 @@ fn programs(name: &str) -> Vec<PathBuf> {
     v
 }
 
+/// Compiles a fixture. A RAPID fixture with a `NAME.io` beside it is compiled with those
+/// I/O signals (one per line: `name kind global init`), as a workcell's `[[io]]` gives.
 fn compile(name: &str, src: &str) -> Result<vworks_wslc::Compiled, vworks_wslc::CompileError> {
+    let io_file = dir("").join(name).with_extension("io");
+    if Language::of_path(name) == Language::Rapid && io_file.exists() {
+        let io: Vec<IoSignal> = read(&io_file)
+            .lines()
+            .filter(|l| !l.trim().is_empty())
+            .map(|l| {
+                let f: Vec<&str> = l.split_whitespace().collect();
+                IoSignal {
+                    name: f[0].to_string(),
+                    kind: SignalKind::from_name(f[1]).unwrap(),
+                    global: f[2].to_string(),
+                    init: f[3].parse().unwrap(),
+                }
+            })
+            .collect();
+        return vworks_wslc::rapid::compile_with_io(name, src, Some(&io));
+    }
     compile_as(Language::of_path(name), name, src)
 }
 

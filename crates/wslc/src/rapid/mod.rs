@@ -32,8 +32,75 @@ pub fn is_rapid_path(path: &str) -> bool {
         .is_some_and(|e| EXTENSIONS.iter().any(|x| x.eq_ignore_ascii_case(e)))
 }
 
+/// The kind of an I/O signal.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum SignalKind {
+    /// A digital input (0 or 1).
+    Di,
+    /// A digital output (0 or 1).
+    Do,
+    /// A group input (a whole number).
+    Gi,
+    /// A group output (a whole number).
+    Go,
+}
+
+impl SignalKind {
+    /// The kind from its name in a workcell (`di`, `do`, `gi`, `go`, any case).
+    pub fn from_name(s: &str) -> Option<SignalKind> {
+        Some(match s.to_ascii_lowercase().as_str() {
+            "di" => SignalKind::Di,
+            "do" => SignalKind::Do,
+            "gi" => SignalKind::Gi,
+            "go" => SignalKind::Go,
+            _ => return None,
+        })
+    }
+    /// `di`, `do`, `gi` or `go`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SignalKind::Di => "di",
+            SignalKind::Do => "do",
+            SignalKind::Gi => "gi",
+            SignalKind::Go => "go",
+        }
+    }
+    /// An output (written by `SetDO`, `SetGO`, …).
+    pub fn is_output(self) -> bool {
+        matches!(self, SignalKind::Do | SignalKind::Go)
+    }
+}
+
+/// An I/O signal as one robot task sees it: the workcell wires it to one of the cell's
+/// globals (signals are levels; a `SetDO` is a `set` of that global).
+#[derive(Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct IoSignal {
+    /// Its name in this task's programs.
+    pub name: String,
+    /// Its kind.
+    pub kind: SignalKind,
+    /// The cell's global (int) that holds its value: the name of the output that drives it.
+    pub global: String,
+    /// Its value at the start.
+    pub init: i64,
+}
+
 /// Compiles one RAPID file (one or more `MODULE … ENDMODULE`) into a verified module.
+/// Its I/O signals need no workcell: a signal an I/O instruction names is the cell's
+/// global of that name (`SetDO doReady, 1;` sets `doready`). Within a workcell, the
+/// loader calls [`compile_with_io`] with the robot's wired signals.
 pub fn compile(path: &str, source: &str) -> Result<Compiled, CompileError> {
+    compile_with_io(path, source, None)
+}
+
+/// Compiles one RAPID file for a robot whose I/O signals are `io` (the workcell's
+/// `[[io]]`); a signal outside it is error E0302. `None`: any signal an I/O instruction
+/// names, as [`compile`].
+pub fn compile_with_io(
+    path: &str,
+    source: &str,
+    io: Option<&[IoSignal]>,
+) -> Result<Compiled, CompileError> {
     let mut diags: Vec<Diagnostic> = Vec::new();
     let toks = lexer::lex(source, &mut diags);
     let modules = parser::parse(source, toks, &mut diags);
@@ -50,7 +117,7 @@ pub fn compile(path: &str, source: &str) -> Result<Compiled, CompileError> {
                 .with_help("a RAPID program is one or more modules: `MODULE name … ENDMODULE`"),
             );
         }
-        Some(lower::translate(&modules, &mut diags))
+        Some(lower::translate(&modules, io, &mut diags))
     };
     crate::finish(path, source, ast.as_ref(), diags)
 }

@@ -104,6 +104,9 @@ impl Tr<'_> {
                 None
             }
             None => {
+                if let Some(v) = self.signal_value(n) {
+                    return Some(v);
+                }
                 self.unknown_name(n);
                 None
             }
@@ -657,6 +660,9 @@ impl Tr<'_> {
     fn function(&mut self, f: &r::Name, args: &[Arg], span: Span) -> Option<Val> {
         let key = f.key();
         if let Some(v) = self.builtin_function(&key, f, args, span) {
+            return v;
+        }
+        if let Some(v) = self.io_function(&key, f, args, span) {
             return v;
         }
         match self.lookup(&key) {

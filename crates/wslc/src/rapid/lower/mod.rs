@@ -16,6 +16,7 @@
 
 pub(crate) mod data;
 mod expr;
+mod io;
 mod stmt;
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -28,6 +29,7 @@ use data::{Ty, build as b};
 /// Translates a task's RAPID modules into one WSL module.
 pub(crate) fn translate(
     modules: &[r::RapidModule],
+    signals: Option<&[super::IoSignal]>,
     diags: &mut Vec<Diagnostic>,
 ) -> w::SourceModule {
     let mut t = Tr {
@@ -40,8 +42,13 @@ pub(crate) fn translate(
         temps: 0,
         routine: None,
         spelled: BTreeMap::new(),
+        io: signals.map(<[super::IoSignal]>::to_vec),
+        signals: BTreeMap::new(),
+        connects: BTreeMap::new(),
+        ordered: BTreeSet::new(),
     };
     t.collect(modules);
+    t.collect_connects(modules);
     for m in modules {
         for it in &m.items {
             if let r::Item::Data(d) = it {
@@ -56,6 +63,7 @@ pub(crate) fn translate(
             }
         }
     }
+    t.declare_signals();
     w::SourceModule { items: t.items }
 }
 
@@ -142,6 +150,14 @@ pub(crate) struct Tr<'d> {
     pub(crate) routine: Option<RoutineCx>,
     /// Each declared name (lower case) as it was first written, for messages.
     pub(crate) spelled: BTreeMap<String, String>,
+    /// The robot's wired I/O signals (`None`: any signal an I/O instruction names).
+    pub(crate) io: Option<Vec<super::IoSignal>>,
+    /// The signals the task uses: global name → initial value.
+    pub(crate) signals: BTreeMap<String, i64>,
+    /// Each interrupt variable (lower case) and the TRAP its `CONNECT` names.
+    pub(crate) connects: BTreeMap<String, Sig>,
+    /// The handlers some interrupt order enables (a TRAP, or its `'single` wrapper).
+    pub(crate) ordered: BTreeSet<String>,
 }
 
 /// Names WSL's own built-in functions take; RAPID names equal to them get a `'`.
@@ -708,13 +724,6 @@ impl Tr<'_> {
             },
             _ => None,
         };
-        if rt.kind == r::RoutineKind::Trap {
-            self.unsupported(
-                &format!("the TRAP routine `{}`", rt.name.text),
-                rt.name.span,
-                "interrupts come with CONNECT and ISignalDI; see docs/rapid.md",
-            );
-        }
         let is_func = rt.kind == r::RoutineKind::Func;
         self.items.push(w::Item::Proc(w::ProcDecl {
             is_func: is_func && ret.is_some(),

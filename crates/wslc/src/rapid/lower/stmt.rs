@@ -163,13 +163,8 @@ impl Tr<'_> {
                 }
             }
             r::StmtKind::Exit => push(w::StmtKind::Stop),
-            r::StmtKind::Connect { intno, .. } => {
-                self.unsupported(
-                    "CONNECT (interrupts)",
-                    intno.span.to(span),
-                    "interrupts come with TRAP routines and ISignalDI; see docs/rapid.md",
-                );
-            }
+            // Bound for the whole task before any routine (`collect_connects`).
+            r::StmtKind::Connect { .. } => {}
             r::StmtKind::Unsupported(what) => {
                 self.unsupported(what, span, "write the program without it");
             }
@@ -577,6 +572,9 @@ impl Tr<'_> {
     /// An instruction or a call of one of the task's PROCs.
     fn call(&mut self, name: &r::Name, args: &[Arg], span: Span, out: &mut Vec<w::Stmt>) {
         let key = name.key();
+        if self.io_instruction(&key, name, args, span, out) {
+            return;
+        }
         let mut push = |kind| out.push(w::Stmt { kind, span });
         match key.as_str() {
             "movej" | "movel" | "movec" | "moveabsj" => {
@@ -852,9 +850,22 @@ impl Tr<'_> {
             return;
         };
         let cond = self.condition(p[0]);
+        self.timed_wait(&f.text, cond, &opts, span, out);
+    }
+
+    /// A wait until `cond` holds, with RAPID's `\MaxTime` (then `\TimeFlag` is set, or
+    /// without it the wait is the error ERR_WAIT_MAXTIME) for the instruction `instr`.
+    pub(crate) fn timed_wait(
+        &mut self,
+        instr: &str,
+        cond: w::Expr,
+        opts: &[(String, &r::Name, Option<&r::Expr>)],
+        span: Span,
+        out: &mut Vec<w::Stmt>,
+    ) {
         let mut timeout = None;
         let mut flag = None;
-        for (k, name, v) in &opts {
+        for (k, name, v) in opts {
             match (k.as_str(), v) {
                 ("maxtime", Some(e)) => {
                     timeout = self
@@ -897,7 +908,7 @@ impl Tr<'_> {
                 // Without \TimeFlag, an expired \MaxTime is the error ERR_WAIT_MAXTIME.
                 let fail = w::Stmt {
                     kind: w::StmtKind::Fail(vec![b::expr(
-                        w::ExprKind::Str("WaitUntil: \\MaxTime expired (ERR_WAIT_MAXTIME)".into()),
+                        w::ExprKind::Str(format!("{instr}: \\MaxTime expired (ERR_WAIT_MAXTIME)")),
                         span,
                     )]),
                     span,

@@ -1,0 +1,563 @@
+//! RAPID's I/O and interrupts, on the engine's globals and `when` handlers.
+//!
+//! A signal is a level held in one of the cell's globals (an int): `SetDO`, `Set`, `Reset`,
+//! `SetGO` and `PulseDO` are `set` events, `WaitDI`/`WaitDO`/`WaitGI`/`WaitGO` are waits on
+//! it (released when the signal changes, as on a controller), `DInput`/`DOutput`/`GInput`/
+//! `GOutput` and a signal's bare name read it. Which global a signal is comes from the
+//! workcell's `[[io]]` (see [`super::super::IoSignal`]).
+//!
+//! Interrupts: `CONNECT i WITH trap` binds the interrupt variable `i` to the TRAP for the
+//! whole task (found before any routine is translated, so the order of the routines does
+//! not matter). `ISignalDI`/`ISignalDO`/`ISignalGI`/`ISignalGO` enable a condition handler
+//! on the signal reaching the value (a false→true edge, as the controller's interrupt on a
+//! change), `ITimer` a periodic or single timer, and `IDelete`/`ISleep` disable the trap.
+
+use vworks_vm::Dim;
+
+use super::data::{Ty, build as b};
+use super::{Sig, Sym, Tr, Val, block};
+use crate::diag::{Code, Diagnostic};
+use crate::rapid::SignalKind;
+use crate::rapid::syntax::{self as r, Arg};
+use crate::syntax::{self as w, Span};
+
+impl Tr<'_> {
+    /// Finds every `CONNECT` of the task.
+    /// Finds every `CONNECT` of the task, and how each interrupt is ordered (`\Single` or
+    /// not), so that `IDelete` knows which handlers it disables wherever it stands.
+    pub(crate) fn collect_connects(&mut self, modules: &[r::RapidModule]) {
+        type Found = (Vec<(r::Name, r::Name, Span)>, Vec<(String, bool)>);
+        let mut found: Found = (Vec::new(), Vec::new());
+        fn walk(ss: &[r::Stmt], found: &mut Found) {
+            for s in ss {
+                match &s.kind {
+                    r::StmtKind::Connect { intno, trap } => {
+                        if let r::ExprKind::Name(n) = &intno.kind {
+                            found.0.push((n.clone(), trap.clone(), s.span));
+                        }
+                    }
+                    r::StmtKind::Call { name, args } => {
+                        let k = name.key();
+                        if k.starts_with("isignal") || k == "itimer" {
+                            let single = args.iter().any(|a| matches!(a, Arg::Opt(..)));
+                            let last = args.iter().rev().find_map(|a| match a {
+                                Arg::Pos(e) => Some(e),
+                                Arg::Opt(..) => None,
+                            });
+                            if let Some(r::Expr {
+                                kind: r::ExprKind::Name(n),
+                                ..
+                            }) = last
+                            {
+                                found.1.push((n.key(), single));
+                            }
+                        }
+                    }
+                    r::StmtKind::If { branches, els } => {
+                        for (_, body) in branches {
+                            walk(body, found);
+                        }
+                        if let Some(e) = els {
+                            walk(e, found);
+                        }
+                    }
+                    r::StmtKind::While { body, .. } | r::StmtKind::For { body, .. } => {
+                        walk(body, found)
+                    }
+                    r::StmtKind::Test { cases, default, .. } => {
+                        for (_, body) in cases {
+                            walk(body, found);
+                        }
+                        if let Some(d) = default {
+                            walk(d, found);
+                        }
+                    }
+                    _ => {}
+                }
+            }
+        }
+        for m in modules {
+            for it in &m.items {
+                if let r::Item::Routine(rt) = it {
+                    walk(&rt.body, &mut found);
+                }
+            }
+        }
+        let (connects, orders) = found;
+        for (intno, trap, span) in connects {
+            let sig = match self.scope.get(&trap.key()) {
+                Some(Sym::Routine(s)) if s.kind == r::RoutineKind::Trap => s.clone(),
+                Some(_) => {
+                    self.error(
+                        Code::E0020,
+                        format!("`{}` is not a TRAP routine", trap.text),
+                        trap.span,
+                    );
+                    continue;
+                }
+                None => {
+                    self.error(
+                        Code::E0011,
+                        format!("unknown TRAP `{}`", trap.text),
+                        trap.span,
+                    )
+                    .help = Some("declare it: `TRAP name … ENDTRAP`".into());
+                    continue;
+                }
+            };
+            match self.connects.get(&intno.key()) {
+                Some(prev) if prev.wsl != sig.wsl => {
+                    let d = Diagnostic::error(
+                        Code::E0300,
+                        format!(
+                            "`{}` is connected to a second TRAP; vworks binds an interrupt to one TRAP for the whole task",
+                            intno.text
+                        ),
+                        span,
+                    )
+                    .with_help("use one interrupt variable per TRAP");
+                    self.diags.push(d);
+                }
+                _ => {
+                    self.connects.insert(intno.key(), sig);
+                }
+            }
+        }
+        for (intno, single) in orders {
+            if let Some(sig) = self.connects.get(&intno) {
+                let handler = if single {
+                    format!("_{}_single", sig.wsl)
+                } else {
+                    sig.wsl.clone()
+                };
+                self.ordered.insert(handler);
+            }
+        }
+    }
+
+    /// The used signals as the cell's globals.
+    pub(crate) fn declare_signals(&mut self) {
+        let span = Span::default();
+        for (g, init) in std::mem::take(&mut self.signals) {
+            self.items.push(w::Item::Global(w::VarDecl {
+                name: b::ident(&g, span),
+                ty: Some(b::ident("int", span)),
+                init: Some(b::expr(w::ExprKind::Int(init), span)),
+                span,
+            }));
+        }
+    }
+
+    /// The global of signal `n`, which must be of one of `kinds`.
+    pub(crate) fn signal(&mut self, n: &r::Name, kinds: &[SignalKind]) -> Option<String> {
+        if let Some(Sym::Data(_) | Sym::Routine(_)) = self.lookup(&n.key()) {
+            self.error(
+                Code::E0020,
+                format!("`{}` is data or a routine, not an I/O signal", n.text),
+                n.span,
+            );
+            return None;
+        }
+        let kind_names = kinds
+            .iter()
+            .map(|k| k.name())
+            .collect::<Vec<_>>()
+            .join(" or ");
+        let (global, init) = match &self.io {
+            None => (n.key(), 0),
+            Some(io) => {
+                let Some(s) = io.iter().find(|s| s.name.eq_ignore_ascii_case(&n.text)) else {
+                    let mut names: Vec<String> = io
+                        .iter()
+                        .map(|s| format!("{} ({})", s.name, s.kind.name()))
+                        .collect();
+                    names.sort();
+                    let listed = if names.is_empty() {
+                        "none".to_string()
+                    } else {
+                        names.join(", ")
+                    };
+                    let near = crate::nearest(&n.text, io.iter().map(|s| s.name.as_str()))
+                        .map(|m| format!("did you mean `{m}`? "))
+                        .unwrap_or_default();
+                    self.error(
+                        Code::E0302,
+                        format!("`{}` is not an I/O signal of this robot", n.text),
+                        n.span,
+                    )
+                    .help = Some(format!(
+                        "{near}declare it in the workcell's [[io]] ({kind_names}); this robot's signals: {listed}"
+                    ));
+                    return None;
+                };
+                if !kinds.contains(&s.kind) {
+                    self.error(
+                        Code::E0020,
+                        format!(
+                            "`{}` is a {} signal; this needs {kind_names}",
+                            n.text,
+                            s.kind.name()
+                        ),
+                        n.span,
+                    );
+                    return None;
+                }
+                (s.global.clone(), s.init)
+            }
+        };
+        self.signals.entry(global.clone()).or_insert(init);
+        Some(global)
+    }
+
+    /// A signal's bare name read as a value (a num), within a workcell.
+    pub(crate) fn signal_value(&mut self, n: &r::Name) -> Option<Val> {
+        let io = self.io.as_ref()?;
+        io.iter().find(|s| s.name.eq_ignore_ascii_case(&n.text))?;
+        let all = [
+            SignalKind::Di,
+            SignalKind::Do,
+            SignalKind::Gi,
+            SignalKind::Go,
+        ];
+        let g = self.signal(n, &all)?;
+        Some(Val::one(
+            Ty::Num,
+            b::call("num", vec![b::name(&g, n.span)], n.span),
+        ))
+    }
+
+    /// The signal named by an argument.
+    fn signal_arg(&mut self, e: &r::Expr, kinds: &[SignalKind]) -> Option<String> {
+        match &e.kind {
+            r::ExprKind::Name(n) => self.signal(n, kinds),
+            _ => {
+                self.error(Code::E0020, "expected an I/O signal's name", e.span);
+                None
+            }
+        }
+    }
+
+    /// `DInput(s)`, `DOutput(s)`, `GInput(s)`, `GOutput(s)`, `TestDI(s)`; `None` if `key`
+    /// is not one of them.
+    pub(crate) fn io_function(
+        &mut self,
+        key: &str,
+        f: &r::Name,
+        args: &[Arg],
+        span: Span,
+    ) -> Option<Option<Val>> {
+        let kinds: &[SignalKind] = match key {
+            "dinput" | "testdi" => &[SignalKind::Di],
+            "doutput" => &[SignalKind::Do],
+            "ginput" => &[SignalKind::Gi],
+            "goutput" => &[SignalKind::Go],
+            _ => return None,
+        };
+        Some((|| {
+            let (p, _) = self.split_args(f, args, 1..=1, &[], span)?;
+            let g = self.signal_arg(p[0], kinds)?;
+            let v = b::name(&g, p[0].span);
+            if key == "testdi" {
+                let one = b::expr(w::ExprKind::Int(1), span);
+                return Some(Val::one(Ty::Bool, b::bin(w::BinOp::Eq, v, one)));
+            }
+            Some(Val::one(Ty::Num, b::call("num", vec![v], span)))
+        })())
+    }
+
+    /// The I/O and interrupt instructions; false if `key` is none of them.
+    pub(crate) fn io_instruction(
+        &mut self,
+        key: &str,
+        f: &r::Name,
+        args: &[Arg],
+        span: Span,
+        out: &mut Vec<w::Stmt>,
+    ) -> bool {
+        let digital_out = &[SignalKind::Do];
+        match key {
+            "set" | "reset" => {
+                if let Some((p, _)) = self.split_args(f, args, 1..=1, &[], span)
+                    && let Some(g) = self.signal_arg(p[0], digital_out)
+                {
+                    let v = i64::from(key == "set");
+                    out.push(assign(&g, b::expr(w::ExprKind::Int(v), span), span));
+                }
+            }
+            "setdo" | "setgo" => {
+                let kinds: &[SignalKind] = if key == "setdo" {
+                    digital_out
+                } else {
+                    &[SignalKind::Go]
+                };
+                let Some((p, opts)) = self.split_args(f, args, 2..=2, &["SDelay", "Sync"], span)
+                else {
+                    return true;
+                };
+                if let Some((_, n, _)) = opts.iter().find(|(k, _, _)| k == "sdelay") {
+                    self.unsupported(
+                        "`\\SDelay`",
+                        n.span,
+                        "wait with WaitTime before setting the signal",
+                    );
+                    return true;
+                }
+                let Some(g) = self.signal_arg(p[0], kinds) else {
+                    return true;
+                };
+                if let Some(v) = self.value(p[1], Ty::Num) {
+                    let v = b::call("int", vec![v.leaf()], p[1].span);
+                    out.push(assign(&g, v, span));
+                }
+            }
+            "pulsedo" => {
+                let Some((p, opts)) = self.split_args(f, args, 1..=1, &["High", "PLength"], span)
+                else {
+                    return true;
+                };
+                let Some(g) = self.signal_arg(p[0], digital_out) else {
+                    return true;
+                };
+                let mut length = b::quantity(0.2, Dim::TIME, span);
+                for (k, n, v) in &opts {
+                    if k == "plength" {
+                        let Some(e) = v else {
+                            self.error(
+                                Code::E0301,
+                                "`\\PLength` is written `\\PLength:=seconds`",
+                                n.span,
+                            );
+                            return true;
+                        };
+                        match self.value(e, Ty::Num) {
+                            Some(v) => length = b::with_unit(v.leaf(), Dim::TIME),
+                            None => return true,
+                        }
+                    }
+                }
+                // The pulse's end is a handler after PLength: the program goes on at once.
+                let end = format!("_pulse_end_{g}");
+                if self.helpers.insert(end.clone()) {
+                    let body = vec![assign(&g, b::expr(w::ExprKind::Int(0), span), span)];
+                    self.items.push(w::Item::Proc(w::ProcDecl {
+                        is_func: false,
+                        name: b::ident(&end, span),
+                        params: Vec::new(),
+                        ret: None,
+                        body: block(body, span),
+                        span,
+                    }));
+                }
+                out.push(assign(&g, b::expr(w::ExprKind::Int(1), span), span));
+                out.push(w::Stmt {
+                    kind: w::StmtKind::When {
+                        trigger: w::TriggerExpr::After(length),
+                        handler: b::ident(&end, span),
+                        args: Vec::new(),
+                    },
+                    span,
+                });
+            }
+            "waitdi" | "waitdo" | "waitgi" | "waitgo" => {
+                let kinds: &[SignalKind] = match key {
+                    "waitdi" => &[SignalKind::Di],
+                    "waitdo" => digital_out,
+                    "waitgi" => &[SignalKind::Gi],
+                    _ => &[SignalKind::Go],
+                };
+                let Some((p, opts)) =
+                    self.split_args(f, args, 2..=2, &["MaxTime", "TimeFlag"], span)
+                else {
+                    return true;
+                };
+                let Some(g) = self.signal_arg(p[0], kinds) else {
+                    return true;
+                };
+                let Some(v) = self.value(p[1], Ty::Num) else {
+                    return true;
+                };
+                let cond = b::bin(
+                    w::BinOp::Eq,
+                    b::name(&g, p[0].span),
+                    b::call("int", vec![v.leaf()], p[1].span),
+                );
+                self.timed_wait(&f.text, cond, &opts, span, out);
+            }
+            "isignaldi" | "isignaldo" | "isignalgi" | "isignalgo" => {
+                let kinds: &[SignalKind] = match key {
+                    "isignaldi" => &[SignalKind::Di],
+                    "isignaldo" => digital_out,
+                    "isignalgi" => &[SignalKind::Gi],
+                    _ => &[SignalKind::Go],
+                };
+                let Some((p, opts)) =
+                    self.split_args(f, args, 3..=3, &["Single", "SingleSafe"], span)
+                else {
+                    return true;
+                };
+                let Some(g) = self.signal_arg(p[0], kinds) else {
+                    return true;
+                };
+                let Some(v) = self.value(p[1], Ty::Num) else {
+                    return true;
+                };
+                let Some(trap) = self.connected(p[2]) else {
+                    return true;
+                };
+                let cond = b::bin(
+                    w::BinOp::Eq,
+                    b::name(&g, p[0].span),
+                    b::call("int", vec![v.leaf()], p[1].span),
+                );
+                let single = !opts.is_empty();
+                self.enable(w::TriggerExpr::Cond(cond), &trap, single, span, out);
+            }
+            "itimer" => {
+                let Some((p, opts)) =
+                    self.split_args(f, args, 2..=2, &["Single", "SingleSafe"], span)
+                else {
+                    return true;
+                };
+                let Some(t) = self.value(p[0], Ty::Num) else {
+                    return true;
+                };
+                let Some(trap) = self.connected(p[1]) else {
+                    return true;
+                };
+                let t = b::with_unit(t.leaf(), Dim::TIME);
+                let trigger = if opts.is_empty() {
+                    w::TriggerExpr::Every(t)
+                } else {
+                    w::TriggerExpr::After(t)
+                };
+                self.enable(trigger, &trap, false, span, out);
+            }
+            "idelete" | "isleep" => {
+                if let Some((p, _)) = self.split_args(f, args, 1..=1, &[], span)
+                    && let Some(trap) = self.connected(p[0])
+                {
+                    for name in [trap.wsl.clone(), format!("_{}_single", trap.wsl)] {
+                        if self.ordered.contains(&name) {
+                            out.push(w::Stmt {
+                                kind: w::StmtKind::Disable(b::ident(&name, span)),
+                                span,
+                            });
+                        }
+                    }
+                }
+            }
+            "iwatch" | "ienable" | "idisable" => {
+                self.unsupported(
+                    &format!("`{}`", f.text),
+                    f.span,
+                    "delete the interrupt with IDelete and order it again with ISignalDI or ITimer",
+                );
+            }
+            _ => return false,
+        }
+        true
+    }
+
+    /// The TRAP an interrupt variable is connected to.
+    fn connected(&mut self, e: &r::Expr) -> Option<Sig> {
+        let r::ExprKind::Name(n) = &e.kind else {
+            self.error(
+                Code::E0020,
+                "expected an interrupt variable (intnum)",
+                e.span,
+            );
+            return None;
+        };
+        match self.lookup(&n.key()) {
+            Some(Sym::Data(d)) if d.ty == Ty::Intnum => {}
+            Some(_) => {
+                self.error(
+                    Code::E0020,
+                    format!("`{}` is not an intnum", n.text),
+                    n.span,
+                );
+                return None;
+            }
+            None => {
+                self.unknown_name(n);
+                return None;
+            }
+        }
+        match self.connects.get(&n.key()) {
+            Some(s) => Some(s.clone()),
+            None => {
+                self.error(
+                    Code::E0303,
+                    format!("the interrupt `{}` is not connected to a TRAP", n.text),
+                    n.span,
+                )
+                .help = Some(format!(
+                    "connect it first: `CONNECT {} WITH trap_name;`",
+                    n.text
+                ));
+                None
+            }
+        }
+    }
+
+    /// `when trigger do trap();` — with `single`, through a wrapper that disables itself
+    /// before running the trap, so it fires once.
+    fn enable(
+        &mut self,
+        trigger: w::TriggerExpr,
+        trap: &Sig,
+        single: bool,
+        span: Span,
+        out: &mut Vec<w::Stmt>,
+    ) {
+        let handler = if single {
+            let name = format!("_{}_single", trap.wsl);
+            if self.helpers.insert(name.clone()) {
+                let body = vec![
+                    w::Stmt {
+                        kind: w::StmtKind::Disable(b::ident(&name, span)),
+                        span,
+                    },
+                    w::Stmt {
+                        kind: w::StmtKind::Call {
+                            name: b::ident(&trap.wsl, span),
+                            args: Vec::new(),
+                        },
+                        span,
+                    },
+                ];
+                self.items.push(w::Item::Proc(w::ProcDecl {
+                    is_func: false,
+                    name: b::ident(&name, span),
+                    params: Vec::new(),
+                    ret: None,
+                    body: block(body, span),
+                    span,
+                }));
+            }
+            name
+        } else {
+            trap.wsl.clone()
+        };
+        out.push(w::Stmt {
+            kind: w::StmtKind::When {
+                trigger,
+                handler: b::ident(&handler, span),
+                args: Vec::new(),
+            },
+            span,
+        });
+    }
+}
+
+/// `g = v;`
+fn assign(g: &str, v: w::Expr, span: Span) -> w::Stmt {
+    w::Stmt {
+        kind: w::StmtKind::Assign {
+            target: b::name(g, span),
+            op: None,
+            value: v,
+        },
+        span,
+    }
+}

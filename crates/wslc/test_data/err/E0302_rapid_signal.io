@@ -1,0 +1,2 @@
+doGrip do dogrip 0
+diPartReady di dopartready 0
