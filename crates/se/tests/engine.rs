@@ -21,6 +21,7 @@ const EXAMPLES: &[(&str, Outcome)] = &[
     ("deadlock", Outcome::Deadlock),
     ("track", Outcome::Completed),
     ("palletize", Outcome::Completed),
+    ("rapid_handoff", Outcome::Completed),
 ];
 
 fn root() -> PathBuf {

@@ -26,8 +26,12 @@ impl Tr<'_> {
     /// Finds every `CONNECT` of the task, and how each interrupt is ordered (`\Single` or
     /// not), so that `IDelete` knows which handlers it disables wherever it stands.
     pub(crate) fn collect_connects(&mut self, modules: &[r::RapidModule]) {
-        type Found = (Vec<(r::Name, r::Name, Span)>, Vec<(String, bool)>);
-        let mut found: Found = (Vec::new(), Vec::new());
+        type Found = (
+            Vec<(r::Name, r::Name, Span)>,
+            Vec<(String, bool)>,
+            Vec<String>,
+        );
+        let mut found: Found = (Vec::new(), Vec::new(), Vec::new());
         fn walk(ss: &[r::Stmt], found: &mut Found) {
             for s in ss {
                 match &s.kind {
@@ -38,6 +42,15 @@ impl Tr<'_> {
                     }
                     r::StmtKind::Call { name, args } => {
                         let k = name.key();
+                        if k == "gripload"
+                            && let Some(Arg::Pos(r::Expr {
+                                kind: r::ExprKind::Name(n),
+                                ..
+                            })) = args.first()
+                            && n.key() != "load0"
+                        {
+                            found.2.push(n.key());
+                        }
                         if k.starts_with("isignal") || k == "itimer" {
                             let single = args.iter().any(|a| matches!(a, Arg::Opt(..)));
                             let last = args.iter().rev().find_map(|a| match a {
@@ -83,7 +96,10 @@ impl Tr<'_> {
                 }
             }
         }
-        let (connects, orders) = found;
+        let (connects, orders, mut parts) = found;
+        parts.sort();
+        parts.dedup();
+        self.grip_parts = parts;
         for (intno, trap, span) in connects {
             let sig = match self.scope.get(&trap.key()) {
                 Some(Sym::Routine(s)) if s.kind == r::RoutineKind::Trap => s.clone(),
@@ -446,6 +462,7 @@ impl Tr<'_> {
                     }
                 }
             }
+            "gripload" => self.grip_load(f, args, span, out),
             "iwatch" | "ienable" | "idisable" => {
                 self.unsupported(
                     &format!("`{}`", f.text),
@@ -456,6 +473,80 @@ impl Tr<'_> {
             _ => return false,
         }
         true
+    }
+
+    /// `GripLoad part;` grips the workcell part the loaddata is named after (`grip`);
+    /// `GripLoad load0;` releases the part the robot holds. Which part that is, is kept in
+    /// the module variable `_held` (0: none; k: the k-th part the task's GripLoads name).
+    fn grip_load(&mut self, f: &r::Name, args: &[Arg], span: Span, out: &mut Vec<w::Stmt>) {
+        let Some((p, _)) = self.split_args(f, args, 1..=1, &[], span) else {
+            return;
+        };
+        let r::ExprKind::Name(n) = &p[0].kind else {
+            self.error(Code::E0020, "GripLoad takes a loaddata's name", p[0].span);
+            return;
+        };
+        match self.lookup(&n.key()) {
+            Some(Sym::Data(d)) if d.ty == Ty::Load => {}
+            Some(_) => {
+                self.error(
+                    Code::E0020,
+                    format!("`{}` is not a loaddata", n.text),
+                    n.span,
+                );
+                return;
+            }
+            None => {
+                self.unknown_name(n);
+                return;
+            }
+        }
+        if self.helpers.insert("_held".into()) {
+            self.items.push(w::Item::Var(w::VarDecl {
+                name: b::ident("_held", Span::default()),
+                ty: Some(b::ident("int", Span::default())),
+                init: Some(b::expr(w::ExprKind::Int(0), Span::default())),
+                span: Span::default(),
+            }));
+        }
+        let int = |k: i64| b::expr(w::ExprKind::Int(k), span);
+        let held = || b::name("_held", span);
+        let stmt = |kind| w::Stmt { kind, span };
+        if n.key() == "load0" {
+            let branches = self
+                .grip_parts
+                .iter()
+                .enumerate()
+                .map(|(k, part)| {
+                    let cond = b::bin(w::BinOp::Eq, held(), int(k as i64 + 1));
+                    let rel = stmt(w::StmtKind::Release(b::ident(part, span)));
+                    (cond, block(vec![rel], span))
+                })
+                .collect::<Vec<_>>();
+            if !branches.is_empty() {
+                out.push(stmt(w::StmtKind::If {
+                    branches,
+                    els: None,
+                }));
+            }
+            out.push(stmt(w::StmtKind::Assign {
+                target: held(),
+                op: None,
+                value: int(0),
+            }));
+            return;
+        }
+        let k = self
+            .grip_parts
+            .iter()
+            .position(|x| *x == n.key())
+            .unwrap_or(0);
+        out.push(stmt(w::StmtKind::Grip(b::ident(&n.key(), n.span))));
+        out.push(stmt(w::StmtKind::Assign {
+            target: held(),
+            op: None,
+            value: int(k as i64 + 1),
+        }));
     }
 
     /// The TRAP an interrupt variable is connected to.

@@ -46,6 +46,7 @@ pub(crate) fn translate(
         signals: BTreeMap::new(),
         connects: BTreeMap::new(),
         ordered: BTreeSet::new(),
+        grip_parts: Vec::new(),
     };
     t.collect(modules);
     t.collect_connects(modules);
@@ -158,6 +159,8 @@ pub(crate) struct Tr<'d> {
     pub(crate) connects: BTreeMap<String, Sig>,
     /// The handlers some interrupt order enables (a TRAP, or its `'single` wrapper).
     pub(crate) ordered: BTreeSet<String>,
+    /// The workcell parts the task's `GripLoad`s name (loaddata names, lower case), sorted.
+    pub(crate) grip_parts: Vec<String>,
 }
 
 /// Names WSL's own built-in functions take; RAPID names equal to them get a `'`.
