@@ -103,6 +103,52 @@ def test_compile_error_carries_every_diagnostic():
     assert "bad.wsl" in str(info.value)
 
 
+RAPID = """MODULE Main
+  ! A RAPID module: one PERS (the cell's global), a FUNC, a motion.
+  PERS num nParts := 0;
+  CONST robtarget pA := [[400,0,400],[0,1,0,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];
+  FUNC num Twice(num x)
+    RETURN 2 * x;
+  ENDFUNC
+  PROC Main()
+    MoveL Offs(pA, 0, 0, 100), v100, fine, tool0;
+    nParts := Twice(nParts);
+  ENDPROC
+ENDMODULE
+"""
+
+
+def test_compile_rapid_by_language_or_by_extension():
+    by_language = vworks.compile(RAPID, language="rapid")
+    assert by_language.path == "x.mod"
+    # RAPID names are case-insensitive: the WSL names are in lower case.
+    assert by_language.globals == ["nparts"]
+    assert by_language.procs == ["twice", "main"]
+    assert "MoveL Offs(pA, 0, 0, 100), v100, fine, tool0;" in by_language.disasm()
+    by_path = vworks.compile(RAPID, "cell/R1.MOD")
+    assert by_path.to_bytes() != b"" and by_path.globals == ["nparts"]
+    # The same text read as WSL does not compile.
+    with pytest.raises(vworks.CompileError):
+        vworks.compile(RAPID, "r1.wsl")
+    with pytest.raises(ValueError, match="unknown language"):
+        vworks.compile(RAPID, language="krl")
+
+
+def test_compile_rapid_errors_name_the_rapid_line():
+    src = "MODULE m\n  PROC main()\n    SearchL \\Stop, di1, p, p2, v100, tool0;\n  ENDPROC\nENDMODULE\n"
+    with pytest.raises(vworks.CompileError) as info:
+        vworks.compile(src, "r1.mod")
+    first = info.value.diagnostics[0]
+    assert (first.code, first.file, first.line, first.col) == ("E0300", "r1.mod", 3, 5)
+    assert "SearchL" in first.message
+
+
+def test_a_rapid_cell_runs_from_python():
+    r = vworks.load_cell(str(ROOT / "workcells/rapid_handoff/cell.toml")).run()
+    assert r.outcome == "completed"
+    assert r.end_time == pytest.approx(63.087, abs=5e-4)
+
+
 # --- load_cell and run --------------------------------------------------------------------
 
 
