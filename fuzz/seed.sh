@@ -4,9 +4,13 @@
 # example workcells bundled in the same format (workcell, run), the built-in robots' URDFs
 # and the test meshes (urdf), and the logs of small runs (log).
 set -euo pipefail
+shopt -s nullglob
 cd "$(dirname "$0")/.."
-for c in compile load_bytecode workcell run urdf log; do mkdir -p "fuzz/corpus/$c"; done
+for c in compile rapid load_bytecode workcell run urdf log; do mkdir -p "fuzz/corpus/$c"; done
 cp crates/wslc/test_data/ok/*.wsl crates/wslc/test_data/err/*.wsl crates/wslc/test_data/spec/*.wsl fuzz/corpus/compile/
+# RAPID: the fixtures, the example workcells' modules and the vendored corpus.
+cp crates/wslc/test_data/ok/*.mod crates/wslc/test_data/err/*.mod workcells/*/*.mod fuzz/corpus/rapid/
+find tests/rapid/corpus -type f \( -iname '*.mod' -o -iname '*.sys' -o -iname '*.prg' -o -iname '*.modx' \) -exec cp {} fuzz/corpus/rapid/ \; 2>/dev/null || true
 cargo build -q -p vworks-cli
 for f in crates/wslc/test_data/ok/*.wsl; do
   ./target/debug/vworks build "$f" -o "fuzz/corpus/load_bytecode/$(basename "$f" .wsl).wslb" 2>/dev/null
@@ -18,7 +22,7 @@ for f in tests/errors/cell-*.case tests/runs/*.case; do
 done
 for d in workcells/*/; do
   name=$(basename "$d")
-  { for f in "$d"cell.toml "$d"*.wsl; do echo "--- $(basename "$f")"; cat "$f"; done; } > "fuzz/corpus/workcell/wc-$name"
+  { for f in "$d"cell.toml "$d"*.wsl "$d"*.mod; do echo "--- $(basename "$f")"; cat "$f"; done; } > "fuzz/corpus/workcell/wc-$name"
   cp "fuzz/corpus/workcell/wc-$name" "fuzz/corpus/run/wc-$name"
 done
 # URDFs (first byte even: URDF text) and meshes (odd: 1 STL, 3 OBJ).

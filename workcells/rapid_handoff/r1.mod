@@ -6,14 +6,14 @@ MODULE Carrier
   CONST robtarget pStation := [[300,250,140],[0,1,0,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];
   ! The part's mass; GripLoad part1 grips the workcell's part1.
   PERS loaddata part1 := [0.5,[0,0,20],[1,0,0,0],0,0,0];
-  VAR intnum iBack;
-  VAR num nBack := 0;
+  VAR intnum iInspected;
+  VAR num nInspected := 0;
   VAR syncident sDone;
   PERS tasks tlBoth{2} := [["T_ROB1"],["T_ROB2"]];
 
-  TRAP PartBack
-    Incr nBack;
-    TPWrite "r1: part back from inspection, " \Num:=nBack;
+  TRAP PartInspected
+    Incr nInspected;
+    TPWrite "r1: r2 has inspected part " \Num:=nInspected;
   ENDTRAP
 
   PROC Carry(robtarget pFrom, robtarget pTo)
@@ -28,20 +28,18 @@ MODULE Carrier
   ENDPROC
 
   PROC main()
-    CONNECT iBack WITH PartBack;
-    ISignalDI diPartBack, 1, iBack;
+    CONNECT iInspected WITH PartInspected;
+    ISignalDI diInspected, 1, iInspected;
     MoveAbsJ jHome, v1000, fine, tool0;
     FOR i FROM 1 TO 3 DO
       Carry pInfeed, pStation;
       MoveAbsJ jHome, v1000, fine, tool0;
-      SetDO doPartReady, 1;
-      WaitDI diPartBack, 1;
-      SetDO doPartReady, 0;
-      WaitDI diPartBack, 0;
+      SetGO goPartsReady, i;
+      WaitGI giPartsBack, i;
       Carry pStation, pInfeed;
     ENDFOR
     MoveAbsJ jHome, v1000, fine, tool0;
     WaitSyncTask sDone, tlBoth;
-    TPWrite "r1 done, parts back: " \Num:=nBack;
+    TPWrite "r1 done, parts inspected: " \Num:=nInspected;
   ENDPROC
 ENDMODULE

@@ -13,7 +13,7 @@ MODULE Inspector
   PROC main()
     MoveAbsJ jHome, v1000, fine, tool0;
     FOR i FROM 1 TO 3 DO
-      WaitDI diPartReady, 1;
+      WaitGI giPartsReady, i;
       MoveL Offs(pStation, 0, 0, 100), v500, fine, tool0;
       MoveL pStation, v100, fine, tool0;
       GripLoad part1;
@@ -21,14 +21,13 @@ MODULE Inspector
       MoveJ pInspect, v500, fine, tool0;
       WaitTime 0.5;
       Incr nInspected;
+      PulseDO \PLength:=0.1, doInspected;
       MoveL Offs(pStation, 0, 0, 100), v500, z10, tool0;
       MoveL pStation, v100, fine, tool0;
       GripLoad load0;
       MoveL Offs(pStation, 0, 0, 100), v500, z10, tool0;
+      SetGO goPartsBack, i;
       MoveAbsJ jHome, v1000, fine, tool0;
-      SetDO doPartBack, 1;
-      WaitDI diPartReady, 0;
-      SetDO doPartBack, 0;
     ENDFOR
     WaitSyncTask sDone, tlBoth;
     TPWrite "r2 done, inspected: " \Num:=nInspected;

@@ -651,6 +651,7 @@ impl Parser<'_, '_> {
         let mut speed = None;
         let mut accel = None;
         let mut zone = None;
+        let mut tool = None;
         loop {
             if self.at_ident("zone") {
                 let t = self.bump();
@@ -670,6 +671,8 @@ impl Parser<'_, '_> {
                 &mut speed
             } else if self.at_ident("accel") {
                 &mut accel
+            } else if self.at_ident("tool") {
+                &mut tool
             } else {
                 break;
             };
@@ -687,7 +690,7 @@ impl Parser<'_, '_> {
                 format!("unknown motion option `{}`", self.text(t.span)),
                 t.span,
             )
-            .with_help("the options are `speed`, `accel` and `zone`");
+            .with_help("the options are `speed`, `accel`, `zone` and `tool`");
             return Err(self.report(d));
         }
         self.end(&format!("`{}`", kind.keyword()))?;
@@ -698,6 +701,7 @@ impl Parser<'_, '_> {
             speed,
             accel,
             zone,
+            tool,
         })
     }
 

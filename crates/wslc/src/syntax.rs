@@ -227,6 +227,8 @@ pub enum StmtKind {
         accel: Option<Expr>,
         /// `zone e` or `zone fine`.
         zone: Option<Zone>,
+        /// `tool e`: the TCP (a pose in the tool link's frame) from this motion on.
+        tool: Option<Expr>,
     },
     /// `delay t;`
     Delay(Expr),

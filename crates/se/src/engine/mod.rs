@@ -383,15 +383,18 @@ impl Simulation {
         }
     }
 
-    /// Robot `r`'s TCP in the cell now (base × flange × tool); identity if there is no
-    /// robot `r`.
+    /// Robot `r`'s TCP in the cell now (base × the TCP in its base frame, with the tool
+    /// its program moves with: the workcell's, or the last motion's `tool`); identity if
+    /// there is no robot `r`.
     pub fn tcp(&self, r: usize) -> Iso {
         match (self.vms.get(r), self.cell.robots.get(r)) {
             (Some(vm), Some(robot)) => {
                 let q = vm.joints_at(self.time);
-                robot
-                    .base
-                    .mul(&robot.model.tcp(&q[..robot.model.dof()], &robot.tool))
+                robot.base.mul(
+                    &robot
+                        .model
+                        .tcp(&q[..robot.model.dof()], &vm.tool_at(self.time)),
+                )
             }
             _ => Iso::IDENTITY,
         }

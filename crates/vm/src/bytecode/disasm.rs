@@ -219,13 +219,20 @@ fn operands(m: &Module, ins: &Instr) -> String {
                 });
             }
             if f.has(MoveFlags::SPEED) {
-                parts.push("speed");
+                parts.push(if f.has(MoveFlags::TCP_SPEED) {
+                    "tcp-speed"
+                } else {
+                    "speed"
+                });
             }
             if f.has(MoveFlags::ACCEL) {
                 parts.push("accel");
             }
             if f.has(MoveFlags::ZONE) {
                 parts.push("zone");
+            }
+            if f.has(MoveFlags::TOOL) {
+                parts.push("tool");
             }
             parts.join(" ")
         }

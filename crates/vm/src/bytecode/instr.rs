@@ -81,7 +81,12 @@ impl MoveFlags {
     pub const ACCEL: u8 = 8;
     /// A `zone` operand (radius in m; 0 for `zone fine`) is on the stack.
     pub const ZONE: u8 = 16;
-    const ALL: u8 = 31;
+    /// A `tool` operand (a pose: the TCP in the tool link's frame) is on the stack, on top;
+    /// it becomes the robot's TCP from this motion on.
+    pub const TOOL: u8 = 32;
+    /// The `speed` operand of a `move_j` is a TCP speed (m/s), not a ratio.
+    pub const TCP_SPEED: u8 = 64;
+    const ALL: u8 = 127;
 
     /// True if every bit of `bit` is set.
     pub fn has(self, bit: u8) -> bool {
@@ -324,11 +329,11 @@ instruction_set! {
     0x6b CurrentJoints;
     /// Pushes the robot's current TCP pose in the base frame.
     0x6c CurrentPose;
-    /// EVENT `motion_start`: joint move. Pops accel and speed (when flagged), then the target.
+    /// EVENT `motion_start`: joint move. Pops tool, zone, accel and speed (when flagged), then the target.
     0x70 MoveJ(f: MoveFlags);
-    /// EVENT `motion_start`: straight-line move. Pops accel and speed (when flagged), then the target.
+    /// EVENT `motion_start`: straight-line move. Pops tool, zone, accel and speed (when flagged), then the target.
     0x71 MoveL(f: MoveFlags);
-    /// EVENT `motion_start`: circular move. Pops accel and speed (when flagged), then the target and the via point.
+    /// EVENT `motion_start`: circular move. Pops tool, zone, accel and speed (when flagged), then the target and the via point.
     0x72 MoveC(f: MoveFlags);
     /// EVENT: pops a time; the robot holds still that long.
     0x73 Delay;
@@ -429,7 +434,8 @@ impl Instr {
                 };
                 let extra = u32::from(f.has(MoveFlags::SPEED))
                     + u32::from(f.has(MoveFlags::ACCEL))
-                    + u32::from(f.has(MoveFlags::ZONE));
+                    + u32::from(f.has(MoveFlags::ZONE))
+                    + if f.has(MoveFlags::TOOL) { P } else { 0 };
                 eff(target + via + extra, 0)
             }
             Instr::Delay => eff(1, 0),

@@ -55,6 +55,8 @@ pub(super) struct Planned {
     pub(super) programmed: Option<f64>,
     /// The radius within which it blends out of the previous zoned point, if it does.
     pub(super) blend: Option<f64>,
+    /// Its TCP in the tool link's frame.
+    pub(super) tool: Iso,
 }
 
 /// Samples of the corner checked for reachability, axis speeds and (joint-space corners)
@@ -151,8 +153,20 @@ impl Vm {
             }
             _ => {
                 let q = self.joints_at(t);
-                self.model.tcp(&q[..self.model.dof()], &self.cfg.tool)
+                self.model.tcp(&q[..self.model.dof()], &self.tool_at(t))
             }
+        }
+    }
+
+    /// The TCP in the tool link's frame at `t`: the tool of the motion the robot is in
+    /// (a tool change never blends: the next motion starts at the point), else the last
+    /// motion's (or the workcell's, before any).
+    pub fn tool_at(&self, t: i64) -> Iso {
+        match (self.fading_at(t), &self.motion) {
+            (Some(f), _) => f.motion.tool,
+            (None, Some(m)) if t >= m.start => m.tool,
+            (None, Some(m)) => self.fading.as_ref().map_or(m.tool, |f| f.motion.tool),
+            (None, None) => self.tool,
         }
     }
 
@@ -186,15 +200,27 @@ impl Vm {
             Some(z) if z > 0.0 => Some(z),
             _ => None,
         };
+        if let Some(tool) = self.motion_operands(ins).tool {
+            self.tool = tool;
+        }
         let (traj, point_ns) = self.plan_path(ins)?;
         // Inside a zoned motion's corner: when this one can start, the radius it blends
-        // within, and when the robot would reach that corner's point.
+        // within, and when the robot would reach that corner's point. **Choice:** a motion
+        // with another tool than the zoned one does not blend: it starts at the point.
+        let tool_changed = self
+            .fading_at(self.time)
+            .is_some_and(|f| f.motion.tool != self.tool);
         let corner = self.fading_at(self.time).map(|f| {
-            let (ts, radius) = self.blend_start(f, &traj, point_ns);
+            let (ts, radius) = if tool_changed {
+                (f.end(), 0.0)
+            } else {
+                self.blend_start(f, &traj, point_ns)
+            };
             (ts, radius, f.end(), f.pos.line)
         });
         if let Some((ts, _, point, line)) = corner
             && ts >= point
+            && !tool_changed
         {
             self.warn_once(
                 self.main.pc,
@@ -205,7 +231,11 @@ impl Vm {
                 ),
             );
         }
-        let (start, blend) = corner.map_or((self.time, None), |(ts, r, ..)| (ts, Some(r)));
+        let (start, blend) = match corner {
+            Some((ts, _, _, _)) if tool_changed => (ts, None),
+            Some((ts, r, ..)) => (ts, Some(r)),
+            None => (self.time, None),
+        };
         let (mut end_ns, zone) = match programmed {
             // A TCP that does not move (a turntable's, on its axis) enters no zone.
             Some(r) => match self.zone_entry(&traj, point_ns, r) {
@@ -226,6 +256,7 @@ impl Vm {
             zone: if end_ns < point_ns { zone } else { 0.0 },
             programmed,
             blend,
+            tool: self.tool,
         })
     }
 
@@ -261,11 +292,11 @@ impl Vm {
             return (to_ns(t), r1);
         }
         let n = self.model.dof();
-        let point = self.model.tcp(&traj.end_joints()[..n], &self.cfg.tool).t;
+        let point = self.model.tcp(&traj.end_joints()[..n], &self.tool).t;
         let dist = |t: f64| {
             let q = self.eval_joints(traj, t).unwrap_or(self.rest);
             vworks_model::math::norm(vworks_model::math::sub(
-                self.model.tcp(&q[..n], &self.cfg.tool).t,
+                self.model.tcp(&q[..n], &self.tool).t,
                 point,
             ))
         };
@@ -449,7 +480,7 @@ impl Vm {
                 }
             }
             if joint_space {
-                let p = self.model.tcp(&q[..n], &self.cfg.tool).t;
+                let p = self.model.tcp(&q[..n], &self.tool).t;
                 let d = vworks_model::math::norm(vworks_model::math::sub(p, f.corner_pose.t));
                 if d > f.motion.zone {
                     return None;

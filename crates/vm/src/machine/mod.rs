@@ -363,6 +363,9 @@ pub struct Vm {
     /// Cartesian paths sampled, by the bits of their joints, poses and speed
     /// (`plan::PathSamples`): a program repeating its moves samples each once.
     path_memo: Vec<([u64; plan::PATH_KEY], plan::PathSamples)>,
+    /// The TCP in the tool link's frame: the workcell's tool, then the last motion's
+    /// `tool`.
+    tool: Iso,
     m: Arc<Module>,
     model: Arc<RobotModel>,
     cfg: VmConfig,
@@ -490,6 +493,7 @@ impl Vm {
     /// A VM for `module` on `model`, about to run procedure `entry`; with `None` the robot
     /// only serves remote requests (`serve_only`).
     pub fn new(m: Arc<Module>, model: Arc<RobotModel>, cfg: VmConfig, entry: Option<u32>) -> Vm {
+        let initial_tool = cfg.tool;
         let mut vars = vec![0u64; m.var_slots as usize];
         for v in &m.vars {
             let w = v.ty.width() as usize;
@@ -553,6 +557,7 @@ impl Vm {
             globals,
             warnings: Vec::new(),
             path_memo: Vec::with_capacity(plan::PATH_MEMO),
+            tool: initial_tool,
             instant: -1,
             instant_budget: 0,
             instant_events: 0,
@@ -1037,7 +1042,7 @@ impl Vm {
                         let n = self.model.dof();
                         let corner_pose = match &motion.traj {
                             Trajectory::Cartesian { to, .. } => *to,
-                            _ => self.model.tcp(&self.rest[..n], &self.cfg.tool),
+                            _ => self.model.tcp(&self.rest[..n], &motion.tool),
                         };
                         self.fading = Some(Fading {
                             motion,

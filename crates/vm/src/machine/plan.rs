@@ -11,7 +11,7 @@ pub(super) const PATH_SAMPLES: usize = 64;
 pub(super) const PATH_MEMO: usize = 32;
 /// A sampled path's key: the bits of the start joints, the start and goal poses (rotation,
 /// translation), the via point (NaN for a line) and the path speed.
-pub(super) const PATH_KEY: usize = MAX_AXES + 12 + 12 + 3 + 1;
+pub(super) const PATH_KEY: usize = MAX_AXES + 12 + 12 + 3 + 1 + 12;
 
 /// What sampling a Cartesian path found: the slowest ratio of an axis's speed limit to its
 /// speed (1 if none is exceeded) and that axis, each axis's largest speed, the joints at
@@ -54,6 +54,10 @@ pub(super) struct MotionOperands {
     accel: Option<f64>,
     /// `zone` radius (m; 0 for `zone fine`), if given.
     pub(super) zone: Option<f64>,
+    /// `tool` (the TCP in the tool link's frame), if given.
+    pub(super) tool: Option<Iso>,
+    /// The `speed` of a `move_j` is a TCP speed (m/s), not a ratio.
+    tcp_speed: bool,
     /// Slots they take on the stack.
     pub(super) width: usize,
 }
@@ -92,6 +96,8 @@ pub(super) enum Trajectory {
         rates: [f64; MAX_AXES],
         /// The joints it starts from (the seed of numeric IK).
         seed: [f64; MAX_AXES],
+        /// The TCP (in the tool link's frame) the path is for.
+        tool: Iso,
     },
 }
 
@@ -204,10 +210,13 @@ impl Vm {
     /// The joints of a TCP pose on the configuration of Cartesian motion `traj`: on its
     /// analytic branch, or seeded from its start joints (numeric IK).
     pub(super) fn ik_on(&self, traj: &Trajectory, tcp: &Iso) -> Option<[f64; MAX_AXES]> {
-        let Trajectory::Cartesian { branch, seed, .. } = traj else {
+        let Trajectory::Cartesian {
+            branch, seed, tool, ..
+        } = traj
+        else {
             return None;
         };
-        let flange = tcp.mul(&self.cfg.tool.inverse());
+        let flange = tcp.mul(&tool.inverse());
         let mut q = [0.0; MAX_AXES];
         let n = self.model.dof();
         let solved = match branch {
@@ -238,7 +247,7 @@ impl Vm {
             }
             _ => {
                 let q = self.eval_joints(traj, dt).unwrap_or(self.rest);
-                self.model.tcp(&q[..self.model.dof()], &self.cfg.tool)
+                self.model.tcp(&q[..self.model.dof()], &self.tool)
             }
         }
     }
@@ -304,6 +313,10 @@ impl Vm {
         };
         let s = &self.main.stack;
         let mut k = 0;
+        let tool = f.has(MoveFlags::TOOL).then(|| {
+            k += 6;
+            to_iso(&s[s.len() - k..s.len() - k + 6])
+        });
         let zone = f.has(MoveFlags::ZONE).then(|| {
             k += 1;
             f64::from_bits(s[s.len() - k])
@@ -339,6 +352,8 @@ impl Vm {
             speed,
             accel,
             zone,
+            tool,
+            tcp_speed: f.has(MoveFlags::TCP_SPEED),
             width: k,
         }
     }
@@ -353,7 +368,7 @@ impl Vm {
             .take(self.model.dof())
             .map(|x| f64::from_bits(*x))
             .collect();
-        self.model.tcp(&q, &self.cfg.tool)
+        self.model.tcp(&q, &self.tool)
     }
 
     /// Samples a Cartesian path at [`PATH_SAMPLES`] points from joints `from`: every point
@@ -402,7 +417,7 @@ impl Vm {
     pub(super) fn ik_tcp(&self, tcp: &Iso, near: &[f64]) -> Result<[f64; MAX_AXES], String> {
         let n = self.model.dof();
         let mut q = [0.0; MAX_AXES];
-        let flange = tcp.mul(&self.cfg.tool.inverse());
+        let flange = tcp.mul(&self.tool.inverse());
         self.model
             .ik(&flange, &near[..n], &mut q[..n])
             // In the TCP's terms, as the program wrote the target.
@@ -412,12 +427,36 @@ impl Vm {
 
     /// Plans the path and profile of `ins` from the robot's state now (from the corner
     /// of a zoned motion still finishing: see `blend`); returns it and its duration.
+    /// The time (s) a joint motion from `from` to `goal` takes at 100 % speed.
+    fn joint_duration(&self, from: &[f64; MAX_AXES], goal: &[f64; MAX_AXES], aratio: f64) -> f64 {
+        let n = self.model.dof();
+        if (0..n).any(|i| goal[i] != from[i] && self.model.axis(i).max_jerk.is_some()) {
+            let (_, dur) = self.plan_synced(*from, *goal, 1.0, aratio);
+            return dur as f64 / NS;
+        }
+        let (mut vs, mut as_) = (f64::INFINITY, f64::INFINITY);
+        for i in 0..n {
+            let d = (goal[i] - from[i]).abs();
+            if d > 0.0 {
+                let j = self.model.axis(i);
+                vs = vs.min(j.max_velocity / d);
+                as_ = as_.min(aratio * j.max_accel / d);
+            }
+        }
+        if vs.is_finite() {
+            Profile::new(1.0, vs, as_).duration_ns() as f64 / NS
+        } else {
+            0.0
+        }
+    }
+
     pub(super) fn plan_path(&mut self, ins: Instr) -> Result<(Trajectory, i64), String> {
         let MotionOperands {
             target: target_slots,
             via,
             speed,
             accel,
+            tcp_speed,
             ..
         } = self.motion_operands(ins);
         let from = self.rest;
@@ -451,8 +490,30 @@ impl Vm {
                     ));
                 }
             }
-            let ratio = speed.unwrap_or(1.0);
             let aratio = accel.unwrap_or(1.0);
+            let ratio = match speed {
+                // A TCP speed: the axes' ratio at which the motion lasts about the TCP's
+                // straight-line distance over that speed (docs/language.md, Motion).
+                Some(v) if tcp_speed => {
+                    if v.is_nan() || v <= 0.0 {
+                        return Err(format!(
+                            "the speed must be greater than zero (got {})",
+                            fmt_quantity(v, Dim::SPEED)
+                        ));
+                    }
+                    let d = vworks_model::math::norm(vworks_model::math::sub(
+                        self.model.tcp(&goal[..n], &self.tool).t,
+                        self.model.tcp(&from[..n], &self.tool).t,
+                    ));
+                    let full = self.joint_duration(&from, &goal, aratio);
+                    if d > 0.0 && full > 0.0 {
+                        (v * full / d).clamp(1e-6, 1.0)
+                    } else {
+                        1.0
+                    }
+                }
+                _ => speed.unwrap_or(1.0),
+            };
             if !(ratio > 0.0 && ratio <= 1.0 && aratio > 0.0 && aratio <= 1.0) {
                 return Err(format!(
                     "speed and acceleration of move_j must be more than 0% and at most 100% (got {}%, {}%)",
@@ -547,6 +608,7 @@ impl Vm {
                 branch: None,
                 rates: [0.0; MAX_AXES],
                 seed: from,
+                tool: self.tool,
             };
             return Ok((traj, 0));
         }
@@ -563,6 +625,8 @@ impl Vm {
             .chain(&goal.t)
             .chain(&via_or_none)
             .chain([&vs])
+            .chain(self.tool.r.iter().flatten())
+            .chain(&self.tool.t)
             .enumerate()
         {
             key[k] = x.to_bits();
@@ -604,7 +668,7 @@ impl Vm {
         let dur = profile.duration_ns();
         let branch = self
             .model
-            .ik_branch(&start.mul(&self.cfg.tool.inverse()), &from[..n]);
+            .ik_branch(&start.mul(&self.tool.inverse()), &from[..n]);
         Ok((
             Trajectory::Cartesian {
                 path,
@@ -615,6 +679,7 @@ impl Vm {
                 branch,
                 rates,
                 seed: from,
+                tool: self.tool,
             },
             dur,
         ))

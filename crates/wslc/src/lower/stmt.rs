@@ -159,6 +159,7 @@ impl Compiler<'_> {
                 speed,
                 accel,
                 zone,
+                tool,
             } => self.move_stmt(
                 *kind,
                 via.as_ref(),
@@ -167,6 +168,7 @@ impl Compiler<'_> {
                     speed: speed.as_ref(),
                     accel: accel.as_ref(),
                     zone: zone.as_ref(),
+                    tool: tool.as_ref(),
                 },
                 sp,
             ),
@@ -757,7 +759,12 @@ impl Compiler<'_> {
         kind: MoveKind,
         via: Option<&Expr>,
         target: &Expr,
-        MoveOptions { speed, accel, zone }: MoveOptions<'_>,
+        MoveOptions {
+            speed,
+            accel,
+            zone,
+            tool,
+        }: MoveOptions<'_>,
         sp: Span,
     ) {
         self.takes_time("move", sp);
@@ -796,7 +803,9 @@ impl Compiler<'_> {
         }
         if let Some(s) = speed {
             flags |= MoveFlags::SPEED;
-            self.motion_rate(kind, s, Dim::SPEED, "speed");
+            if self.motion_rate(kind, s, Dim::SPEED, "speed") {
+                flags |= MoveFlags::TCP_SPEED;
+            }
         }
         if let Some(a) = accel {
             flags |= MoveFlags::ACCEL;
@@ -827,6 +836,12 @@ impl Compiler<'_> {
                 }
             }
         }
+        if let Some(t) = tool {
+            flags |= MoveFlags::TOOL;
+            let out = self.expr(t);
+            let what = format!("the tool of `{}`", kind.keyword());
+            self.coerce(out, Ty::Pose, t.span, &what);
+        }
         let f = MoveFlags(flags);
         self.emit(
             match kind {
@@ -839,12 +854,14 @@ impl Compiler<'_> {
     }
 
     /// The `speed`/`accel` option of a motion: a ratio for `move_j`, else `dim` (> 0).
-    pub(super) fn motion_rate(&mut self, kind: MoveKind, e: &Expr, dim: Dim, what: &str) {
+    /// A `move_j` may also take a TCP speed (`speed 250mm/s`): then it returns true.
+    pub(super) fn motion_rate(&mut self, kind: MoveKind, e: &Expr, dim: Dim, what: &str) -> bool {
         let out = self.expr(e);
         let what = format!("the {what} of `{}`", kind.keyword());
-        if kind == MoveKind::J {
+        let tcp_speed = kind == MoveKind::J && dim == Dim::SPEED && out.ty == Ty::Num(Dim::SPEED);
+        if kind == MoveKind::J && !tcp_speed {
             self.ratio(out, e.span, &what, "50%");
-            return;
+            return false;
         }
         let out = self.coerce(out, Ty::Num(dim), e.span, &what);
         if let Some(ConstValue::Num(x)) = out.k
@@ -856,6 +873,7 @@ impl Compiler<'_> {
                 e.span,
             ));
         }
+        tcp_speed
     }
 
     /// A ratio such as `50%`: a plain number in (0, 1], written with `%` when literal.
@@ -1009,4 +1027,5 @@ pub(super) struct MoveOptions<'a> {
     pub(super) speed: Option<&'a Expr>,
     pub(super) accel: Option<&'a Expr>,
     pub(super) zone: Option<&'a Zone>,
+    pub(super) tool: Option<&'a Expr>,
 }

@@ -797,15 +797,7 @@ impl Tr<'_> {
         let rest = &p[n - 3..];
         let speed = self.value(rest[0], Ty::Speed)?;
         let zone = self.value(rest[1], Ty::Zone)?.leaf();
-        let tool = self.value(rest[2], Ty::Tool)?;
-        if !is_identity_pose(&tool.parts[0]) {
-            self.unsupported(
-                "a tool other than tool0 (the TCP is the workcell's tool for now)",
-                rest[2].span,
-                "use tool0 and give the robot its tool in the workcell",
-            );
-            return None;
-        }
+        let tool = self.value(rest[2], Ty::Tool)?.leaf();
         if let Some(w) = &wobj
             && !(is_identity_pose(&w.parts[0]) && is_identity_pose(&w.parts[1]))
         {
@@ -827,15 +819,15 @@ impl Tr<'_> {
             "movec" => w::MoveKind::C,
             _ => w::MoveKind::J,
         };
-        // MoveJ and MoveAbsJ: the axes move at full speed for now (docs/rapid.md).
-        let speed = (kind != w::MoveKind::J).then_some(v_tcp);
+        // MoveJ and MoveAbsJ take the TCP speed too (WSL's `move_j … speed 250mm/s`).
         Some(w::StmtKind::Move {
             kind,
             via,
             target,
-            speed,
+            speed: Some(v_tcp),
             accel: None,
             zone: Some(zone),
+            tool: Some(tool),
         })
     }
 
