@@ -373,6 +373,16 @@ proptest::proptest! {
         let (fast, all) = (run(true), run(false));
         let lines = |r: &RunResult| r.trace.iter().map(|e| e.line(&cell)).collect::<Vec<_>>();
         proptest::prop_assert_eq!(lines(&fast), lines(&all));
-        proptest::prop_assert!(fast.queries <= all.queries);
+        // One bounded query per pair and checked boundary, adaptive or not: adaptive
+        // checking makes no more queries than checking every boundary. (It used to add an
+        // unbounded distance query behind each promise: (-6, 55, -54, 0, 0, 0),
+        // (0, 20, -2, 0, 0, 0) against (-7, 61, -56, 26, 46, 13), (3, 53, -11, -35, 27, 21)
+        // at 98 % made 19,092 queries against 19,051; this test found it.)
+        proptest::prop_assert!(
+            fast.queries <= all.queries,
+            "adaptive {} against exhaustive {} queries",
+            fast.queries,
+            all.queries
+        );
     }
 }

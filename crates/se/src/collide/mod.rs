@@ -129,6 +129,10 @@ const SPEED_MARGIN: f64 = 1.25;
 /// but grows the boxes of the look-ahead broadphase (more pairs to bound).
 pub const HORIZON_NS: i64 = 100_000_000;
 
+/// How far ahead one boundary query of a pair proves it apart (1 s): the query looks as far
+/// as the pair could close in that time.
+const PROMISE_NS: i64 = 1_000_000_000;
+
 /// Per moving joint on the path from the root to `link`: (joint index, the farthest any
 /// point within `extent` of the link's origin can be from the joint's axis).
 fn reach_of(
@@ -635,17 +639,19 @@ impl Collider {
                 };
                 self.queries += 1;
                 let (pa, pb) = (&self.poses[pair.0], &self.poses[pair.1]);
-                let found = gap(pa, a.shape.as_ref(), pb, b.shape.as_ref(), margin);
+                // One bounded query per pair and boundary: with adaptive checking it looks
+                // as far as the pair could close in `PROMISE_NS`, so the same query gives
+                // the gap behind the promise (at least that far when it finds nothing) —
+                // adaptive checking never makes more queries than checking every boundary.
+                let within = if self.adaptive && v.is_finite() && v > 0.0 {
+                    margin + v * PROMISE_NS as f64 / 1e9
+                } else {
+                    margin
+                };
+                let wide = gap(pa, a.shape.as_ref(), pb, b.shape.as_ref(), within);
+                let found = wide.filter(|(d, _, _)| *d <= margin);
                 if self.adaptive && v.is_finite() {
-                    // The gap behind the promise: the query's when within the clearance,
-                    // else an unbounded distance query.
-                    let d = match &found {
-                        Some((d, _, _)) => *d,
-                        None => {
-                            self.queries += 1;
-                            distance(pa, a.shape.as_ref(), pb, b.shape.as_ref())
-                        }
-                    };
+                    let d = wide.map_or(within, |(d, _, _)| d);
                     let gap = d.max(0.0) * trust(a.shape.as_ref(), b.shape.as_ref());
                     self.safe_until[idx] = if v <= 0.0 {
                         i64::MAX

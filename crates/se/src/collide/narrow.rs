@@ -43,7 +43,9 @@ pub(super) fn gap(
     }
 }
 
-/// The distance between two placed shapes (m; 0 when they overlap), unbounded.
+/// The distance between two placed shapes (m; 0 when they overlap), unbounded: the
+/// tests' reference for the closed forms.
+#[cfg(test)]
 pub(super) fn distance(
     pa: &Pose,
     a: &dyn parry3d::shape::Shape,
