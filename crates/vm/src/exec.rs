@@ -400,6 +400,30 @@ impl Thread {
                         self.stack[at + k] = b(*v);
                     }
                 }
+                Instr::PoseMul | Instr::PoseInv => {
+                    let read = |s: &[u64]| {
+                        let mut p = [0.0; 6];
+                        for (v, x) in p.iter_mut().zip(s) {
+                            *v = f(*x);
+                        }
+                        p
+                    };
+                    let n = self.stack.len();
+                    let q = if matches!(ins, Instr::PoseMul) {
+                        let r = math::pose_mul(
+                            read(&self.stack[n - 12..n - 6]),
+                            read(&self.stack[n - 6..]),
+                        );
+                        self.stack.truncate(n - 6);
+                        r
+                    } else {
+                        math::pose_inv(read(&self.stack[n - 6..]))
+                    };
+                    let at = self.stack.len() - 6;
+                    for (k, v) in q.iter().enumerate() {
+                        self.stack[at + k] = b(*v);
+                    }
+                }
                 Instr::Jump(t) => self.pc = self.frame_start(m) + t,
                 Instr::JumpIfFalse(t) => {
                     if self.pop() == 0 {

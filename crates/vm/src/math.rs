@@ -30,6 +30,46 @@ pub fn tool_offset(p: Pose6, dx: f64, dy: f64, dz: f64) -> Pose6 {
     ]
 }
 
+/// The rotation matrix and translation of a pose.
+fn frame(p: Pose6) -> ([[f64; 3]; 3], [f64; 3]) {
+    (rpy_to_matrix(p[3], p[4], p[5]), [p[0], p[1], p[2]])
+}
+
+/// A pose from a rotation matrix and a translation (angles as the robot models read them).
+fn pose_of(r: [[f64; 3]; 3], t: [f64; 3]) -> Pose6 {
+    let rpy = vworks_model::math::Iso { r, t }.rpy();
+    [t[0], t[1], t[2], rpy[0], rpy[1], rpy[2]]
+}
+
+/// `pose_mul(a, b)`: the pose `b` given in the frame `a`, in `a`'s frame (a · b).
+pub fn pose_mul(a: Pose6, b: Pose6) -> Pose6 {
+    let (ra, ta) = frame(a);
+    let (rb, tb) = frame(b);
+    let mut r = [[0.0; 3]; 3];
+    let mut t = ta;
+    for i in 0..3 {
+        for j in 0..3 {
+            r[i][j] = (0..3).map(|k| ra[i][k] * rb[k][j]).sum();
+            t[i] += ra[i][j] * tb[j];
+        }
+    }
+    pose_of(r, t)
+}
+
+/// `pose_inv(p)`: the inverse transform.
+pub fn pose_inv(p: Pose6) -> Pose6 {
+    let (r, t) = frame(p);
+    let mut rt = [[0.0; 3]; 3];
+    let mut ti = [0.0; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            rt[i][j] = r[j][i];
+            ti[i] -= r[j][i] * t[j];
+        }
+    }
+    pose_of(rt, ti)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -42,6 +82,20 @@ mod tests {
         let q = tool_offset(p, 0.0, 0.0, 0.1);
         assert!((q[2] - 0.2).abs() < 1e-12);
         assert!((q[0] - 0.45).abs() < 1e-12 && (q[1] + 0.2).abs() < 1e-12);
+    }
+
+    #[test]
+    fn pose_mul_and_inverse() {
+        let a = [0.1, 0.2, 0.3, 0.4, -0.5, 0.6];
+        let b = [-0.3, 0.05, 0.7, -1.0, 0.2, 2.5];
+        let back = pose_mul(pose_inv(a), pose_mul(a, b));
+        for k in 0..6 {
+            assert!((back[k] - b[k]).abs() < 1e-12, "{back:?}");
+        }
+        // A frame turned 90° about z maps x to y.
+        let f = [1.0, 0.0, 0.0, 0.0, 0.0, PI / 2.0];
+        let p = pose_mul(f, [0.5, 0.0, 0.0, 0.0, 0.0, 0.0]);
+        assert!((p[0] - 1.0).abs() < 1e-12 && (p[1] - 0.5).abs() < 1e-12);
     }
 
     #[test]

@@ -307,6 +307,10 @@ instruction_set! {
     0x5b Offset;
     /// Pops dz, dy, dx and a pose; pushes the pose translated in its own tool frame.
     0x5c ToolOffset;
+    /// Pops pose b and pose a; pushes a · b (b given in the frame a).
+    0x5d PoseMul;
+    /// Pops a pose; pushes its inverse.
+    0x5e PoseInv;
     /// Jumps to instruction `t` of this procedure.
     0x60 Jump(t: u32);
     /// Pops a bool; jumps to `t` if it is false.
@@ -408,6 +412,8 @@ impl Instr {
             Instr::JointsGet => eff(J + 1, 1),
             Instr::PoseGet(_) => eff(P, 1),
             Instr::Offset | Instr::ToolOffset => eff(P + 3, P),
+            Instr::PoseMul => eff(2 * P, P),
+            Instr::PoseInv => eff(P, P),
             Instr::JumpIfFalse(_) | Instr::JumpIfTrue(_) => eff(1, 0),
             Instr::Call(p) => {
                 let callee = m.procs.get(p as usize)?;

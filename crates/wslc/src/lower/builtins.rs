@@ -15,6 +15,8 @@ pub(crate) enum Builtin {
     CurrentPose,
     Offset,
     ToolOffset,
+    PoseMul,
+    PoseInv,
     Abs,
     Min,
     Max,
@@ -81,6 +83,20 @@ pub(crate) const BUILTINS: &[BuiltinInfo] = &[
         "tool_offset(p, dx, dy, dz)",
         "pose",
         &[Instr::ToolOffset],
+    ),
+    row(
+        "pose_mul",
+        Builtin::PoseMul,
+        "pose_mul(a, b)",
+        "pose",
+        &[Instr::PoseMul],
+    ),
+    row(
+        "pose_inv",
+        Builtin::PoseInv,
+        "pose_inv(p)",
+        "pose",
+        &[Instr::PoseInv],
     ),
     row(
         "abs",
@@ -240,6 +256,28 @@ impl Compiler<'_> {
                     } else {
                         math::tool_offset(p, ds[0], ds[1], ds[2])
                     })),
+                    _ => None,
+                };
+                Out {
+                    ty: Ty::Pose,
+                    k,
+                    bare: false,
+                }
+            }
+            Builtin::PoseMul | Builtin::PoseInv => {
+                let mut ks = Vec::new();
+                for (i, a) in args.iter().enumerate() {
+                    let o = self.expr(a);
+                    let o =
+                        self.coerce(o, Ty::Pose, a.span, &format!("argument {} of `{n}`", i + 1));
+                    ks.push(o.k);
+                }
+                self.emit(info.instrs[0], sp);
+                let k = match ks.as_slice() {
+                    [Some(ConstValue::Pose(a)), Some(ConstValue::Pose(b))] => {
+                        Some(ConstValue::Pose(math::pose_mul(*a, *b)))
+                    }
+                    [Some(ConstValue::Pose(p))] => Some(ConstValue::Pose(math::pose_inv(*p))),
                     _ => None,
                 };
                 Out {

@@ -840,32 +840,78 @@ impl Tr<'_> {
             })(),
             "reltool" => (|| {
                 let (p, opts) = self.split_args(f, args, 4..=4, &["Rx", "Ry", "Rz"], span)?;
-                if let Some((_, n, _)) = opts.first() {
-                    self.unsupported(
-                        "RelTool's rotations (`\\Rx`, `\\Ry`, `\\Rz`)",
-                        n.span,
-                        "rotate with a second robtarget",
-                    );
-                    return None;
-                }
                 let base = self.value(p[0], Ty::Robtarget)?.leaf();
                 let d = nums(self, &p[1..])?;
                 let mut a = vec![base];
                 a.extend(d.into_iter().map(|e| b::with_unit(e, Dim::LENGTH)));
-                Some(Val::one(Ty::Robtarget, b::call("tool_offset", a, span)))
+                let mut out = b::call("tool_offset", a, span);
+                // Rotations about the tool's x, then the new y, then the new z.
+                for axis in ["rx", "ry", "rz"] {
+                    let Some((_, n, v)) = opts.iter().find(|(k, _, _)| k == axis) else {
+                        continue;
+                    };
+                    let Some(e) = v else {
+                        self.error(
+                            Code::E0301,
+                            format!("`\\{}` is written `\\{}:=degrees`", n.text, n.text),
+                            n.span,
+                        );
+                        return None;
+                    };
+                    let angle = b::with_unit(self.value(e, Ty::Num)?.leaf(), Dim::ANGLE);
+                    let zero_l = || b::quantity(0.0, Dim::LENGTH, span);
+                    let zero_a = || b::quantity(0.0, Dim::ANGLE, span);
+                    let rot = match axis {
+                        "rx" => [zero_l(), zero_l(), zero_l(), angle, zero_a(), zero_a()],
+                        "ry" => [zero_l(), zero_l(), zero_l(), zero_a(), angle, zero_a()],
+                        _ => [zero_l(), zero_l(), zero_l(), zero_a(), zero_a(), angle],
+                    };
+                    out = b::call("pose_mul", vec![out, b::pose(rot, span)], span);
+                }
+                Some(Val::one(Ty::Robtarget, out))
+            })(),
+            "posemult" | "poseinv" => (|| {
+                let n = if key == "posemult" { 2 } else { 1 };
+                let (p, _) = self.split_args(f, args, n..=n, &[], span)?;
+                let mut a = Vec::new();
+                for e in &p {
+                    a.push(self.value(e, Ty::Pose)?.leaf());
+                }
+                let g = if key == "posemult" {
+                    "pose_mul"
+                } else {
+                    "pose_inv"
+                };
+                Some(Val::one(Ty::Pose, b::call(g, a, span)))
             })(),
             "crobt" => (|| {
-                self.split_args(
+                let (_, opts) = self.split_args(
                     f,
                     args,
                     0..=0,
                     &["Tool", "WObj", "TaskRef", "TaskName"],
                     span,
                 )?;
-                Some(Val::one(
-                    Ty::Robtarget,
-                    b::call("current_pose", vec![], span),
-                ))
+                let mut pose = b::call("current_pose", vec![], span);
+                // In a work object: (uframe · oframe)⁻¹ · the TCP.
+                if let Some((_, n, v)) = opts.iter().find(|(k, _, _)| k == "wobj") {
+                    let Some(e) = v else {
+                        self.error(Code::E0301, "`\\WObj` is written `\\WObj:=wobj1`", n.span);
+                        return None;
+                    };
+                    let w = self.value(e, Ty::Wobj)?;
+                    let frame = b::call(
+                        "pose_mul",
+                        vec![w.parts[0].clone(), w.parts[1].clone()],
+                        span,
+                    );
+                    pose = b::call(
+                        "pose_mul",
+                        vec![b::call("pose_inv", vec![frame], span), pose],
+                        span,
+                    );
+                }
+                Some(Val::one(Ty::Robtarget, pose))
             })(),
             "cjointt" => (|| {
                 self.split_args(f, args, 0..=0, &["TaskRef", "TaskName"], span)?;

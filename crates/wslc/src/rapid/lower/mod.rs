@@ -163,33 +163,11 @@ pub(crate) struct Tr<'d> {
     pub(crate) grip_parts: Vec<String>,
 }
 
-/// Names WSL's own built-in functions take; RAPID names equal to them get a `'`.
-const WSL_BUILTINS: &[&str] = &[
-    "now",
-    "cycle",
-    "timed_out",
-    "current_joints",
-    "current_pose",
-    "offset",
-    "tool_offset",
-    "abs",
-    "min",
-    "max",
-    "sqrt",
-    "sin",
-    "cos",
-    "atan2",
-    "int",
-    "num",
-    "joints",
-    "pose",
-    "axis_length",
-];
-
 /// The WSL name of a RAPID name: lower case (RAPID is case-insensitive).
 pub(crate) fn wsl_name(n: &r::Name) -> String {
     let k = n.key();
-    if WSL_BUILTINS.contains(&k.as_str()) {
+    // Names WSL's own built-in functions take get a `'`.
+    if crate::builtin_functions().any(|(b, _, _)| b == k) {
         format!("{k}'")
     } else {
         k

@@ -798,16 +798,23 @@ impl Tr<'_> {
         let speed = self.value(rest[0], Ty::Speed)?;
         let zone = self.value(rest[1], Ty::Zone)?.leaf();
         let tool = self.value(rest[2], Ty::Tool)?.leaf();
-        if let Some(w) = &wobj
-            && !(is_identity_pose(&w.parts[0]) && is_identity_pose(&w.parts[1]))
-        {
-            self.unsupported(
-                "a work object other than wobj0 (for now)",
-                span,
-                "write the targets in the robot's base frame",
-            );
-            return None;
-        }
+        // A target in a work object: uframe · oframe · p, in the base frame.
+        let in_wobj = |e: w::Expr| match &wobj {
+            Some(w) if !(is_identity_pose(&w.parts[0]) && is_identity_pose(&w.parts[1])) => {
+                let frame = b::call(
+                    "pose_mul",
+                    vec![w.parts[0].clone(), w.parts[1].clone()],
+                    span,
+                );
+                b::call("pose_mul", vec![frame, e], span)
+            }
+            _ => e,
+        };
+        let (via, target) = if key == "moveabsj" {
+            (via, target)
+        } else {
+            (via.map(in_wobj), in_wobj(target))
+        };
         let v_tcp = v_override.unwrap_or_else(|| speed.parts[0].clone());
         let zone = z_override.unwrap_or(zone);
         let zone = match b::literal(&zone) {
