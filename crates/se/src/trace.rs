@@ -876,7 +876,7 @@ fn vm_data(kind: &EventKind, m: &Module) -> Data {
         // The engine records a set as `Detail::Set` (the cell's global and the value it
         // replaces), never as a VM event.
         EventKind::Set { .. } => Data::None,
-        EventKind::WaitUntil { cond, deadline } => Data::WaitCondition {
+        EventKind::WaitUntil { cond, deadline, .. } => Data::WaitCondition {
             globals: cond_globals(m, *cond),
             deadline_ns: *deadline,
         },

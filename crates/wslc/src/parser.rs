@@ -521,9 +521,19 @@ impl Parser<'_, '_> {
             Kw::WaitUntil => {
                 self.bump();
                 let cond = self.expr()?;
+                let poll = if self.at_ident("poll") {
+                    self.bump();
+                    Some(self.expr()?)
+                } else {
+                    None
+                };
                 let timeout = self.timeout()?;
                 self.end("the wait")?;
-                Ok(StmtKind::WaitUntil { cond, timeout })
+                Ok(StmtKind::WaitUntil {
+                    cond,
+                    timeout,
+                    poll,
+                })
             }
             Kw::WaitSignal => {
                 self.bump();

@@ -238,6 +238,8 @@ pub enum StmtKind {
         cond: Expr,
         /// Optional timeout.
         timeout: Option<Expr>,
+        /// `poll p`: tested at once, then every `p` from the wait's start.
+        poll: Option<Expr>,
     },
     /// `signal robot.name;`
     Signal {

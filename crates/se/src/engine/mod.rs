@@ -574,6 +574,10 @@ impl Simulation {
                     // What r does next follows the set that released it.
                     self.merge_clock(r, Seen::Set(cg as usize));
                     self.requeue(r);
+                } else if let Some(poll) = self.vms[r].take_poll_check() {
+                    // A polled wait whose condition holds between polls: tested again at
+                    // the next poll.
+                    self.push(poll, Entry::CheckWait(r, cg));
                 }
             }
             Entry::CheckWhen(r, cg) => {

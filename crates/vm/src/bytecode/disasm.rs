@@ -237,6 +237,7 @@ fn operands(m: &Module, ins: &Instr) -> String {
             parts.join(" ")
         }
         Instr::WaitUntil(c, t) => format!("c{c}{}", if t { " timeout" } else { "" }),
+        Instr::WaitPoll(c, t) => format!("c{c} poll{}", if t { " timeout" } else { "" }),
         Instr::WaitSignal(s, t) => format!("{}{}", m.str(s), if t { " timeout" } else { "" }),
         Instr::Signal(s) => m.signals_sent.get(s as usize).map_or("?".into(), |x| {
             format!("{}.{}", m.str(x.robot), m.str(x.name))

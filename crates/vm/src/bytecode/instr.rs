@@ -367,6 +367,10 @@ instruction_set! {
     0x7f Fail(f: u32);
     /// EVENT `end`: ends this robot's program.
     0x80 Stop;
+    /// EVENT `wait_until` on condition `c`, tested at once and then on a grid of the
+    /// popped period from the wait's start (a controller polling it); pops the period, then
+    /// a timeout (time) if `t`.
+    0x81 WaitPoll(c: u32, t: bool);
 }
 
 /// What an instruction does to the operand stack, in slots.
@@ -446,6 +450,7 @@ impl Instr {
             }
             Instr::Delay => eff(1, 0),
             Instr::WaitUntil(_, t) | Instr::WaitSignal(_, t) => eff(u32::from(t), 0),
+            Instr::WaitPoll(_, t) => eff(1 + u32::from(t), 0),
             Instr::Remote(r) => eff(m.remotes.get(r as usize)?.arg_width(), 0),
             Instr::When(h) => eff(
                 u32::from(m.handlers.get(h as usize)?.trigger.has_operand()),
@@ -465,6 +470,7 @@ impl Instr {
                 | Instr::MoveC(_)
                 | Instr::Delay
                 | Instr::WaitUntil(..)
+                | Instr::WaitPoll(..)
                 | Instr::WaitSignal(..)
                 | Instr::Signal(_)
                 | Instr::Remote(_)
@@ -490,6 +496,7 @@ impl Instr {
                 | Instr::MoveC(_)
                 | Instr::Delay
                 | Instr::WaitUntil(..)
+                | Instr::WaitPoll(..)
                 | Instr::WaitSignal(..)
                 | Instr::Grip(_)
                 | Instr::Release(_)

@@ -250,7 +250,7 @@ impl Module {
                 },
                 Instr::Ret => !zero_time,
                 Instr::RetVal => zero_time,
-                Instr::WaitUntil(c, _) => self
+                Instr::WaitUntil(c, _) | Instr::WaitPoll(c, _) => self
                     .conds
                     .get(c as usize)
                     .is_some_and(|c| caps_fit(&c.captures)),

@@ -502,7 +502,7 @@ impl Vm {
             None | Some(Instr::Stop) if self.serving.is_some() => "the end of the remote procedure",
             None | Some(Instr::Stop) => "the end of the program",
             Some(Instr::Delay) => "`delay`",
-            Some(Instr::WaitUntil(..)) => "`wait_until`",
+            Some(Instr::WaitUntil(..) | Instr::WaitPoll(..)) => "`wait_until`",
             Some(Instr::WaitSignal(..)) => "`wait_signal`",
             Some(Instr::ParJoin) => "the end of a `parallel` block",
             Some(Instr::Grip(_)) => "`grip`",

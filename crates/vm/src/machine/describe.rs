@@ -73,7 +73,23 @@ impl Vm {
             Instr::WaitUntil(c, timeout) => EventKind::WaitUntil {
                 cond: c,
                 deadline: self.deadline(timeout, t)?,
+                poll_ns: None,
             },
+            Instr::WaitPoll(c, timeout) => {
+                let p = f64::from_bits(self.top(false, 0));
+                if p.is_nan() || p <= 0.0 {
+                    return Err(format!(
+                        "the poll period must be more than 0 ({})",
+                        fmt_quantity(p, Dim::TIME)
+                    ));
+                }
+                let poll = span_ns(p, t, "the poll period")?.max(1);
+                EventKind::WaitUntil {
+                    cond: c,
+                    deadline: self.deadline_at(timeout, t, 1)?,
+                    poll_ns: Some(poll),
+                }
+            }
             Instr::WaitSignal(s, timeout) => EventKind::WaitSignal {
                 name: s,
                 deadline: self.deadline(timeout, t)?,

@@ -120,6 +120,8 @@ pub enum EventKind {
         cond: u32,
         /// Deadline (absolute ns) if a timeout was given.
         deadline: Option<i64>,
+        /// The poll period (ns) of a polled wait: it is released only on its grid.
+        poll_ns: Option<i64>,
     },
     /// The robot starts waiting for a signal (string index of its name).
     WaitSignal {
@@ -289,6 +291,8 @@ enum State {
         cond: Option<u32>,
         signal: Option<u32>,
         deadline: Option<i64>,
+        /// A polled wait's start and period (ns).
+        poll: Option<(i64, i64)>,
         pos: SrcPos,
     },
     /// Released from a wait at `time`; `timed`: the wait had a timeout (only those set
@@ -363,6 +367,10 @@ pub struct Vm {
     /// Cartesian paths sampled, by the bits of their joints, poses and speed
     /// (`plan::PathSamples`): a program repeating its moves samples each once.
     path_memo: Vec<([u64; plan::PATH_KEY], plan::PathSamples)>,
+    /// A polled wait's next poll the SE should check at (taken once), and the last one
+    /// asked for (not asked twice).
+    poll_check: Option<i64>,
+    poll_requested: Option<i64>,
     /// The TCP in the tool link's frame: the workcell's tool, then the last motion's
     /// `tool`.
     tool: Iso,
@@ -557,6 +565,8 @@ impl Vm {
             globals,
             warnings: Vec::new(),
             path_memo: Vec::with_capacity(plan::PATH_MEMO),
+            poll_check: None,
+            poll_requested: None,
             tool: initial_tool,
             instant: -1,
             instant_budget: 0,
@@ -970,10 +980,18 @@ impl Vm {
                             pos: e.pos,
                         };
                     }
-                    EventKind::WaitUntil { cond, deadline } => {
+                    EventKind::WaitUntil {
+                        cond,
+                        deadline,
+                        poll_ns,
+                    } => {
+                        if poll_ns.is_some() {
+                            self.main.stack.pop();
+                        }
                         if deadline.is_some() {
                             self.main.stack.pop();
                         }
+                        self.poll_requested = None;
                         self.state = if self.eval_cond(*cond, e.time) {
                             State::released(e.time, *deadline, e.pos)
                         } else {
@@ -981,6 +999,7 @@ impl Vm {
                                 cond: Some(*cond),
                                 signal: None,
                                 deadline: *deadline,
+                                poll: poll_ns.map(|p| (e.time, p)),
                                 pos: e.pos,
                             }
                         };
@@ -998,6 +1017,7 @@ impl Vm {
                                 cond: None,
                                 signal: Some(*name),
                                 deadline: *deadline,
+                                poll: None,
                                 pos: e.pos,
                             }
                         };

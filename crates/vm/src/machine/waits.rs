@@ -56,10 +56,20 @@ impl Vm {
     }
 
     pub(super) fn deadline(&self, timeout: bool, t: i64) -> Result<Option<i64>, String> {
+        self.deadline_at(timeout, t, 0)
+    }
+
+    /// The deadline of a timeout `depth` slots below the top of the stack.
+    pub(super) fn deadline_at(
+        &self,
+        timeout: bool,
+        t: i64,
+        depth: usize,
+    ) -> Result<Option<i64>, String> {
         if !timeout {
             return Ok(None);
         }
-        let d = f64::from_bits(self.top(false, 0));
+        let d = f64::from_bits(self.top(false, depth));
         if d.is_nan() || d < 0.0 {
             return Err(format!(
                 "a timeout cannot be negative ({})",
@@ -109,21 +119,44 @@ impl Vm {
 
     /// The SE's `check_wait` at time `t`: re-tests the condition this VM waits on.
     /// Returns true if the VM is released (its next event becomes `wait_end` at `t`).
+    /// A polled wait (`wait_until … poll p`) is released only on its grid (its start plus
+    /// a whole number of periods): when the condition holds between two polls, the VM asks
+    /// for a check at the next one ([`Vm::take_poll_check`]), where it is tested again.
     pub fn check_wait(&mut self, t: i64) -> bool {
         let State::Waiting {
             cond: Some(c),
             pos,
             deadline,
+            poll,
             ..
         } = self.state
         else {
             return false;
         };
-        if self.eval_cond(c, t) {
-            self.state = State::released(t, deadline, pos);
-            return true;
+        if !self.eval_cond(c, t) {
+            return false;
         }
-        false
+        match poll {
+            Some((start, period)) if (t - start) % period != 0 => {
+                let next = start + ((t - start) / period + 1) * period;
+                // A timeout at or before the next poll ends the wait first.
+                if self.poll_requested != Some(next) && deadline.is_none_or(|d| next < d) {
+                    self.poll_requested = Some(next);
+                    self.poll_check = Some(next);
+                }
+                false
+            }
+            _ => {
+                self.state = State::released(t, deadline, pos);
+                true
+            }
+        }
+    }
+
+    /// The time of the next poll of a polled wait whose condition held between polls, once:
+    /// the SE queues a `check_wait` then.
+    pub fn take_poll_check(&mut self) -> Option<i64> {
+        self.poll_check.take()
     }
 
     /// Delivers a signal named `name` at time `t`: releases a matching wait, or is counted

@@ -187,13 +187,25 @@ impl Compiler<'_> {
                 }
                 self.emit(Instr::Delay, sp);
             }
-            StmtKind::WaitUntil { cond, timeout } => {
+            StmtKind::WaitUntil {
+                cond,
+                timeout,
+                poll,
+            } => {
                 self.takes_time("wait", sp);
                 let c = self.condition(cond, "`wait_until`");
                 if let Some(t) = timeout {
                     self.time_operand(t, "a timeout");
                 }
-                self.emit(Instr::WaitUntil(c, timeout.is_some()), sp);
+                match poll {
+                    Some(p) => {
+                        self.time_operand(p, "a poll period");
+                        self.emit(Instr::WaitPoll(c, timeout.is_some()), sp);
+                    }
+                    None => {
+                        self.emit(Instr::WaitUntil(c, timeout.is_some()), sp);
+                    }
+                }
             }
             StmtKind::WaitSignal { name, timeout } => {
                 self.takes_time("wait", sp);

@@ -397,7 +397,7 @@ impl Tr<'_> {
                     b::name(&g, p[0].span),
                     b::call("int", vec![v.leaf()], p[1].span),
                 );
-                self.timed_wait(&f.text, cond, &opts, span, out);
+                self.timed_wait(&f.text, cond, &opts, false, span, out);
             }
             "isignaldi" | "isignaldo" | "isignalgi" | "isignalgo" => {
                 let kinds: &[SignalKind] = match key {

@@ -849,21 +849,26 @@ impl Tr<'_> {
             return;
         };
         let cond = self.condition(p[0]);
-        self.timed_wait(&f.text, cond, &opts, span, out);
+        self.timed_wait(&f.text, cond, &opts, true, span, out);
     }
 
     /// A wait until `cond` holds, with RAPID's `\MaxTime` (then `\TimeFlag` is set, or
     /// without it the wait is the error ERR_WAIT_MAXTIME) for the instruction `instr`.
+    ///
+    /// `polled`: as `WaitUntil`, the condition is tested every `\PollRate` (0.1 s, at
+    /// least 0.04 s) from the wait's start, not when the data changes.
     pub(crate) fn timed_wait(
         &mut self,
         instr: &str,
         cond: w::Expr,
         opts: &[(String, &r::Name, Option<&r::Expr>)],
+        polled: bool,
         span: Span,
         out: &mut Vec<w::Stmt>,
     ) {
         let mut timeout = None;
         let mut flag = None;
+        let mut poll = polled.then(|| b::quantity(0.1, Dim::TIME, span));
         for (k, name, v) in opts {
             match (k.as_str(), v) {
                 ("maxtime", Some(e)) => {
@@ -873,7 +878,17 @@ impl Tr<'_> {
                 }
                 ("timeflag", Some(e)) => flag = self.place(e),
                 ("pollrate", Some(e)) => {
-                    self.value(e, Ty::Num);
+                    if let Some(v) = self.value(e, Ty::Num) {
+                        let p = b::with_unit(v.leaf(), Dim::TIME);
+                        poll = Some(match b::literal(&p) {
+                            Some(x) => b::quantity(x.max(0.04), Dim::TIME, e.span),
+                            None => b::call(
+                                "max",
+                                vec![p, b::quantity(0.04, Dim::TIME, e.span)],
+                                e.span,
+                            ),
+                        });
+                    }
                 }
                 ("inpos", None) => {}
                 _ => {
@@ -887,7 +902,11 @@ impl Tr<'_> {
         }
         let has_timeout = timeout.is_some();
         out.push(w::Stmt {
-            kind: w::StmtKind::WaitUntil { cond, timeout },
+            kind: w::StmtKind::WaitUntil {
+                cond,
+                timeout,
+                poll,
+            },
             span,
         });
         let timed_out = || b::call("timed_out", vec![], span);
@@ -1032,6 +1051,7 @@ impl Tr<'_> {
                 b::name(&target, span),
             ),
             timeout,
+            poll: None,
         });
         if has_timeout {
             let fail = w::Stmt {
