@@ -104,7 +104,12 @@ pub fn compile_with_io(
     let mut diags: Vec<Diagnostic> = Vec::new();
     let toks = lexer::lex(source, &mut diags);
     let modules = parser::parse(source, toks, &mut diags);
-    let ast = if diags.iter().any(Diagnostic::is_error) {
+    // A construct the parser recognised but vworks does not run (E0300: `RECORD`) does
+    // not stop the translation, which reports the others.
+    let syntax_error = diags
+        .iter()
+        .any(|d| d.is_error() && d.code != crate::Code::E0300);
+    let ast = if syntax_error {
         None
     } else {
         if modules.is_empty() {

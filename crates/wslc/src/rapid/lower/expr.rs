@@ -1006,8 +1006,41 @@ impl Tr<'_> {
                     ),
                 ))
             })(),
-            "numtostr" | "valtostr" | "dim" | "present" | "strlen" | "strpart" | "pow" | "exp"
-            | "clktime" | "getnextsym" | "readnum" | "testdi" => {
+            "dim" => (|| {
+                let (p, _) = self.split_args(f, args, 2..=2, &[], span)?;
+                let r::ExprKind::Name(n) = &p[0].kind else {
+                    self.error(Code::E0020, "Dim takes an array's name", p[0].span);
+                    return None;
+                };
+                let len = match self.lookup(&n.key()) {
+                    Some(Sym::Data(d)) => match d.len {
+                        Some(len) => len,
+                        None => {
+                            self.error(
+                                Code::E0022,
+                                format!("`{}` is not an array", n.text),
+                                n.span,
+                            );
+                            return None;
+                        }
+                    },
+                    _ => {
+                        self.unknown_name(n);
+                        return None;
+                    }
+                };
+                if self.const_num(p[1]) != Some(1.0) {
+                    self.error(
+                        Code::E0025,
+                        "vworks's arrays have one dimension: Dim(a, 1)",
+                        p[1].span,
+                    );
+                    return None;
+                }
+                Some(Val::one(Ty::Num, b::num(f64::from(len), span)))
+            })(),
+            "numtostr" | "valtostr" | "present" | "strlen" | "strpart" | "pow" | "exp"
+            | "clktime" | "getnextsym" | "readnum" => {
                 self.unsupported(
                     &format!("the function `{}` here", f.text),
                     f.span,
