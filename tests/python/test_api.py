@@ -146,7 +146,7 @@ def test_compile_rapid_errors_name_the_rapid_line():
 def test_a_rapid_cell_runs_from_python():
     r = vworks.load_cell(str(ROOT / "workcells/rapid_handoff/cell.toml")).run()
     assert r.outcome == "completed"
-    assert r.end_time == pytest.approx(60.449, abs=5e-4)
+    assert r.end_time == pytest.approx(59.482, abs=5e-4)
 
 
 # --- load_cell and run --------------------------------------------------------------------

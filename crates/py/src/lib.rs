@@ -217,7 +217,7 @@ fn compile(
         Some("wsl") => vworks_wslc::Language::Wsl,
         Some("rapid") => vworks_wslc::Language::Rapid,
         Some(other) => {
-            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            return Err(PyValueError::new_err(format!(
                 "unknown language {other:?}: use \"wsl\" or \"rapid\""
             )));
         }

@@ -13,14 +13,16 @@ use stats_alloc::{INSTRUMENTED_SYSTEM, Region, StatsAlloc};
 #[global_allocator]
 static GLOBAL: &StatsAlloc<System> = &INSTRUMENTED_SYSTEM;
 
-/// The counts are process-wide: one test at a time.
-static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
-
+/// The counts are process-wide, so the measurements run in one test, one after the other:
+/// with two tests, the harness reporting the end of one (it allocates) while the other
+/// measured made that one fail now and then (1 run in 7).
 #[test]
+fn the_hot_loops_allocate_nothing_in_steady_state() {
+    four_arms_run_for_thousands_of_cycles_without_allocating();
+    a_ring_of_robots_handing_a_global_round_allocates_nothing_per_event();
+}
+
 fn four_arms_run_for_thousands_of_cycles_without_allocating() {
-    let _one = ONE_AT_A_TIME
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner);
     let cell = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../bench/cells/grid4/cell.toml");
     let cell = Arc::new(vworks_cell::load(&cell).unwrap());
     let mut sim = vworks_se::engine::Simulation::new(cell);
@@ -41,11 +43,7 @@ fn four_arms_run_for_thousands_of_cycles_without_allocating() {
     );
 }
 
-#[test]
 fn a_ring_of_robots_handing_a_global_round_allocates_nothing_per_event() {
-    let _one = ONE_AT_A_TIME
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner);
     // Eight robots, each waiting until a shared counter reaches its turn, then advancing it
     // (set, check_wait for every waiting robot, wait_end), and a signal ping-pong beside
     // them: scheduler events only.

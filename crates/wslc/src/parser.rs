@@ -662,6 +662,7 @@ impl Parser<'_, '_> {
         let mut accel = None;
         let mut zone = None;
         let mut tool = None;
+        let mut orient = None;
         loop {
             if self.at_ident("zone") {
                 let t = self.bump();
@@ -683,6 +684,8 @@ impl Parser<'_, '_> {
                 &mut accel
             } else if self.at_ident("tool") {
                 &mut tool
+            } else if self.at_ident("orient") {
+                &mut orient
             } else {
                 break;
             };
@@ -700,7 +703,7 @@ impl Parser<'_, '_> {
                 format!("unknown motion option `{}`", self.text(t.span)),
                 t.span,
             )
-            .with_help("the options are `speed`, `accel`, `zone` and `tool`");
+            .with_help("the options are `speed`, `accel`, `orient`, `zone` and `tool`");
             return Err(self.report(d));
         }
         self.end(&format!("`{}`", kind.keyword()))?;
@@ -710,6 +713,7 @@ impl Parser<'_, '_> {
             target,
             speed,
             accel,
+            orient,
             zone,
             tool,
         })

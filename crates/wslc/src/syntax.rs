@@ -160,6 +160,9 @@ pub enum TriggerExpr {
 }
 
 /// Statement kinds.
+// Built once per compilation, never in a hot loop: a motion's options in line are
+// simpler than boxing them.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, PartialEq)]
 pub enum StmtKind {
     /// `var x = e;`
@@ -225,6 +228,8 @@ pub enum StmtKind {
         speed: Option<Expr>,
         /// `accel e`.
         accel: Option<Expr>,
+        /// `orient e`: the largest orientation speed of `move_l`/`move_c`.
+        orient: Option<Expr>,
         /// `zone e` or `zone fine`.
         zone: Option<Zone>,
         /// `tool e`: the TCP (a pose in the tool link's frame) from this motion on.

@@ -228,6 +228,9 @@ fn operands(m: &Module, ins: &Instr) -> String {
             if f.has(MoveFlags::ACCEL) {
                 parts.push("accel");
             }
+            if f.has(MoveFlags::ORIENT) {
+                parts.push("orient");
+            }
             if f.has(MoveFlags::ZONE) {
                 parts.push("zone");
             }

@@ -86,7 +86,11 @@ impl MoveFlags {
     pub const TOOL: u8 = 32;
     /// The `speed` operand of a `move_j` is a TCP speed (m/s), not a ratio.
     pub const TCP_SPEED: u8 = 64;
-    const ALL: u8 = 127;
+    /// An `orient` operand (rad/s: how fast a `move_l`/`move_c` may turn the TCP) is on the
+    /// stack, above `accel`.
+    pub const ORIENT: u8 = 128;
+    /// Every flag: all eight bits are in use.
+    pub const ALL: u8 = 255;
 
     /// True if every bit of `bit` is set.
     pub fn has(self, bit: u8) -> bool {
@@ -142,10 +146,8 @@ impl Operand for MoveFlags {
         out.push(self.0);
     }
     fn read(r: &mut super::encode::Reader<'_>) -> Result<Self, super::LoadError> {
+        // Every bit has a meaning (`MoveFlags::ALL`).
         let b = r.u8()?;
-        if b & !MoveFlags::ALL != 0 {
-            return Err(r.error(format!("unknown motion flags {b:#x}")));
-        }
         Ok(MoveFlags(b))
     }
 }
@@ -335,9 +337,9 @@ instruction_set! {
     0x6c CurrentPose;
     /// EVENT `motion_start`: joint move. Pops tool, zone, accel and speed (when flagged), then the target.
     0x70 MoveJ(f: MoveFlags);
-    /// EVENT `motion_start`: straight-line move. Pops tool, zone, accel and speed (when flagged), then the target.
+    /// EVENT `motion_start`: straight-line move. Pops tool, zone, orient, accel and speed (when flagged), then the target.
     0x71 MoveL(f: MoveFlags);
-    /// EVENT `motion_start`: circular move. Pops tool, zone, accel and speed (when flagged), then the target and the via point.
+    /// EVENT `motion_start`: circular move. Pops tool, zone, orient, accel and speed (when flagged), then the target and the via point.
     0x72 MoveC(f: MoveFlags);
     /// EVENT: pops a time; the robot holds still that long.
     0x73 Delay;
@@ -445,6 +447,7 @@ impl Instr {
                 let extra = u32::from(f.has(MoveFlags::SPEED))
                     + u32::from(f.has(MoveFlags::ACCEL))
                     + u32::from(f.has(MoveFlags::ZONE))
+                    + u32::from(f.has(MoveFlags::ORIENT))
                     + if f.has(MoveFlags::TOOL) { P } else { 0 };
                 eff(target + via + extra, 0)
             }

@@ -58,6 +58,8 @@ pub(super) struct MotionOperands {
     pub(super) tool: Option<Iso>,
     /// The `speed` of a `move_j` is a TCP speed (m/s), not a ratio.
     tcp_speed: bool,
+    /// `orient`: the largest orientation speed of a Cartesian motion (rad/s).
+    orient: Option<f64>,
     /// Slots they take on the stack.
     pub(super) width: usize,
 }
@@ -321,6 +323,10 @@ impl Vm {
             k += 1;
             f64::from_bits(s[s.len() - k])
         });
+        let orient = f.has(MoveFlags::ORIENT).then(|| {
+            k += 1;
+            f64::from_bits(s[s.len() - k])
+        });
         let accel = f.has(MoveFlags::ACCEL).then(|| {
             k += 1;
             f64::from_bits(s[s.len() - k])
@@ -353,6 +359,7 @@ impl Vm {
             accel,
             zone,
             tool,
+            orient,
             tcp_speed: f.has(MoveFlags::TCP_SPEED),
             width: k,
         }
@@ -457,6 +464,7 @@ impl Vm {
             speed,
             accel,
             tcp_speed,
+            orient,
             ..
         } = self.motion_operands(ins);
         let from = self.rest;
@@ -579,8 +587,14 @@ impl Vm {
         let angle = vworks_model::math::norm(vworks_model::math::rotation_vector(
             &vworks_model::math::mat_mul(&vworks_model::math::transpose(&start.r), &goal.r),
         ));
-        // Orientation moves at most 180°/s (with the same ramp time).
-        let w = std::f64::consts::PI;
+        // Orientation moves at most `orient` (180°/s without it), with the same ramp time.
+        let w = orient.unwrap_or(std::f64::consts::PI);
+        if w.is_nan() || w <= 0.0 {
+            return Err(format!(
+                "the orientation speed must be greater than zero (got {})",
+                fmt_quantity(w, Dim::ANGSPEED)
+            ));
+        }
         let wa = w / vworks_model::model::DEFAULT_ACCEL_TIME;
         // With jerk limits, the path's jerk ramps as long as the slowest axis's does.
         let ramp = self.jerk_ramp_time();

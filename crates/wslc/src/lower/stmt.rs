@@ -158,6 +158,7 @@ impl Compiler<'_> {
                 target,
                 speed,
                 accel,
+                orient,
                 zone,
                 tool,
             } => self.move_stmt(
@@ -167,6 +168,7 @@ impl Compiler<'_> {
                 MoveOptions {
                     speed: speed.as_ref(),
                     accel: accel.as_ref(),
+                    orient: orient.as_ref(),
                     zone: zone.as_ref(),
                     tool: tool.as_ref(),
                 },
@@ -774,6 +776,7 @@ impl Compiler<'_> {
         MoveOptions {
             speed,
             accel,
+            orient,
             zone,
             tool,
         }: MoveOptions<'_>,
@@ -822,6 +825,20 @@ impl Compiler<'_> {
         if let Some(a) = accel {
             flags |= MoveFlags::ACCEL;
             self.motion_rate(kind, a, Dim::ACCEL, "acceleration");
+        }
+        if let Some(o) = orient {
+            flags |= MoveFlags::ORIENT;
+            if kind == MoveKind::J {
+                self.err(
+                    Diagnostic::error(
+                        Code::E0022,
+                        "`orient` bounds how fast a `move_l` or `move_c` turns the TCP; a `move_j` has no orientation path",
+                        o.span,
+                    )
+                    .with_help("remove `orient`, or give the speed of the axes with `speed`"),
+                );
+            }
+            self.motion_rate(MoveKind::L, o, Dim::ANGSPEED, "orientation speed");
         }
         match zone {
             None => {}
@@ -1038,6 +1055,7 @@ impl Compiler<'_> {
 pub(super) struct MoveOptions<'a> {
     pub(super) speed: Option<&'a Expr>,
     pub(super) accel: Option<&'a Expr>,
+    pub(super) orient: Option<&'a Expr>,
     pub(super) zone: Option<&'a Zone>,
     pub(super) tool: Option<&'a Expr>,
 }

@@ -833,6 +833,8 @@ impl Tr<'_> {
             target,
             speed: Some(v_tcp),
             accel: None,
+            // The orientation speed of the speeddata, for the Cartesian motions.
+            orient: (kind != w::MoveKind::J).then(|| speed.parts[1].clone()),
             zone: Some(zone),
             tool: Some(tool),
         })
