@@ -340,9 +340,9 @@ fn a_delay_after_a_zoned_point_waits_for_the_robot_with_one_warning() {
     assert_eq!(warnings.len(), 1, "{warnings:?}");
     assert_eq!(warnings[0].kind, "stop-point");
     assert!(
-        warnings[0]
-            .message
-            .contains("`delay` makes the zoned point of the motion at line 6 a stop point")
+        warnings[0].message.contains(
+            "`delay` makes the zoned point of the motion at line 6 of t.wsl a stop point"
+        )
     );
     // The delay starts when the robot reaches the point: the moves take as long as fine.
     let mut f = vm(&fine(&src), None);

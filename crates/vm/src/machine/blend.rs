@@ -227,7 +227,8 @@ impl Vm {
                 point,
                 "corner",
                 format!(
-                    "this motion cannot start inside the zone of the motion at line {line} within the zone and the axes' limits: the robot stops at that point first (a corner path failure); a larger zone, a lower speed or a jerk limit can let it fly by"
+                    "this motion cannot start inside the zone of the motion at line {line} of {} within the zone and the axes' limits: the robot stops at that point first (a corner path failure); a larger zone, a lower speed or a jerk limit can let it fly by",
+                    self.file_name()
                 ),
             );
         }
@@ -258,6 +259,15 @@ impl Vm {
             blend,
             tool: self.tool,
         })
+    }
+
+    /// The program's file name, for messages about another line of it.
+    fn file_name(&self) -> String {
+        std::path::Path::new(&self.m.source_path)
+            .file_name()
+            .map_or(self.m.source_path.clone(), |n| {
+                n.to_string_lossy().into_owned()
+            })
     }
 
     /// A warning about the statement at `pc`, at `time`, once per statement (a loop
@@ -519,7 +529,8 @@ impl Vm {
             end,
             "stop-point",
             format!(
-                "{what} makes the zoned point of the motion at line {line} a stop point: the robot reaches it first; write `zone fine` on that motion to say so"
+                "{what} makes the zoned point of the motion at line {line} of {} a stop point: the robot reaches it first; make that motion stop at its point to say so (`zone fine`; in RAPID, `fine`)",
+                    self.file_name()
             ),
         );
         end
