@@ -41,6 +41,35 @@ fn pose_of(r: [[f64; 3]; 3], t: [f64; 3]) -> Pose6 {
     [t[0], t[1], t[2], rpy[0], rpy[1], rpy[2]]
 }
 
+/// Roll, pitch and yaw (a pose's angles) of a quaternion `[w, x, y, z]`, normalised;
+/// `None` for a zero (or not finite) quaternion.
+pub fn quat_rpy(q: [f64; 4]) -> Option<[f64; 3]> {
+    let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if n.is_nan() || n <= 1e-9 || !n.is_finite() {
+        return None;
+    }
+    let [w, x, y, z] = q.map(|v| v / n);
+    let r = [
+        [
+            1.0 - 2.0 * (y * y + z * z),
+            2.0 * (x * y - w * z),
+            2.0 * (x * z + w * y),
+        ],
+        [
+            2.0 * (x * y + w * z),
+            1.0 - 2.0 * (x * x + z * z),
+            2.0 * (y * z - w * x),
+        ],
+        [
+            2.0 * (x * z - w * y),
+            2.0 * (y * z + w * x),
+            1.0 - 2.0 * (x * x + y * y),
+        ],
+    ];
+    let p = pose_of(r, [0.0; 3]);
+    Some([p[3], p[4], p[5]])
+}
+
 /// `pose_mul(a, b)`: the pose `b` given in the frame `a`, in `a`'s frame (a · b).
 pub fn pose_mul(a: Pose6, b: Pose6) -> Pose6 {
     let (ra, ta) = frame(a);

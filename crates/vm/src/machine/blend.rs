@@ -190,7 +190,8 @@ impl Vm {
     /// Plans motion `ins`: its path and profile, when it starts (at once, or later within
     /// the corner of a zoned motion still finishing), and where its own zone begins.
     pub(super) fn plan(&mut self, ins: Instr) -> Result<Planned, String> {
-        let programmed = match self.motion_operands(ins).zone.or(self.cfg.default_zone) {
+        let operands = self.motion_operands(ins);
+        let programmed = match operands.zone.or(self.cfg.default_zone) {
             Some(z) if z.is_nan() || z < 0.0 => {
                 return Err(format!(
                     "the zone cannot be negative (got {}); write a radius such as `zone 10mm`, or `zone fine`",
@@ -200,7 +201,7 @@ impl Vm {
             Some(z) if z > 0.0 => Some(z),
             _ => None,
         };
-        if let Some(tool) = self.motion_operands(ins).tool {
+        if let Some(tool) = operands.tool {
             self.tool = tool;
         }
         let (traj, point_ns) = self.plan_path(ins)?;

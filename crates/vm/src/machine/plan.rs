@@ -432,31 +432,49 @@ impl Vm {
         Ok(q)
     }
 
-    /// Plans the path and profile of `ins` from the robot's state now (from the corner
-    /// of a zoned motion still finishing: see `blend`); returns it and its duration.
-    /// The time (s) a joint motion from `from` to `goal` takes at 100 % speed.
-    fn joint_duration(&self, from: &[f64; MAX_AXES], goal: &[f64; MAX_AXES], aratio: f64) -> f64 {
+    /// A joint motion from `from` to `goal` at speed and acceleration ratios `ratio` and
+    /// `aratio`, and its duration: one normalised profile s(t) ∈ [0, 1] within every axis's
+    /// limits, or the axes' own time-synchronised profiles where one has a jerk limit.
+    fn plan_joint(
+        &self,
+        from: [f64; MAX_AXES],
+        goal: [f64; MAX_AXES],
+        ratio: f64,
+        aratio: f64,
+    ) -> (Trajectory, i64) {
         let n = self.model.dof();
         if (0..n).any(|i| goal[i] != from[i] && self.model.axis(i).max_jerk.is_some()) {
-            let (_, dur) = self.plan_synced(*from, *goal, 1.0, aratio);
-            return dur as f64 / NS;
+            return self.plan_synced(from, goal, ratio, aratio);
         }
         let (mut vs, mut as_) = (f64::INFINITY, f64::INFINITY);
+        let mut delta = [0.0; MAX_AXES];
         for i in 0..n {
-            let d = (goal[i] - from[i]).abs();
+            delta[i] = goal[i] - from[i];
+            let d = delta[i].abs();
             if d > 0.0 {
                 let j = self.model.axis(i);
-                vs = vs.min(j.max_velocity / d);
+                vs = vs.min(ratio * j.max_velocity / d);
                 as_ = as_.min(aratio * j.max_accel / d);
             }
         }
-        if vs.is_finite() {
-            Profile::new(1.0, vs, as_).duration_ns() as f64 / NS
+        let profile = if vs.is_finite() {
+            Profile::new(1.0, vs, as_)
         } else {
-            0.0
-        }
+            Profile::new(0.0, 1.0, 1.0)
+        };
+        let dur = profile.duration_ns();
+        (
+            Trajectory::Joint {
+                from,
+                delta,
+                profile,
+            },
+            dur,
+        )
     }
 
+    /// Plans the path and profile of `ins` from the robot's state now (from the corner
+    /// of a zoned motion still finishing: see `blend`); returns it and its duration.
     pub(super) fn plan_path(&mut self, ins: Instr) -> Result<(Trajectory, i64), String> {
         let MotionOperands {
             target: target_slots,
@@ -513,7 +531,7 @@ impl Vm {
                         self.model.tcp(&goal[..n], &self.tool).t,
                         self.model.tcp(&from[..n], &self.tool).t,
                     ));
-                    let full = self.joint_duration(&from, &goal, aratio);
+                    let full = self.plan_joint(from, goal, 1.0, aratio).1 as f64 / NS;
                     if d > 0.0 && full > 0.0 {
                         (v * full / d).clamp(1e-6, 1.0)
                     } else {
@@ -529,35 +547,7 @@ impl Vm {
                     aratio * 100.0
                 ));
             }
-            if (0..n).any(|i| goal[i] != from[i] && self.model.axis(i).max_jerk.is_some()) {
-                return Ok(self.plan_synced(from, goal, ratio, aratio));
-            }
-            // One normalised profile s(t) ∈ [0, 1] within every axis's limits.
-            let (mut vs, mut as_) = (f64::INFINITY, f64::INFINITY);
-            let mut delta = [0.0; MAX_AXES];
-            for i in 0..n {
-                delta[i] = goal[i] - from[i];
-                let d = delta[i].abs();
-                if d > 0.0 {
-                    let j = self.model.axis(i);
-                    vs = vs.min(ratio * j.max_velocity / d);
-                    as_ = as_.min(aratio * j.max_accel / d);
-                }
-            }
-            let profile = if vs.is_finite() {
-                Profile::new(1.0, vs, as_)
-            } else {
-                Profile::new(0.0, 1.0, 1.0)
-            };
-            let dur = profile.duration_ns();
-            return Ok((
-                Trajectory::Joint {
-                    from,
-                    delta,
-                    profile,
-                },
-                dur,
-            ));
+            return Ok(self.plan_joint(from, goal, ratio, aratio));
         }
         // Cartesian: line or arc, orientation by slerp.
         let start = match &self.fading {

@@ -268,35 +268,7 @@ pub(crate) mod build {
 /// Roll, pitch and yaw (WSL's `pose` angles, R = Rz·Ry·Rx) of a RAPID quaternion
 /// `[q1, q2, q3, q4]` (q1 the scalar part), normalised; `None` for a zero quaternion.
 pub(crate) fn quat_rpy(q: [f64; 4]) -> Option<[f64; 3]> {
-    let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
-    if n.is_nan() || n <= 1e-9 || !n.is_finite() {
-        return None;
-    }
-    let [w, x, y, z] = q.map(|v| v / n);
-    let r = [
-        [
-            1.0 - 2.0 * (y * y + z * z),
-            2.0 * (x * y - w * z),
-            2.0 * (x * z + w * y),
-        ],
-        [
-            2.0 * (x * y + w * z),
-            1.0 - 2.0 * (x * x + z * z),
-            2.0 * (y * z - w * x),
-        ],
-        [
-            2.0 * (x * z - w * y),
-            2.0 * (y * z + w * x),
-            1.0 - 2.0 * (x * x + y * y),
-        ],
-    ];
-    // As `vworks_model::math::Iso::rpy`: the angles the robot models read back.
-    let pitch = (-r[2][0]).clamp(-1.0, 1.0).asin();
-    Some(if r[2][0].abs() < 1.0 - 1e-12 {
-        [r[2][1].atan2(r[2][2]), pitch, r[1][0].atan2(r[0][0])]
-    } else {
-        [0.0, pitch, (-r[0][1]).atan2(r[1][1])]
-    })
+    vworks_vm::math::quat_rpy(q)
 }
 
 #[cfg(test)]

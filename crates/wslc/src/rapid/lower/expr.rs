@@ -135,6 +135,31 @@ impl Tr<'_> {
         }
     }
 
+    /// An argument that must be the name of data `fits` accepts (`what` describes it:
+    /// "a loaddata"): its name and the data, or a diagnostic.
+    pub(crate) fn data_arg<'e>(
+        &mut self,
+        e: &'e r::Expr,
+        what: &str,
+        fits: impl Fn(&Data) -> bool,
+    ) -> Option<(&'e r::Name, Data)> {
+        let r::ExprKind::Name(n) = &e.kind else {
+            self.error(Code::E0020, format!("expected the name of {what}"), e.span);
+            return None;
+        };
+        match self.lookup(&n.key()) {
+            Some(Sym::Data(d)) if fits(&d) => Some((n, d)),
+            Some(_) => {
+                self.error(Code::E0020, format!("`{}` is not {what}", n.text), n.span);
+                None
+            }
+            None => {
+                self.unknown_name(n);
+                None
+            }
+        }
+    }
+
     /// The leaves of data `d` (element `index` of an array, 1-based).
     pub(crate) fn data_value(&mut self, d: &Data, index: Option<u32>, span: Span) -> Val {
         if let Some(parts) = &d.inline {
@@ -576,29 +601,23 @@ impl Tr<'_> {
                 Some(Val::one(Ty::Zone, radius))
             }
             Ty::Tool => {
-                let robhold = self.value(&items[0], Ty::Bool)?.leaf();
-                if !matches!(robhold.kind, w::ExprKind::Bool(true)) {
-                    self.unsupported(
-                        "a stationary tool (robhold FALSE)",
-                        items[0].span,
-                        "hold the tool on the robot (robhold TRUE)",
-                    );
-                    return None;
-                }
+                self.robhold(
+                    &items[0],
+                    true,
+                    "a stationary tool (robhold FALSE)",
+                    "hold the tool on the robot (robhold TRUE)",
+                )?;
                 let frame = self.value(&items[1], Ty::Pose)?.leaf();
                 self.value(&items[2], Ty::Load)?;
                 Some(Val::one(Ty::Tool, frame))
             }
             Ty::Wobj => {
-                let robhold = self.value(&items[0], Ty::Bool)?.leaf();
-                if !matches!(robhold.kind, w::ExprKind::Bool(false)) {
-                    self.unsupported(
-                        "a work object held by the robot (robhold TRUE)",
-                        items[0].span,
-                        "use a fixed work object (robhold FALSE)",
-                    );
-                    return None;
-                }
+                self.robhold(
+                    &items[0],
+                    false,
+                    "a work object held by the robot (robhold TRUE)",
+                    "use a fixed work object (robhold FALSE)",
+                )?;
                 self.value(&items[1], Ty::Bool)?;
                 let mech = self.expr(&items[2])?;
                 if mech.ty != Ty::Str {
@@ -654,6 +673,16 @@ impl Tr<'_> {
             }
             Ty::Num | Ty::Bool | Ty::Str | Ty::Intnum | Ty::Syncident => None,
         }
+    }
+
+    /// A record's `robhold`, which vworks runs only as `want` (E0300 otherwise).
+    fn robhold(&mut self, e: &r::Expr, want: bool, what: &str, help: &str) -> Option<()> {
+        let v = self.value(e, Ty::Bool)?.leaf();
+        if v.kind == w::ExprKind::Bool(want) {
+            return Some(());
+        }
+        self.unsupported(what, e.span, help);
+        None
     }
 
     /// A function call in an expression: RAPID's built-in functions, or a FUNC.
@@ -1008,27 +1037,8 @@ impl Tr<'_> {
             })(),
             "dim" => (|| {
                 let (p, _) = self.split_args(f, args, 2..=2, &[], span)?;
-                let r::ExprKind::Name(n) = &p[0].kind else {
-                    self.error(Code::E0020, "Dim takes an array's name", p[0].span);
-                    return None;
-                };
-                let len = match self.lookup(&n.key()) {
-                    Some(Sym::Data(d)) => match d.len {
-                        Some(len) => len,
-                        None => {
-                            self.error(
-                                Code::E0022,
-                                format!("`{}` is not an array", n.text),
-                                n.span,
-                            );
-                            return None;
-                        }
-                    },
-                    _ => {
-                        self.unknown_name(n);
-                        return None;
-                    }
-                };
+                let (_, d) = self.data_arg(p[0], "an array", |d| d.len.is_some())?;
+                let len = d.len.unwrap_or(0);
                 if self.const_num(p[1]) != Some(1.0) {
                     self.error(
                         Code::E0025,

@@ -375,56 +375,27 @@ impl Tr<'_> {
                 });
             }
             "waitdi" | "waitdo" | "waitgi" | "waitgo" => {
-                let kinds: &[SignalKind] = match key {
-                    "waitdi" => &[SignalKind::Di],
-                    "waitdo" => digital_out,
-                    "waitgi" => &[SignalKind::Gi],
-                    _ => &[SignalKind::Go],
-                };
                 let Some((p, opts)) =
                     self.split_args(f, args, 2..=2, &["MaxTime", "TimeFlag"], span)
                 else {
                     return true;
                 };
-                let Some(g) = self.signal_arg(p[0], kinds) else {
-                    return true;
-                };
-                let Some(v) = self.value(p[1], Ty::Num) else {
-                    return true;
-                };
-                let cond = b::bin(
-                    w::BinOp::Eq,
-                    b::name(&g, p[0].span),
-                    b::call("int", vec![v.leaf()], p[1].span),
-                );
-                self.timed_wait(&f.text, cond, &opts, false, span, out);
+                if let Some(cond) = self.signal_is(key, p[0], p[1]) {
+                    self.timed_wait(&f.text, cond, &opts, false, span, out);
+                }
             }
             "isignaldi" | "isignaldo" | "isignalgi" | "isignalgo" => {
-                let kinds: &[SignalKind] = match key {
-                    "isignaldi" => &[SignalKind::Di],
-                    "isignaldo" => digital_out,
-                    "isignalgi" => &[SignalKind::Gi],
-                    _ => &[SignalKind::Go],
-                };
                 let Some((p, opts)) =
                     self.split_args(f, args, 3..=3, &["Single", "SingleSafe"], span)
                 else {
                     return true;
                 };
-                let Some(g) = self.signal_arg(p[0], kinds) else {
-                    return true;
-                };
-                let Some(v) = self.value(p[1], Ty::Num) else {
+                let Some(cond) = self.signal_is(key, p[0], p[1]) else {
                     return true;
                 };
                 let Some(trap) = self.connected(p[2]) else {
                     return true;
                 };
-                let cond = b::bin(
-                    w::BinOp::Eq,
-                    b::name(&g, p[0].span),
-                    b::call("int", vec![v.leaf()], p[1].span),
-                );
                 let single = !opts.is_empty();
                 self.enable(w::TriggerExpr::Cond(cond), &trap, single, span, out);
             }
@@ -482,25 +453,9 @@ impl Tr<'_> {
         let Some((p, _)) = self.split_args(f, args, 1..=1, &[], span) else {
             return;
         };
-        let r::ExprKind::Name(n) = &p[0].kind else {
-            self.error(Code::E0020, "GripLoad takes a loaddata's name", p[0].span);
+        let Some((n, _)) = self.data_arg(p[0], "a loaddata", |d| d.ty == Ty::Load) else {
             return;
         };
-        match self.lookup(&n.key()) {
-            Some(Sym::Data(d)) if d.ty == Ty::Load => {}
-            Some(_) => {
-                self.error(
-                    Code::E0020,
-                    format!("`{}` is not a loaddata", n.text),
-                    n.span,
-                );
-                return;
-            }
-            None => {
-                self.unknown_name(n);
-                return;
-            }
-        }
         if self.helpers.insert("_held".into()) {
             self.items.push(w::Item::Var(w::VarDecl {
                 name: b::ident("_held", Span::default()),
@@ -549,31 +504,22 @@ impl Tr<'_> {
         }));
     }
 
+    /// `signal == int(value)` for the wait or interrupt instruction `key`, whose last two
+    /// letters are the signal's kind (`WaitDI`, `ISignalGO`).
+    fn signal_is(&mut self, key: &str, signal: &r::Expr, value: &r::Expr) -> Option<w::Expr> {
+        let kind = SignalKind::from_name(&key[key.len().saturating_sub(2)..])?;
+        let g = self.signal_arg(signal, &[kind])?;
+        let v = self.value(value, Ty::Num)?;
+        Some(b::bin(
+            w::BinOp::Eq,
+            b::name(&g, signal.span),
+            b::call("int", vec![v.leaf()], value.span),
+        ))
+    }
+
     /// The TRAP an interrupt variable is connected to.
     fn connected(&mut self, e: &r::Expr) -> Option<Sig> {
-        let r::ExprKind::Name(n) = &e.kind else {
-            self.error(
-                Code::E0020,
-                "expected an interrupt variable (intnum)",
-                e.span,
-            );
-            return None;
-        };
-        match self.lookup(&n.key()) {
-            Some(Sym::Data(d)) if d.ty == Ty::Intnum => {}
-            Some(_) => {
-                self.error(
-                    Code::E0020,
-                    format!("`{}` is not an intnum", n.text),
-                    n.span,
-                );
-                return None;
-            }
-            None => {
-                self.unknown_name(n);
-                return None;
-            }
-        }
+        let (n, _) = self.data_arg(e, "an interrupt variable (intnum)", |d| d.ty == Ty::Intnum)?;
         match self.connects.get(&n.key()) {
             Some(s) => Some(s.clone()),
             None => {

@@ -952,56 +952,16 @@ impl Tr<'_> {
         let Some((p, opts)) = self.split_args(f, args, 2..=2, &["InPos", "TimeOut"], span) else {
             return;
         };
-        let sync = match &p[0].kind {
-            r::ExprKind::Name(n) => match self.lookup(&n.key()) {
-                Some(Sym::Data(d)) if d.ty == Ty::Syncident && !d.local => d,
-                Some(_) => {
-                    self.error(
-                        Code::E0020,
-                        format!("`{}` is not a syncident declared at module level", n.text),
-                        n.span,
-                    );
-                    return;
-                }
-                None => {
-                    self.unknown_name(n);
-                    return;
-                }
-            },
-            _ => {
-                self.error(
-                    Code::E0020,
-                    "WaitSyncTask's first argument is a syncident's name",
-                    p[0].span,
-                );
-                return;
-            }
+        let Some((_, sync)) = self.data_arg(p[0], "a syncident declared at module level", |d| {
+            d.ty == Ty::Syncident && !d.local
+        }) else {
+            return;
         };
-        let tasks = match &p[1].kind {
-            r::ExprKind::Name(n) => match self.lookup(&n.key()) {
-                Some(Sym::Data(d)) if d.ty == Ty::Tasks => d.len.unwrap_or(1),
-                Some(_) => {
-                    self.error(
-                        Code::E0020,
-                        format!("`{}` is not a task list (`tasks`)", n.text),
-                        n.span,
-                    );
-                    return;
-                }
-                None => {
-                    self.unknown_name(n);
-                    return;
-                }
-            },
-            _ => {
-                self.error(
-                    Code::E0020,
-                    "WaitSyncTask's second argument is a task list's name",
-                    p[1].span,
-                );
-                return;
-            }
+        let Some((_, list)) = self.data_arg(p[1], "a task list (`tasks`)", |d| d.ty == Ty::Tasks)
+        else {
+            return;
         };
+        let tasks = list.len.unwrap_or(1);
         let mut timeout = None;
         for (k, n, v) in &opts {
             if k == "timeout" {
