@@ -143,6 +143,26 @@ def test_compile_rapid_errors_name_the_rapid_line():
     assert "SearchL" in first.message
 
 
+def test_compile_files_makes_one_program_of_a_tasks_modules():
+    main = "MODULE MainMod\n  PERS num nParts := 0;\n  PROC main()\n    Pick;\n  ENDPROC\nENDMODULE\n"
+    tools = "MODULE Tools\n  PROC Pick()\n    WaitTime 0.5;\n    Incr nParts;\n  ENDPROC\nENDMODULE\n"
+    m = vworks.compile_files([("main.mod", main), ("tools.mod", tools)])
+    assert m.path == "main.mod" and m.files == ["main.mod", "tools.mod"]
+    assert m.procs == ["main", "pick"] and m.globals == ["nparts"]
+    listing = m.disasm()
+    assert "; tools.mod:3:5" in listing and "| WaitTime 0.5;" in listing
+    # Alone, the main module misses Pick; an error in the second file names it.
+    with pytest.raises(vworks.CompileError):
+        vworks.compile(main, "main.mod")
+    with pytest.raises(vworks.CompileError) as info:
+        vworks.compile_files([("main.mod", main), ("tools.mod", tools.replace("nParts", "nPart"))])
+    first = info.value.diagnostics[0]
+    assert (first.code, first.file, first.line, first.col) == ("E0010", "tools.mod", 4, 10)
+    assert "tools.mod:4:10" in first.rendered
+    with pytest.raises(ValueError, match="at least one"):
+        vworks.compile_files([])
+
+
 def test_a_rapid_cell_runs_from_python():
     r = vworks.load_cell(str(ROOT / "workcells/rapid_handoff/cell.toml")).run()
     assert r.outcome == "completed"

@@ -94,7 +94,8 @@ struct RobotFile {
     package_path: Vec<String>,
     base: Option<PoseFile>,
     tool: Option<PoseFile>,
-    program: Option<String>,
+    /// One file, or a list of files (a RAPID task's modules).
+    program: Option<toml::Value>,
     entry: Option<String>,
     serve_only: Option<bool>,
     default_speed: Option<toml::Value>,
@@ -160,7 +161,8 @@ pub struct Robot {
     pub tool: Iso,
     /// Its compiled program.
     pub module: Arc<Module>,
-    /// The program file.
+    /// The program file (the first, for a program of several files: the module's
+    /// `files` lists them all, and positions name their own).
     pub program: String,
     /// Entry procedure (`None`: serve-only).
     pub entry: Option<u32>,
@@ -534,6 +536,74 @@ fn with_suggestion(msg: &str) -> String {
 /// typo (a unit missing), and would break the collision geometry's arithmetic.
 const MAX_LENGTH: f64 = 1e4;
 
+/// The program files of robot `key` (`program`: one path, or a list of paths to files of
+/// one language), each joined to the workcell's folder `dir`.
+fn program_files(
+    cx: &Ctx<'_>,
+    key: &str,
+    program: &toml::Value,
+    dir: &Path,
+) -> Result<Vec<String>, CellError> {
+    let at = format!("{key}.program");
+    let how = "write one file (`program = \"r1.wsl\"`) or a list of files of one language (`program = [\"main.mod\", \"tools.mod\"]`)";
+    let names: Vec<&str> = match program {
+        toml::Value::String(s) => vec![s.as_str()],
+        toml::Value::Array(list) if !list.is_empty() => {
+            let mut names = Vec::with_capacity(list.len());
+            for (k, v) in list.iter().enumerate() {
+                let Some(s) = v.as_str() else {
+                    return Err(cx.bad(
+                        &format!("{at}[{k}]"),
+                        format!("`{v}` is not a file name; {how}"),
+                    ));
+                };
+                names.push(s);
+            }
+            names
+        }
+        toml::Value::Array(_) => {
+            return Err(cx.bad(&at, format!("lists no files; {how}")));
+        }
+        v => return Err(cx.bad(&at, format!("`{v}` is not a file name; {how}"))),
+    };
+    let paths: Vec<String> = names
+        .iter()
+        .map(|n| dir.join(n).display().to_string())
+        .collect();
+    let language = vworks_wslc::Language::of_path(&paths[0]);
+    // The same file however it is written (`main.mod`, `./main.mod`).
+    let same: Vec<PathBuf> = names
+        .iter()
+        .map(|n| {
+            Path::new(n)
+                .components()
+                .filter(|c| !matches!(c, std::path::Component::CurDir))
+                .collect()
+        })
+        .collect();
+    for (k, p) in paths.iter().enumerate().skip(1) {
+        if same[..k].contains(&same[k]) {
+            return Err(cx.bad(
+                &format!("{at}[{k}]"),
+                format!("lists `{}` a second time; name each file once", names[k]),
+            ));
+        }
+        if vworks_wslc::Language::of_path(p) != language {
+            return Err(cx.bad(
+                &format!("{at}[{k}]"),
+                format!(
+                    "`{}` is {} but `{}` is {}: a robot's program files are all in one language (give a robot of each language its own program)",
+                    names[k],
+                    vworks_wslc::Language::of_path(p).name(),
+                    names[0],
+                    language.name()
+                ),
+            ));
+        }
+    }
+    Ok(paths)
+}
+
 /// What to do about a file that cannot be read.
 fn read_hint(e: &std::io::Error) -> &'static str {
     match e.kind() {
@@ -722,8 +792,8 @@ fn load_parsed(
                 "every robot needs a program file (`program = \"r1.wsl\"`)",
             ));
         };
-        let ppath = dir.join(program);
-        let pname = ppath.display().to_string();
+        let pnames = program_files(&cx, &key, program, &dir)?;
+        let pname = pnames[0].clone();
         let language = vworks_wslc::Language::of_path(&pname);
         // A RAPID program is compiled with its robot's wired signals: robots that share a
         // file but not their signals get a copy each.
@@ -731,9 +801,10 @@ fn load_parsed(
             (Some(w), vworks_wslc::Language::Rapid) => w.get(i).map(Vec::as_slice),
             _ => None,
         };
+        let files_key = pnames.join("\u{1}");
         let mkey = match signals {
-            Some(s) => format!("{pname}\u{0}{s:?}"),
-            None => pname.clone(),
+            Some(s) => format!("{files_key}\u{0}{s:?}"),
+            None => files_key,
         };
         let module = match modules.iter().find(|(p, _)| *p == mkey) {
             Some((_, m)) => Arc::clone(m),
@@ -741,35 +812,46 @@ fn load_parsed(
                 let compiled = match cache.program(&mkey) {
                     Some(c) => c,
                     None => {
-                        let bytes = fs.read(&ppath).map_err(|e| {
-                            cx.bad(
-                                &format!("{key}.program"),
-                                format!("cannot read `{pname}`: {e}{}", read_hint(&e)),
-                            )
-                        })?;
-                        let src = vworks_wslc::source_text(bytes).map_err(|e| {
-                            cx.bad(&format!("{key}.program"), format!("{pname}: {e}"))
-                        })?;
+                        let mut texts = Vec::with_capacity(pnames.len());
+                        for (k, name) in pnames.iter().enumerate() {
+                            let at = if pnames.len() > 1 {
+                                format!("{key}.program[{k}]")
+                            } else {
+                                format!("{key}.program")
+                            };
+                            let bytes = fs.read(Path::new(name)).map_err(|e| {
+                                cx.bad(&at, format!("cannot read `{name}`: {e}{}", read_hint(&e)))
+                            })?;
+                            let src = vworks_wslc::source_text(bytes)
+                                .map_err(|e| cx.bad(&at, format!("{name}: {e}")))?;
+                            texts.push((name.clone(), src));
+                        }
+                        let files: Vec<(&str, &str)> = texts
+                            .iter()
+                            .map(|(p, t)| (p.as_str(), t.as_str()))
+                            .collect();
                         let result = match language {
                             vworks_wslc::Language::Rapid => {
-                                vworks_wslc::rapid::compile_with_io(&pname, &src, signals)
+                                vworks_wslc::rapid::compile_files(&files, signals)
                             }
-                            vworks_wslc::Language::Wsl => vworks_wslc::compile(&pname, &src),
+                            vworks_wslc::Language::Wsl => vworks_wslc::compile_files(&files),
                         }
                         .map(|out| (Arc::new(out.module), out.warnings))
                         .map_err(|e| e.diagnostics);
                         cache.keep_program(
                             &mkey,
                             Compiled {
-                                source: src,
+                                sources: texts,
                                 result,
                             },
                         )
                     }
                 };
-                render_sources.add(&pname, &compiled.source);
-                if !sources.iter().any(|(p, _)| *p == pname) {
-                    sources.push((pname.clone(), compiled.source.clone()));
+                for (path, text) in &compiled.sources {
+                    render_sources.add(path, text);
+                    if !sources.iter().any(|(p, _)| p == path) {
+                        sources.push((path.clone(), text.clone()));
+                    }
                 }
                 match &compiled.result {
                     Ok((m, w)) => {

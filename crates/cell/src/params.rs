@@ -75,7 +75,7 @@ pub(crate) fn apply(
     };
     if let Some(same) = copies
         .iter()
-        .find(|c| c.source_path == patched.source_path && c.vars == patched.vars)
+        .find(|c| c.files == patched.files && c.vars == patched.vars)
     {
         return Ok(Arc::clone(same));
     }

@@ -17,10 +17,10 @@ use vworks_wslc::Diagnostic;
 
 use crate::{Cell, CellError, CellFile, Files, load_parsed, read_cell_file};
 
-/// A program compiled for the cache: its source and the module with its warnings, or
-/// its diagnostics.
+/// A program compiled for the cache: its source files (path, text) and the module with
+/// its warnings, or its diagnostics.
 pub(crate) struct Compiled {
-    pub(crate) source: String,
+    pub(crate) sources: Vec<(String, String)>,
     pub(crate) result: Result<(Arc<Module>, Vec<Diagnostic>), Vec<Diagnostic>>,
 }
 

@@ -21,7 +21,7 @@ mod sweep;
 use vworks_se::result::issue_json as json_issue;
 use vworks_vm::Module;
 use vworks_vm::bytecode::disassemble;
-use vworks_wslc::{Language, Sources, compile_as, render};
+use vworks_wslc::{Language, Sources, compile_files_as, render};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -41,22 +41,28 @@ struct Cli {
 enum Command {
     /// Compile programs and report every problem found (exit 1 if any is an error).
     Check {
-        /// The .wsl files.
+        /// The program files (.wsl, or RAPID .mod/.modx/.sys/.prg).
         #[arg(required = true)]
         files: Vec<PathBuf>,
+        /// Check the files as one robot's program (a RAPID task's modules, a WSL program
+        /// and its library files) instead of each on its own.
+        #[arg(long)]
+        task: bool,
     },
-    /// Compile one program to a bytecode file.
+    /// Compile one program (one file, or the files of one robot task) to a bytecode file.
     Build {
-        /// The .wsl file.
-        file: PathBuf,
-        /// Output file (default: the input with extension .wslb).
+        /// The program's files, in order (.wsl, or RAPID .mod/.modx/.sys/.prg).
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// Output file (default: the first file with extension .wslb).
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
-    /// List the bytecode of a .wslb file (or compile a .wsl file and list it).
+    /// List the bytecode of a .wslb file (or compile a program's files and list it).
     Disasm {
-        /// A .wslb or .wsl file.
-        file: PathBuf,
+        /// A .wslb file, or a program's files.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
     },
     /// Simulate a workcell and print a summary (exit 1 on collision stop, deadlock or error).
     Run {
@@ -198,12 +204,37 @@ fn display(path: &Path) -> String {
 }
 
 /// Compiles one file, printing its diagnostics; `None` if it had errors.
-fn compile_file(path: &Path, color: bool) -> Result<(Option<Module>, usize, usize), String> {
-    let src = read(path)?;
-    let name = display(path);
+/// Compiles the files of one program (one file, or a robot task's files in order),
+/// printing its diagnostics: the module if it compiled, and the counts of errors and
+/// warnings.
+fn compile_program(
+    paths: &[PathBuf],
+    color: bool,
+) -> Result<(Option<Module>, usize, usize), String> {
+    let mut texts = Vec::with_capacity(paths.len());
+    for p in paths {
+        texts.push((display(p), read(p)?));
+    }
+    let Some((first, _)) = texts.first() else {
+        return Err("name at least one program file".into());
+    };
+    let language = Language::of_path(first);
+    if let Some((other, _)) = texts.iter().find(|(p, _)| Language::of_path(p) != language) {
+        return Err(format!(
+            "`{other}` is {} but `{first}` is {}: one program's files are all in one language",
+            Language::of_path(other).name(),
+            language.name()
+        ));
+    }
     let mut sources = Sources::new();
-    sources.add(&name, &src);
-    match compile_as(Language::of_path(&name), &name, &src) {
+    for (name, src) in &texts {
+        sources.add(name, src);
+    }
+    let files: Vec<(&str, &str)> = texts
+        .iter()
+        .map(|(p, t)| (p.as_str(), t.as_str()))
+        .collect();
+    match compile_files_as(language, &files) {
         Ok(out) => {
             eprint!("{}", render(&out.warnings, &sources, color));
             Ok((Some(out.module), 0, out.warnings.len()))
@@ -750,10 +781,15 @@ fn plural(n: usize, word: &str) -> String {
 
 fn run(cmd: Command, color: bool) -> Result<ExitCode, String> {
     match cmd {
-        Command::Check { files } => {
+        Command::Check { files, task } => {
             let (mut errors, mut warnings) = (0, 0);
-            for f in &files {
-                let (_, e, w) = compile_file(f, color)?;
+            let programs: Vec<&[PathBuf]> = if task {
+                vec![&files]
+            } else {
+                files.chunks(1).collect()
+            };
+            for program in programs {
+                let (_, e, w) = compile_program(program, color)?;
                 errors += e;
                 warnings += w;
             }
@@ -769,13 +805,14 @@ fn run(cmd: Command, color: bool) -> Result<ExitCode, String> {
                 ExitCode::SUCCESS
             })
         }
-        Command::Build { file, output } => {
-            let (module, errors, _) = compile_file(&file, color)?;
+        Command::Build { files, output } => {
+            let (module, errors, _) = compile_program(&files, color)?;
+            let first = &files[0];
             let Some(module) = module else {
-                eprintln!("{} not built: {}", display(&file), plural(errors, "error"));
+                eprintln!("{} not built: {}", display(first), plural(errors, "error"));
                 return Ok(ExitCode::FAILURE);
             };
-            let out = output.unwrap_or_else(|| file.with_extension("wslb"));
+            let out = output.unwrap_or_else(|| first.with_extension("wslb"));
             let bytes = module.encode();
             std::fs::write(&out, &bytes)
                 .map_err(|e| format!("cannot write `{}`: {e}", out.display()))?;
@@ -822,31 +859,49 @@ fn run(cmd: Command, color: bool) -> Result<ExitCode, String> {
             out!("{}", String::from_utf8_lossy(&buf).trim_end());
             Ok(ExitCode::SUCCESS)
         }
-        Command::Disasm { file } => {
-            let bytes = std::fs::read(&file).map_err(|e| cannot_read(&file, &e))?;
-            let (module, source) = if bytes.starts_with(&vworks_vm::bytecode::MAGIC) {
+        Command::Disasm { files } => {
+            let file = &files[0];
+            let bytes = std::fs::read(file).map_err(|e| cannot_read(file, &e))?;
+            let (module, sources) = if bytes.starts_with(&vworks_vm::bytecode::MAGIC) {
+                if files.len() > 1 {
+                    return Err(format!(
+                        "{} is a bytecode file: list it alone (`vworks disasm {}`)",
+                        file.display(),
+                        file.display()
+                    ));
+                }
                 let m = Module::decode(&bytes).map_err(|e| {
                     format!(
                         "{}: {e}; the file is damaged or from another vworks version: build it again with `vworks build PROGRAM.wsl`",
                         file.display()
                     )
                 })?;
-                // The source beside the listing, if it is where the module says.
-                let near = file
-                    .parent()
-                    .map(|d| d.join(Path::new(&m.source_path).file_name().unwrap_or_default()));
-                let src = std::fs::read_to_string(&m.source_path)
-                    .ok()
-                    .or_else(|| near.and_then(|p| std::fs::read_to_string(p).ok()));
-                (m, src)
+                // The sources beside the listing, if they are where the module says or
+                // beside the bytecode file.
+                let sources: Vec<String> = m
+                    .files
+                    .iter()
+                    .map(|f| {
+                        let near = file
+                            .parent()
+                            .map(|d| d.join(Path::new(f).file_name().unwrap_or_default()));
+                        std::fs::read_to_string(f)
+                            .ok()
+                            .or_else(|| near.and_then(|p| std::fs::read_to_string(p).ok()))
+                            .unwrap_or_default()
+                    })
+                    .collect();
+                (m, sources)
             } else {
-                let (m, _, _) = compile_file(&file, color)?;
+                let (m, _, _) = compile_program(&files, color)?;
                 let Some(m) = m else {
                     return Ok(ExitCode::FAILURE);
                 };
-                (m, read(&file).ok())
+                let sources = files.iter().map(|f| read(f).unwrap_or_default()).collect();
+                (m, sources)
             };
-            let listing = disassemble(&module, source.as_deref());
+            let texts: Vec<&str> = sources.iter().map(String::as_str).collect();
+            let listing = disassemble(&module, &texts);
             out!("{}", listing.trim_end_matches('\n'));
             Ok(ExitCode::SUCCESS)
         }

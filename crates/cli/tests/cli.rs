@@ -94,6 +94,57 @@ fn build_then_disasm_shows_source_beside_code() {
 }
 
 #[test]
+fn a_task_of_several_rapid_modules_is_checked_built_and_listed_as_one_program() {
+    let d = temp_dir("task");
+    let main = d.join("main.mod");
+    let tools = d.join("tools.mod");
+    std::fs::write(
+        &main,
+        "MODULE MainMod\n  PERS num nParts := 0;\n  PROC main()\n    Pick;\n  ENDPROC\nENDMODULE\n",
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    std::fs::write(
+        &tools,
+        "MODULE Tools\n  PROC Pick()\n    WaitTime 0.5;\n    Incr nParts;\n  ENDPROC\nENDMODULE\n",
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let (m, t) = (
+        main.to_str().unwrap_or_default(),
+        tools.to_str().unwrap_or_default(),
+    );
+    // One by one, each module misses the other's names.
+    let out = vworks(&["check", m, t]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = text(&out.stderr);
+    assert!(
+        err.contains("unknown instruction or procedure `Pick`"),
+        "{err}"
+    );
+    assert!(err.contains("unknown name `nParts`"), "{err}");
+    // As one task they compile.
+    let out = vworks(&["check", "--task", m, t]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert!(text(&out.stderr).contains("checked 2 files: 0 errors, 0 warnings"));
+    // Built into one module whose listing names each file's lines.
+    let wslb = d.join("task.wslb");
+    let out = vworks(&["build", m, t, "-o", wslb.to_str().unwrap_or_default()]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let out = vworks(&["disasm", wslb.to_str().unwrap_or_default()]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let listing = text(&out.stdout);
+    assert!(listing.contains("; tools.mod:3:5"), "{listing}");
+    assert!(listing.contains("| WaitTime 0.5;"), "{listing}");
+    assert!(listing.contains("; main.mod:4:5"), "{listing}");
+    assert!(listing.contains("| Pick;"), "{listing}");
+    let out = vworks(&["disasm", m, t]);
+    assert_eq!(text(&out.stdout), listing);
+    // A bytecode file is listed alone.
+    let out = vworks(&["disasm", wslb.to_str().unwrap_or_default(), t]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out.stderr).contains("list it alone"));
+}
+
+#[test]
 fn bad_inputs_are_errors_with_the_file_named() {
     let d = temp_dir("bad");
     let missing = d.join("missing.wsl");
@@ -107,7 +158,7 @@ fn bad_inputs_are_errors_with_the_file_named() {
     assert!(text(&out.stderr).contains("missing.wsl"));
 
     let corrupt = d.join("corrupt.wslb");
-    std::fs::write(&corrupt, b"WSLB\x02\x00\x00\x00garbage").unwrap_or_else(|e| panic!("{e}"));
+    std::fs::write(&corrupt, b"WSLB\x03\x00\x00\x00garbage").unwrap_or_else(|e| panic!("{e}"));
     let out = vworks(&["disasm", corrupt.to_str().unwrap_or_default()]);
     assert_eq!(out.status.code(), Some(1));
     let err = text(&out.stderr);

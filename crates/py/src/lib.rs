@@ -20,9 +20,11 @@ use pyo3::types::{PyDict, PyList, PySlice};
 use vworks_cell::CellError as WorkcellError;
 use vworks_se::engine::{Issue, Outcome, RunResult, TraceEvent, Value};
 use vworks_se::mcaplog::{LoggedEvent, McapLog};
-use vworks_wslc::Diagnostic as WslDiagnostic;
 
+mod program;
 mod sweep;
+
+use program::{Diagnostic, Module, compile, compile_files, diagnostic, program_error};
 
 create_exception!(
     vworks,
@@ -69,181 +71,6 @@ fn to_ns(seconds: f64, what: &str) -> PyResult<i64> {
         )));
     }
     Ok((seconds * NS).round() as i64)
-}
-
-/// One compiler or linker diagnostic.
-#[pyclass(frozen, module = "vworks", get_all)]
-#[derive(Clone)]
-struct Diagnostic {
-    /// Stable code, e.g. `E0012` or `W0003`.
-    code: String,
-    /// `error` or `warning`.
-    severity: String,
-    /// What is wrong, in a sentence.
-    message: String,
-    /// The file.
-    file: String,
-    /// 1-based line (0 if unknown).
-    line: u32,
-    /// 1-based column (0 if unknown).
-    col: u32,
-    /// What to do about it, if known.
-    help: Option<String>,
-    /// The diagnostic rendered with its source line and a caret, as `vworks check` prints it.
-    rendered: String,
-}
-
-#[pymethods]
-impl Diagnostic {
-    fn __repr__(&self) -> String {
-        format!(
-            "<Diagnostic {} {}:{}:{}: {}>",
-            self.code, self.file, self.line, self.col, self.message
-        )
-    }
-
-    fn __str__(&self) -> String {
-        self.rendered.clone()
-    }
-}
-
-fn diagnostic(d: &WslDiagnostic, sources: &vworks_wslc::Sources) -> Diagnostic {
-    Diagnostic {
-        code: d.code.as_str().to_string(),
-        severity: if d.is_error() { "error" } else { "warning" }.to_string(),
-        message: d.message.clone(),
-        file: d.at.file.clone(),
-        line: d.at.line,
-        col: d.at.col,
-        help: d.help.clone(),
-        rendered: vworks_wslc::render(std::slice::from_ref(d), sources, false),
-    }
-}
-
-/// A `CompileError`/`LinkError` carrying `.diagnostics`.
-fn program_error(
-    py: Python<'_>,
-    link: bool,
-    message: String,
-    diagnostics: Vec<Diagnostic>,
-) -> PyErr {
-    let err = if link {
-        LinkError::new_err(message)
-    } else {
-        CompileError::new_err(message)
-    };
-    let set =
-        PyList::new(py, diagnostics).and_then(|list| err.value(py).setattr("diagnostics", list));
-    match set {
-        Ok(()) => err,
-        Err(e) => e,
-    }
-}
-
-/// A compiled WSL module.
-#[pyclass(frozen, module = "vworks")]
-struct Module {
-    module: vworks_vm::Module,
-    source: String,
-    warnings: Vec<Diagnostic>,
-}
-
-#[pymethods]
-impl Module {
-    /// The file name given to `compile`.
-    #[getter]
-    fn path(&self) -> String {
-        self.module.source_path.clone()
-    }
-
-    /// The module's globals, by name, in declaration order.
-    #[getter]
-    fn globals(&self) -> Vec<String> {
-        let m = &self.module;
-        m.globals
-            .iter()
-            .map(|g| m.str(g.name).to_string())
-            .collect()
-    }
-
-    /// The module's procedures (`proc`) and functions (`func`), by name, in order.
-    #[getter]
-    fn procs(&self) -> Vec<String> {
-        use vworks_vm::bytecode::ProcKind;
-        let m = &self.module;
-        m.procs
-            .iter()
-            .filter(|p| matches!(p.kind, ProcKind::Proc | ProcKind::Func))
-            .map(|p| m.str(p.name).to_string())
-            .collect()
-    }
-
-    /// The compiler's warnings (`Diagnostic`s; errors raise `CompileError` instead).
-    #[getter]
-    fn warnings(&self) -> Vec<Diagnostic> {
-        self.warnings.clone()
-    }
-
-    /// The bytecode, one instruction per line, with the source line beside it (as
-    /// `vworks disasm`).
-    fn disasm(&self) -> String {
-        vworks_vm::bytecode::disassemble(&self.module, Some(&self.source))
-    }
-
-    /// The encoded bytecode (`.wslb`), as `vworks build` writes it.
-    fn to_bytes(&self) -> Vec<u8> {
-        self.module.encode()
-    }
-
-    fn __repr__(&self) -> String {
-        format!("<Module {}>", self.module.source_path)
-    }
-}
-
-/// Compiles `source`, WSL or ABB RAPID; `path` names the file in diagnostics. The
-/// language is `language` (`"wsl"` or `"rapid"`), or else `path`'s extension decides
-/// (`.mod`, `.modx`, `.sys`, `.sysx`, `.prg` are RAPID). Raises `CompileError` (with
-/// `.diagnostics`) if it does not compile, `ValueError` for an unknown language.
-#[pyfunction]
-#[pyo3(signature = (source, path = None, language = None))]
-fn compile(
-    py: Python<'_>,
-    source: &str,
-    path: Option<&str>,
-    language: Option<&str>,
-) -> PyResult<Module> {
-    let lang = match language.map(str::to_ascii_lowercase).as_deref() {
-        None => path.map_or(vworks_wslc::Language::Wsl, vworks_wslc::Language::of_path),
-        Some("wsl") => vworks_wslc::Language::Wsl,
-        Some("rapid") => vworks_wslc::Language::Rapid,
-        Some(other) => {
-            return Err(PyValueError::new_err(format!(
-                "unknown language {other:?}: use \"wsl\" or \"rapid\""
-            )));
-        }
-    };
-    let path = path.unwrap_or(match lang {
-        vworks_wslc::Language::Rapid => "x.mod",
-        vworks_wslc::Language::Wsl => "x.wsl",
-    });
-    let mut sources = vworks_wslc::Sources::new();
-    sources.add(path, source);
-    match vworks_wslc::compile_as(lang, path, source) {
-        Ok(c) => Ok(Module {
-            warnings: c.warnings.iter().map(|d| diagnostic(d, &sources)).collect(),
-            module: c.module,
-            source: source.to_string(),
-        }),
-        Err(e) => {
-            let diags: Vec<Diagnostic> = e
-                .diagnostics
-                .iter()
-                .map(|d| diagnostic(d, &sources))
-                .collect();
-            let message = vworks_wslc::render(&e.diagnostics, &sources, false);
-            Err(program_error(py, false, message, diags))
-        }
-    }
 }
 
 /// A loaded workcell: robots with their models and compiled, linked programs; devices;
@@ -1143,6 +970,7 @@ fn _vworks(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_function(wrap_pyfunction!(compile, m)?)?;
+    m.add_function(wrap_pyfunction!(compile_files, m)?)?;
     m.add_function(wrap_pyfunction!(load_cell, m)?)?;
     m.add_function(wrap_pyfunction!(read_log, m)?)?;
     m.add_function(wrap_pyfunction!(write_report, m)?)?;

@@ -728,12 +728,13 @@ impl Data {
 }
 
 impl TraceEvent {
-    /// The program file the source position refers to (the robot's program).
+    /// The program file the source position refers to (the robot's program file that
+    /// holds it).
     pub fn file<'c>(&self, cell: &'c Cell) -> Option<&'c str> {
-        self.pos?;
+        let pos = self.pos?;
         self.robot
             .and_then(|r| cell.robots.get(r))
-            .map(|r| r.program.as_str())
+            .map(|r| r.module.file_of(pos))
     }
 
     /// The details as trace lines show them (empty when there are none).

@@ -9,7 +9,7 @@ use vworks_vm::{ConstValue, Module, Type};
 
 fn module(code: Vec<Instr>, kind: ProcKind, ret: Option<Type>, frame: u32) -> Module {
     Module {
-        source_path: "hand.wsl".into(),
+        files: vec!["hand.wsl".into()],
         strings: vec!["p".into()],
         procs: vec![ProcInfo {
             name: 0,
@@ -19,7 +19,11 @@ fn module(code: Vec<Instr>, kind: ProcKind, ret: Option<Type>, frame: u32) -> Mo
             frame_slots: frame,
             code_start: 0,
             code_len: code.len() as u32,
-            pos: SrcPos { line: 1, col: 1 },
+            pos: SrcPos {
+                file: 0,
+                line: 1,
+                col: 1,
+            },
             max_stack: 0,
         }],
         code,

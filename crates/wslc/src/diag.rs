@@ -261,20 +261,6 @@ impl Diagnostic {
         self
     }
 
-    /// Fills in file, line and column of every location that has only a span.
-    pub(crate) fn resolve(&mut self, file: &str, index: &LineIndex) {
-        for loc in std::iter::once(&mut self.at).chain(self.related.iter_mut().map(|n| &mut n.at)) {
-            if loc.file.is_empty() {
-                loc.file = file.to_string();
-            }
-            if let (Some(span), 0) = (loc.span, loc.line) {
-                let (l, c) = index.line_col(span.start as usize);
-                loc.line = l;
-                loc.col = c;
-            }
-        }
-    }
-
     /// `file:line:col: error[E0021]: message` — one line, for logs and tests.
     pub fn short(&self) -> String {
         let sev = match self.severity() {

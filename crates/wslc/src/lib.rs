@@ -24,6 +24,7 @@ pub mod lexer;
 pub mod link;
 mod lower;
 pub mod parser;
+mod program;
 pub mod rapid;
 pub mod syntax;
 pub mod units;
@@ -115,11 +116,42 @@ pub fn source_text(bytes: Vec<u8>) -> Result<String, NotUtf8> {
 
 /// Compiles one module. `path` names the file in diagnostics and in the module.
 pub fn compile(path: &str, source: &str) -> Result<Compiled, CompileError> {
+    compile_files(&[(path, source)])
+}
+
+/// Compiles a WSL program of several files ((path, text), in order) into one module, as
+/// if their declarations were written one after another in one file: a robot's main
+/// file with the library files it uses. Each file is lexed and parsed on its own;
+/// positions and diagnostics name their own file.
+pub fn compile_files(files: &[(&str, &str)]) -> Result<Compiled, CompileError> {
+    let program = program::ProgramText::new(files);
     let mut diags = Vec::new();
-    let toks = lexer::lex(source, &mut diags);
-    let ast = parser::parse(source, toks, &mut diags);
+    let mut ast = syntax::SourceModule { items: Vec::new() };
+    for (_, start, text) in program.files() {
+        let first_new = diags.len();
+        let mut toks = lexer::lex(text, &mut diags);
+        for t in &mut toks {
+            t.span = t.span.shifted(start);
+        }
+        shift_diagnostics(&mut diags[first_new..], start);
+        ast.items
+            .extend(parser::parse(program.text(), toks, &mut diags).items);
+    }
     let syntax_ok = !diags.iter().any(Diagnostic::is_error);
-    finish(path, source, syntax_ok.then_some(&ast), diags)
+    finish(&program, syntax_ok.then_some(&ast), diags)
+}
+
+/// Moves the spans of diagnostics made on one file's text by `by` bytes: onto the joined
+/// text of a program of several files.
+pub(crate) fn shift_diagnostics(diags: &mut [Diagnostic], by: usize) {
+    for d in diags {
+        let places = std::iter::once(&mut d.at).chain(d.related.iter_mut().map(|n| &mut n.at));
+        for loc in places {
+            if let Some(s) = loc.span.as_mut() {
+                *s = s.shifted(by);
+            }
+        }
+    }
 }
 
 /// The language of a program file, from its extension: RAPID for `.mod`, `.modx`, `.sys`,
@@ -141,28 +173,44 @@ impl Language {
             Language::Wsl
         }
     }
+
+    /// Its name as messages give it: `WSL` or `RAPID`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Language::Wsl => "WSL",
+            Language::Rapid => "RAPID",
+        }
+    }
 }
 
 /// Compiles a program in the given language.
 pub fn compile_as(language: Language, path: &str, source: &str) -> Result<Compiled, CompileError> {
+    compile_files_as(language, &[(path, source)])
+}
+
+/// Compiles a program of several files ((path, text), in order) in `language`: a RAPID
+/// task's modules ([`rapid::compile_files`]) or a WSL program's files ([`compile_files`]).
+pub fn compile_files_as(
+    language: Language,
+    files: &[(&str, &str)],
+) -> Result<Compiled, CompileError> {
     match language {
-        Language::Wsl => compile(path, source),
-        Language::Rapid => rapid::compile(path, source),
+        Language::Wsl => compile_files(files),
+        Language::Rapid => rapid::compile_files(files, None),
     }
 }
 
 /// Checks and generates code for a syntax tree (if the front-end produced one), verifies
 /// the module, and resolves and sorts the diagnostics.
 pub(crate) fn finish(
-    path: &str,
-    source: &str,
+    program: &program::ProgramText,
     ast: Option<&syntax::SourceModule>,
     mut diags: Vec<Diagnostic>,
 ) -> Result<Compiled, CompileError> {
     let mut module = if !diags.iter().any(Diagnostic::is_error)
         && let Some(ast) = ast
     {
-        Some(lower::lower(path, source, ast, &mut diags))
+        Some(lower::lower(program, ast, &mut diags))
     } else {
         None
     };
@@ -181,11 +229,10 @@ pub(crate) fn finish(
             ),
         );
     }
-    let index = diag::LineIndex::new(source);
     for d in &mut diags {
-        d.resolve(path, &index);
+        program.resolve(d);
     }
-    diags.sort_by_key(|d| (d.at.line, d.at.col));
+    diags.sort_by_key(|d| (program.order_of(&d.at.file), d.at.line, d.at.col));
     match module {
         Some(module) if !diags.iter().any(Diagnostic::is_error) => Ok(Compiled {
             module,

@@ -105,7 +105,7 @@ pub struct LinkError {
 }
 
 fn at(m: &Module, code: Code, msg: String, pos: SrcPos) -> Diagnostic {
-    Diagnostic::at_pos(code, msg, &m.source_path, pos.line, pos.col)
+    Diagnostic::at_pos(code, msg, m.file_of(pos), pos.line, pos.col)
 }
 
 fn compatible(arg: Type, param: Type) -> bool {
@@ -152,7 +152,7 @@ pub fn link(cell: &CellSpec<'_>) -> Result<Linked, LinkError> {
     }
     let mut globals = Vec::new();
     for (name, mut list) in decls {
-        list.sort_by(|a, b| a.0.source_path.cmp(&b.0.source_path));
+        list.sort_by(|a, b| a.0.source_path().cmp(b.0.source_path()));
         let (m0, g0) = list[0];
         let first = &m0.globals[g0];
         for (m, gi) in &list[1..] {
@@ -160,14 +160,16 @@ pub fn link(cell: &CellSpec<'_>) -> Result<Linked, LinkError> {
             let what = if g.ty != first.ty {
                 Some(format!(
                     "type {} here but {} in {}",
-                    g.ty, first.ty, m0.source_path
+                    g.ty,
+                    first.ty,
+                    m0.source_path()
                 ))
             } else if g.init != first.init {
                 Some(format!(
                     "initial value {} here but {} in {}",
                     g.init.display(g.ty),
                     first.init.display(first.ty),
-                    m0.source_path
+                    m0.source_path()
                 ))
             } else {
                 None
@@ -175,7 +177,7 @@ pub fn link(cell: &CellSpec<'_>) -> Result<Linked, LinkError> {
             if let Some(what) = what {
                 diags.push(
                     at(m, Code::E0100, format!("global `{name}` has {what}"), g.pos)
-                        .with_related_pos(&m0.source_path, first.pos.line, first.pos.col, "the other declaration")
+                        .with_related_pos(m0.file_of(first.pos), first.pos.line, first.pos.col, "the other declaration")
                         .with_help("every module that declares a global must give it the same type and initial value"),
                 );
             }
@@ -230,11 +232,11 @@ pub fn link(cell: &CellSpec<'_>) -> Result<Linked, LinkError> {
                         Code::E0102,
                         format!(
                             "robot `{target}` runs {}, which has no procedure `{pname}`",
-                            tm.source_path
+                            tm.source_path()
                         ),
                         site.pos,
                     )
-                    .with_help(format!("declare `proc {pname}(…)` in {}", tm.source_path)),
+                    .with_help(format!("declare `proc {pname}(…)` in {}", tm.source_path())),
                 );
                 links.remotes.push((ti as u32, 0));
                 continue;
@@ -266,7 +268,7 @@ pub fn link(cell: &CellSpec<'_>) -> Result<Linked, LinkError> {
                         site.pos,
                     )
                     .with_related_pos(
-                        &tm.source_path,
+                        tm.file_of(proc.pos),
                         proc.pos.line,
                         proc.pos.col,
                         "declared here",
@@ -300,13 +302,13 @@ pub fn link(cell: &CellSpec<'_>) -> Result<Linked, LinkError> {
                                 Code::W0003,
                                 format!(
                                     "robot `{target}` ({}) never waits for the signal `{name}`",
-                                    tm.source_path
+                                    tm.source_path()
                                 ),
                                 site.pos,
                             )
                             .with_help(format!(
                                 "add `wait_signal {name};` to {}, or remove this signal",
-                                tm.source_path
+                                tm.source_path()
                             )),
                         );
                     }
@@ -375,7 +377,7 @@ pub fn link(cell: &CellSpec<'_>) -> Result<Linked, LinkError> {
                         .with_help(format!("declare `proc {entry}() {{ … }}`")),
                 ),
                 None => diags.push(
-                    Diagnostic::at_pos(Code::E0106, format!("robot `{}` starts at `{entry}`, but {} has no `proc {entry}()`", r.name, m.source_path), &m.source_path, 1, 1)
+                    Diagnostic::at_pos(Code::E0106, format!("robot `{}` starts at `{entry}`, but {} has no `proc {entry}()`", r.name, m.source_path()), m.source_path(), 1, 1)
                         .with_help(format!("add `proc {entry}() {{ … }}`, name another entry in the workcell, or mark the robot `serve_only = true`")),
                 ),
             }

@@ -23,6 +23,10 @@ impl Span {
             end: u32::try_from(end).unwrap_or(u32::MAX),
         }
     }
+    /// The span moved `by` bytes later (saturating at 4 GiB).
+    pub fn shifted(self, by: usize) -> Span {
+        Span::new(self.start as usize + by, self.end as usize + by)
+    }
     /// The smallest span covering both.
     pub fn to(self, other: Span) -> Span {
         Span {

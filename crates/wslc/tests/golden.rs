@@ -108,7 +108,7 @@ fn ok_programs_compile_to_the_expected_bytecode() {
             "{name} has warnings: {:?}",
             out.warnings
         );
-        let listing = disassemble(&out.module, Some(&src));
+        let listing = disassemble(&out.module, &[src.as_str()]);
         expect_file![p.with_extension("disasm")].assert_eq(&listing);
         // The binary form round-trips exactly.
         let back = Module::decode(&out.module.encode()).unwrap_or_else(|e| panic!("{name}: {e}"));

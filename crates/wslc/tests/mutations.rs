@@ -251,7 +251,7 @@ fn damaged_bytecode_never_crashes_the_loader() {
         match Module::decode(&b) {
             Ok(m) => {
                 loaded += 1;
-                let _ = disassemble(&m, None);
+                let _ = disassemble(&m, &[]);
             }
             Err(_) => rejected += 1,
         }

@@ -29,6 +29,7 @@ __all__ = [
     "__version__",
     "cell_files",
     "compile",
+    "compile_files",
     "load_cell",
     "read_log",
     "run_variants",
@@ -88,6 +89,8 @@ class Module:
     @property
     def path(self) -> str: ...
     @property
+    def files(self) -> list[str]: ...
+    @property
     def globals(self) -> list[str]: ...
     @property
     def procs(self) -> list[str]: ...
@@ -104,6 +107,14 @@ def compile(
     """Compiles WSL or ABB RAPID `source` (`language`, else `path`'s extension: `.mod`,
     `.modx`, `.sys`, `.sysx`, `.prg` are RAPID); raises `CompileError` if it does not
     compile."""
+
+def compile_files(
+    files: list[tuple[str, str]],
+    language: Optional[Literal["wsl", "rapid"]] = None,
+) -> Module:
+    """Compiles one program of several files, `files` as (path, text) in order: a RAPID
+    task's modules, or a WSL program and its library files (`language`, else the first
+    path's extension); raises `CompileError` if it does not compile."""
 
 def load_cell(path: Union[str, os.PathLike[str]]) -> Cell:
     """Loads a workcell file; raises `CellError`, `CompileError` or `LinkError`."""

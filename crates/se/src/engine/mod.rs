@@ -46,7 +46,6 @@ use races::Seen;
 pub struct Simulation {
     cell: Arc<Cell>,
     vms: Vec<Vm>,
-    files: Vec<Arc<str>>,
     queue: BinaryHeap<Reverse<Queued>>,
     seq: u64,
     /// Tie-break rank per robot for same-time entries of different robots (all 0 normally:
@@ -182,11 +181,6 @@ impl Simulation {
                     .collect()
             })
             .collect();
-        let files = cell
-            .robots
-            .iter()
-            .map(|r| Arc::<str>::from(r.program.as_str()))
-            .collect();
         let fold = Fold::new(cell.robots.iter().map(|r| r.name.clone()).collect(), false);
         let collider = Collider::new(&cell);
         // The programs' compile and link warnings open the run's warnings (kind: the code).
@@ -206,7 +200,6 @@ impl Simulation {
         Simulation {
             vms,
             signal_to,
-            files,
             queue: BinaryHeap::new(),
             seq: 0,
             rank: vec![0; n],
@@ -416,9 +409,10 @@ impl Simulation {
         self.finish()
     }
 
-    /// The program file of robot `r` as messages name it (its file name).
-    fn short(&self, r: usize) -> String {
-        let f = self.files[r].as_ref();
+    /// The file of robot `r`'s program that `pos` is in, as messages name it (its file
+    /// name).
+    fn short(&self, r: usize, pos: SrcPos) -> String {
+        let f = self.cell.robots[r].module.file_of(pos);
         std::path::Path::new(f)
             .file_name()
             .map_or(f.to_string(), |n| n.to_string_lossy().into_owned())
@@ -487,8 +481,8 @@ impl Simulation {
             message,
             robot: robot.map(|r| self.cell.robots[r].name.clone()),
             file: robot
-                .filter(|_| pos.is_some())
-                .map(|r| self.files[r].to_string()),
+                .zip(pos)
+                .map(|(r, p)| self.cell.robots[r].module.file_of(p).to_string()),
             line: pos.map_or(0, |p| p.line),
             col: pos.map_or(0, |p| p.col),
             distance_m: None,
@@ -789,7 +783,7 @@ impl Simulation {
                 format!(
                     "{} ({k} events, the loop at {}:{})",
                     self.cell.robots[r].name,
-                    self.short(r),
+                    self.short(r, self.vms[r].loop_position()),
                     self.vms[r].loop_position()
                 )
             })
@@ -823,7 +817,7 @@ impl Simulation {
             parts.push(format!(
                 "{} waits for {what} ({}:{pos})",
                 self.cell.robots[*r].name,
-                self.short(*r)
+                self.short(*r, pos)
             ));
         }
         let m = format!("deadlock: {}", parts.join("; "));

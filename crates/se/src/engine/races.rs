@@ -112,10 +112,10 @@ impl Simulation {
             "race {subject} at {}: {} ({}:{}) and {} ({}:{}) {what}",
             fmt_quantity(t as f64 / 1e9, vworks_vm::Dim::TIME),
             self.cell.robots[or].name,
-            self.short(or),
+            self.short(or, opos),
             opos,
             self.cell.robots[r].name,
-            self.short(r),
+            self.short(r, pos),
             pos
         );
         self.warning(t, Some(r), Some(pos), "race", m);

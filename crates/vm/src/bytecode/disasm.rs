@@ -7,12 +7,22 @@ use std::fmt::Write;
 use super::instr::Instr;
 use super::*;
 
-/// Lists the module. With `source`, each new source line is printed beside its first
-/// instruction.
-pub fn disassemble(m: &Module, source: Option<&str>) -> String {
-    let lines: Vec<&str> = source.map(|s| s.lines().collect()).unwrap_or_default();
+/// Lists the module. With `sources` (the text of each of the module's files, in order),
+/// each new source line is printed beside its first instruction. Positions are
+/// `line:col`, or `file:line:col` in a module of several files.
+pub fn disassemble(m: &Module, sources: &[&str]) -> String {
+    let lines: Vec<Vec<&str>> = sources.iter().map(|s| s.lines().collect()).collect();
+    let at = |p: SrcPos| -> String {
+        if m.files.len() > 1 {
+            let f = m.file_of(p);
+            let name = f.rsplit(['/', '\\']).next().unwrap_or(f);
+            format!("{name}:{p}")
+        } else {
+            p.to_string()
+        }
+    };
     let mut o = String::new();
-    let _ = writeln!(o, "; module {} (WSLB v{})", m.source_path, FORMAT_VERSION);
+    let _ = writeln!(o, "; module {} (WSLB v{})", m.source_path(), FORMAT_VERSION);
     if !m.globals.is_empty() {
         let _ = writeln!(o, "\n; globals");
         for (i, g) in m.globals.iter().enumerate() {
@@ -22,7 +32,7 @@ pub fn disassemble(m: &Module, source: Option<&str>) -> String {
                 m.str(g.name),
                 g.ty,
                 g.init.display(g.ty),
-                g.pos
+                at(g.pos)
             );
         }
     }
@@ -37,7 +47,7 @@ pub fn disassemble(m: &Module, source: Option<&str>) -> String {
                 m.str(v.name),
                 v.ty,
                 v.init.display(v.ty),
-                v.pos
+                at(v.pos)
             );
         }
     }
@@ -60,7 +70,7 @@ pub fn disassemble(m: &Module, source: Option<&str>) -> String {
                 proc_name(m, c.func),
                 captures(&c.captures),
                 globals.join(", "),
-                c.pos
+                at(c.pos)
             );
         }
     }
@@ -79,7 +89,7 @@ pub fn disassemble(m: &Module, source: Option<&str>) -> String {
                 proc_name(m, h.target),
                 proc_name(m, h.action),
                 captures(&h.captures),
-                h.pos
+                at(h.pos)
             );
         }
     }
@@ -93,7 +103,7 @@ pub fn disassemble(m: &Module, source: Option<&str>) -> String {
                 m.str(r.robot),
                 m.str(r.proc),
                 args.join(", "),
-                r.pos
+                at(r.pos)
             );
         }
     }
@@ -105,7 +115,7 @@ pub fn disassemble(m: &Module, source: Option<&str>) -> String {
                 "s{i:<3} sends {}.{}  ; {}",
                 m.str(x.robot),
                 m.str(x.name),
-                x.pos
+                at(x.pos)
             );
         }
         let awaited: Vec<&str> = m.signals_awaited.iter().map(|s| m.str(*s)).collect();
@@ -116,7 +126,7 @@ pub fn disassemble(m: &Module, source: Option<&str>) -> String {
     if !m.parts.is_empty() {
         let _ = writeln!(o, "\n; part sites");
         for (i, x) in m.parts.iter().enumerate() {
-            let _ = writeln!(o, "p{i:<3} {}  ; {}", m.str(x.part), x.pos);
+            let _ = writeln!(o, "p{i:<3} {}  ; {}", m.str(x.part), at(x.pos));
         }
     }
     for (pi, p) in m.procs.iter().enumerate() {
@@ -132,26 +142,30 @@ pub fn disassemble(m: &Module, source: Option<&str>) -> String {
             p.kind.keyword(),
             m.str(p.name),
             params.join(", "),
-            p.pos,
+            at(p.pos),
             p.frame_slots,
             p.max_stack
         );
-        let mut last_line = 0;
+        let mut last_line = (0, 0);
         for (i, ins) in p.code(m).iter().enumerate() {
             let pc = p.code_start + i as u32;
             let pos = m.pos_of(pc);
             let text = format!("{:>5}  {:<14}{}", i, ins.name(), operands(m, ins));
-            let mut row = format!("{text:<44}; {pos}");
-            if pos.line != last_line {
-                if let Some(src) = lines.get(pos.line.saturating_sub(1) as usize) {
+            let shown = at(pos);
+            let mut row = format!("{text:<44}; {shown}");
+            if pos.line > 0 && (pos.file, pos.line) != last_line {
+                if let Some(src) = lines
+                    .get(pos.file as usize)
+                    .and_then(|l| l.get(pos.line.saturating_sub(1) as usize))
+                {
                     let _ = write!(
                         row,
                         "{}| {}",
-                        " ".repeat(8usize.saturating_sub(pos.to_string().len())),
+                        " ".repeat(8usize.saturating_sub(shown.len())),
                         src.trim()
                     );
                 }
-                last_line = pos.line;
+                last_line = (pos.file, pos.line);
             }
             let _ = writeln!(o, "{}", row.trim_end());
         }

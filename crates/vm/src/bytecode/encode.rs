@@ -19,7 +19,7 @@ use crate::types::{ConstValue, Dim, MAX_AXES, Type};
 /// The first four bytes of every `.wslb` file.
 pub const MAGIC: [u8; 4] = *b"WSLB";
 /// The format version this build writes and reads.
-pub const FORMAT_VERSION: u16 = 2;
+pub const FORMAT_VERSION: u16 = 3;
 
 const SECTIONS: [&[u8; 4]; 15] = [
     b"SRC_", b"STRS", b"CNST", b"GLOB", b"VARS", b"PROC", b"CODE", b"COND", b"WHEN", b"RMTE",
@@ -53,6 +53,7 @@ impl Writer {
         self.out.extend_from_slice(s.as_bytes());
     }
     fn pos(&mut self, p: SrcPos) {
+        self.u32(p.file);
         self.u32(p.line);
         self.u32(p.col);
     }
@@ -116,7 +117,12 @@ impl Module {
     /// Encodes the module as `.wslb` bytes.
     pub fn encode(&self) -> Vec<u8> {
         let mut w = Writer { out: Vec::new() };
-        w.section(SECTIONS[0], |w| w.str(&self.source_path));
+        w.section(SECTIONS[0], |w| {
+            w.len(self.files.len());
+            for f in &self.files {
+                w.str(f);
+            }
+        });
         w.section(SECTIONS[1], |w| {
             w.len(self.strings.len());
             self.strings.iter().for_each(|s| w.str(s));
@@ -312,7 +318,7 @@ impl Module {
             let mut s = r.section(tag)?;
             let s = &mut s;
             match i {
-                0 => m.source_path = s.string()?,
+                0 => m.files = s.list(4, Reader::string)?,
                 1 => m.strings = s.list(4, Reader::string)?,
                 2 => {
                     m.consts = s.list(15, |s| {
@@ -465,7 +471,7 @@ impl Module {
                     })?
                 }
                 _ => {
-                    m.lines = s.list(12, |s| {
+                    m.lines = s.list(16, |s| {
                         Ok(LineEntry {
                             pc: s.u32()?,
                             pos: s.pos()?,
@@ -591,6 +597,7 @@ impl<'a> Reader<'a> {
 
     fn pos(&mut self) -> Result<SrcPos, LoadError> {
         Ok(SrcPos {
+            file: self.u32()?,
             line: self.u32()?,
             col: self.u32()?,
         })

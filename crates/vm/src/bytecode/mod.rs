@@ -22,9 +22,12 @@ pub use verify::{MAX_FRAME, MAX_STACK};
 
 use crate::types::{ConstValue, Type};
 
-/// A position in a source file, 1-based; `col` counts characters.
+/// A position in a source file, 1-based; `col` counts characters. `file` indexes the
+/// module's [`Module::files`] (0, the first file, for a program of one file).
 #[derive(Clone, Copy, PartialEq, Eq, Debug, Default, Hash, PartialOrd, Ord)]
 pub struct SrcPos {
+    /// Which of the module's source files, from 0.
+    pub file: u32,
     /// Line, from 1.
     pub line: u32,
     /// Column in characters, from 1.
@@ -350,8 +353,10 @@ pub struct LineEntry {
 /// A compiled WSL module.
 #[derive(Clone, PartialEq, Debug, Default)]
 pub struct Module {
-    /// The source file it was compiled from, as given to the compiler.
-    pub source_path: String,
+    /// The source files it was compiled from, as given to the compiler, in order: a
+    /// robot task may be several files (RAPID modules). The first names the module; a
+    /// [`SrcPos`]'s `file` indexes this list.
+    pub files: Vec<String>,
     /// Interned names and texts.
     pub strings: Vec<String>,
     /// Named constants and the constant pool.
@@ -387,6 +392,19 @@ pub struct Module {
 }
 
 impl Module {
+    /// The file that names the module: its first source file (empty if it has none).
+    pub fn source_path(&self) -> &str {
+        self.files.first().map_or("", String::as_str)
+    }
+
+    /// The source file a position refers to (the first file for an index out of range;
+    /// verified modules have none).
+    pub fn file_of(&self, pos: SrcPos) -> &str {
+        self.files
+            .get(pos.file as usize)
+            .map_or(self.source_path(), String::as_str)
+    }
+
     /// The string at index `i` (empty if out of range; verified modules never are).
     pub fn str(&self, i: u32) -> &str {
         self.strings.get(i as usize).map_or("", String::as_str)

@@ -183,6 +183,25 @@ impl Module {
                 }
             }
         }
+        let nfiles = self.files.len().max(1) as u64;
+        let positions = (self.procs.iter().map(|x| x.pos))
+            .chain(self.consts.iter().map(|x| x.pos))
+            .chain(self.globals.iter().map(|x| x.pos))
+            .chain(self.vars.iter().map(|x| x.pos))
+            .chain(self.conds.iter().map(|x| x.pos))
+            .chain(self.handlers.iter().map(|x| x.pos))
+            .chain(self.remotes.iter().map(|x| x.pos))
+            .chain(self.signals_sent.iter().map(|x| x.pos))
+            .chain(self.parts.iter().map(|x| x.pos))
+            .chain(self.joints_sites.iter().map(|x| x.pos))
+            .chain(self.lines.iter().map(|x| x.pos));
+        if let Some(p) = positions.into_iter().find(|p| u64::from(p.file) >= nfiles) {
+            return Err(bad(format!(
+                "a source position names file {} but the module has {} files",
+                p.file,
+                self.files.len()
+            )));
+        }
         if self.lines.windows(2).any(|w| w[0].pc >= w[1].pc)
             || self
                 .lines

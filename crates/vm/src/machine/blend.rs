@@ -217,9 +217,9 @@ impl Vm {
             } else {
                 self.blend_start(f, &traj, point_ns)
             };
-            (ts, radius, f.end(), f.pos.line)
+            (ts, radius, f.end(), f.pos)
         });
-        if let Some((ts, _, point, line)) = corner
+        if let Some((ts, _, point, at)) = corner
             && ts >= point
             && !tool_changed
         {
@@ -228,8 +228,9 @@ impl Vm {
                 point,
                 "corner",
                 format!(
-                    "this motion cannot start inside the zone of the motion at line {line} of {} within the zone and the axes' limits: the robot stops at that point first (a corner path failure); a larger zone, a lower speed or a jerk limit can let it fly by",
-                    self.file_name()
+                    "this motion cannot start inside the zone of the motion at line {} of {} within the zone and the axes' limits: the robot stops at that point first (a corner path failure); a larger zone, a lower speed or a jerk limit can let it fly by",
+                    at.line,
+                    self.file_name(at)
                 ),
             );
         }
@@ -262,13 +263,12 @@ impl Vm {
         })
     }
 
-    /// The program's file name, for messages about another line of it.
-    fn file_name(&self) -> String {
-        std::path::Path::new(&self.m.source_path)
+    /// The name of the program file `at` is in, for messages about another line of it.
+    fn file_name(&self, at: SrcPos) -> String {
+        let path = self.m.file_of(at);
+        std::path::Path::new(path)
             .file_name()
-            .map_or(self.m.source_path.clone(), |n| {
-                n.to_string_lossy().into_owned()
-            })
+            .map_or(path.to_string(), |n| n.to_string_lossy().into_owned())
     }
 
     /// A warning about the statement at `pc`, at `time`, once per statement (a loop
@@ -523,15 +523,16 @@ impl Vm {
         let Some(f) = self.fading_at(t) else {
             return t;
         };
-        let (end, line) = (f.end(), f.pos.line);
+        let (end, at) = (f.end(), f.pos);
         // Warned at the stop point's time, where the trace shows the statement's event.
         self.warn_once(
             pc,
             end,
             "stop-point",
             format!(
-                "{what} makes the zoned point of the motion at line {line} of {} a stop point: the robot reaches it first; make that motion stop at its point to say so (`zone fine`; in RAPID, `fine`)",
-                    self.file_name()
+                "{what} makes the zoned point of the motion at line {} of {} a stop point: the robot reaches it first; make that motion stop at its point to say so (`zone fine`; in RAPID, `fine`)",
+                    at.line,
+                    self.file_name(at)
             ),
         );
         end

@@ -35,7 +35,8 @@ use vworks_vm::bytecode::{
 use vworks_vm::math;
 use vworks_vm::{ConstValue, Dim, MAX_AXES, Module, Type};
 
-use crate::diag::{Code, Diagnostic, LineIndex};
+use crate::diag::{Code, Diagnostic};
+use crate::program::ProgramText;
 use crate::syntax::*;
 
 mod builtins;
@@ -238,16 +239,15 @@ struct PendingHandler {
 
 /// Compiles a parsed module. Diagnostics get spans; the caller resolves positions.
 pub(crate) fn lower(
-    path: &str,
-    src: &str,
+    program: &ProgramText,
     ast: &SourceModule,
     diags: &mut Vec<Diagnostic>,
 ) -> Module {
     let mut c = Compiler {
-        index: LineIndex::new(src),
+        program,
         diags,
         m: Module {
-            source_path: path.to_string(),
+            files: program.paths(),
             ..Module::default()
         },
         strings: HashMap::new(),
@@ -269,7 +269,7 @@ pub(crate) fn lower(
 type ProcCode = (Vec<Instr>, Vec<(u32, SrcPos)>);
 
 struct Compiler<'d> {
-    index: LineIndex,
+    program: &'d ProgramText,
     diags: &'d mut Vec<Diagnostic>,
     m: Module,
     strings: HashMap<String, u32>,
@@ -311,8 +311,7 @@ impl Compiler<'_> {
     }
 
     fn pos(&self, span: Span) -> SrcPos {
-        let (line, col) = self.index.line_col(span.start as usize);
-        SrcPos { line, col }
+        self.program.pos(span.start as usize)
     }
 
     fn f(&mut self) -> &mut FnCtx {

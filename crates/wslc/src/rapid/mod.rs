@@ -101,9 +101,36 @@ pub fn compile_with_io(
     source: &str,
     io: Option<&[IoSignal]>,
 ) -> Result<Compiled, CompileError> {
+    compile_files(&[(path, source)], io)
+}
+
+/// Compiles a robot task of several RAPID files ((path, text), in order; each one or
+/// more whole modules) into one module, with the task's I/O signals `io` as
+/// [`compile_with_io`]. The modules of all files are one task: a `PROC` of one file calls
+/// a `PROC` of another, and data declared in one module is seen by the others (`LOCAL`
+/// keeps it to its own module). Each file is lexed and parsed on its own, so a module
+/// cannot run on into the next file; positions and diagnostics name their own file.
+pub fn compile_files(
+    files: &[(&str, &str)],
+    io: Option<&[IoSignal]>,
+) -> Result<Compiled, CompileError> {
+    let program = crate::program::ProgramText::new(files);
     let mut diags: Vec<Diagnostic> = Vec::new();
-    let toks = lexer::lex(source, &mut diags);
-    let modules = parser::parse(source, toks, &mut diags);
+    let mut modules = Vec::new();
+    let mut empty = Vec::new();
+    for (_, start, text) in program.files() {
+        let first_new = diags.len();
+        let mut toks = lexer::lex(text, &mut diags);
+        for t in &mut toks {
+            t.span = t.span.shifted(start);
+        }
+        crate::shift_diagnostics(&mut diags[first_new..], start);
+        let found = parser::parse(program.text(), toks, &mut diags);
+        if found.is_empty() {
+            empty.push(start);
+        }
+        modules.extend(found);
+    }
     // A construct the parser recognised but vworks does not run (E0300: `RECORD`) does
     // not stop the translation, which reports the others.
     let syntax_error = diags
@@ -112,17 +139,17 @@ pub fn compile_with_io(
     let ast = if syntax_error {
         None
     } else {
-        if modules.is_empty() {
+        for start in empty {
             diags.push(
                 Diagnostic::error(
                     crate::Code::E0005,
                     "this file has no `MODULE … ENDMODULE`",
-                    crate::syntax::Span::default(),
+                    crate::syntax::Span::new(start, start),
                 )
                 .with_help("a RAPID program is one or more modules: `MODULE name … ENDMODULE`"),
             );
         }
         Some(lower::translate(&modules, io, &mut diags))
     };
-    crate::finish(path, source, ast.as_ref(), diags)
+    crate::finish(&program, ast.as_ref(), diags)
 }
