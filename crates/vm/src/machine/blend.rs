@@ -315,7 +315,10 @@ impl Vm {
         let at = |k: usize| 0.5 * total + 0.5 * total * k as f64 / STEPS as f64;
         // The last sample still outside the zone, from the end back to the middle.
         let Some(k) = (0..STEPS).rev().find(|&k| dist(at(k)) > r) else {
-            return (to_ns(0.5 * total), dist(0.5 * total));
+            // The TCP is within `r` all through the second half, but its distance from
+            // the point need not fall all the way: the zone is the farthest it gets.
+            let farthest = (0..=STEPS).map(|k| dist(at(k))).fold(0.0, f64::max);
+            return (to_ns(0.5 * total), farthest);
         };
         let (mut lo, mut hi) = (at(k), at(k + 1));
         for _ in 0..60 {
