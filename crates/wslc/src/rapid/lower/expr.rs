@@ -119,6 +119,12 @@ impl Tr<'_> {
             .locals
             .iter()
             .flat_map(|s| s.keys().cloned())
+            .chain(
+                self.module_scope
+                    .keys()
+                    .filter(|(m, _)| *m == self.module)
+                    .map(|(_, k)| k.clone()),
+            )
             .chain(self.scope.keys().cloned())
             .collect();
         let near = crate::nearest(&key, names.iter().map(String::as_str)).map(|m| {
@@ -127,7 +133,9 @@ impl Tr<'_> {
                 .cloned()
                 .unwrap_or_else(|| m.to_string())
         });
+        let elsewhere = self.local_elsewhere(&key);
         let d = self.error(Code::E0010, format!("unknown name `{}`", n.text), n.span);
+        d.notes.extend(elsewhere);
         if let Some(m) = near {
             d.help = Some(format!("did you mean `{m}`?"));
         } else {
@@ -720,12 +728,14 @@ impl Tr<'_> {
                 None
             }
             None => {
-                self.error(
+                let elsewhere = self.local_elsewhere(&f.key());
+                let d = self.error(
                     Code::E0011,
                     format!("unknown function `{}`", f.text),
                     f.span,
-                )
-                .help = Some("docs/rapid.md lists RAPID's functions that vworks runs".into());
+                );
+                d.help = Some("docs/rapid.md lists RAPID's functions that vworks runs".into());
+                d.notes.extend(elsewhere);
                 None
             }
         }

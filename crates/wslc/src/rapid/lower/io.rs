@@ -27,7 +27,7 @@ impl Tr<'_> {
     /// not), so that `IDelete` knows which handlers it disables wherever it stands.
     pub(crate) fn collect_connects(&mut self, modules: &[r::RapidModule]) {
         type Found = (
-            Vec<(r::Name, r::Name, Span)>,
+            Vec<(r::Name, r::Name, Span, usize)>,
             Vec<(String, bool)>,
             Vec<String>,
         );
@@ -37,7 +37,7 @@ impl Tr<'_> {
                 match &s.kind {
                     r::StmtKind::Connect { intno, trap } => {
                         if let r::ExprKind::Name(n) = &intno.kind {
-                            found.0.push((n.clone(), trap.clone(), s.span));
+                            found.0.push((n.clone(), trap.clone(), s.span, usize::MAX));
                         }
                     }
                     r::StmtKind::Call { name, args } => {
@@ -89,19 +89,25 @@ impl Tr<'_> {
                 }
             }
         }
-        for m in modules {
+        for (mi, m) in modules.iter().enumerate() {
+            let first = found.0.len();
             for it in &m.items {
                 if let r::Item::Routine(rt) = it {
                     walk(&rt.body, &mut found);
                 }
+            }
+            // Each CONNECT names its TRAP as its own module sees names.
+            for c in &mut found.0[first..] {
+                c.3 = mi;
             }
         }
         let (connects, orders, mut parts) = found;
         parts.sort();
         parts.dedup();
         self.grip_parts = parts;
-        for (intno, trap, span) in connects {
-            let sig = match self.scope.get(&trap.key()) {
+        for (intno, trap, span, mi) in connects {
+            self.module = mi;
+            let sig = match self.lookup(&trap.key()) {
                 Some(Sym::Routine(s)) if s.kind == r::RoutineKind::Trap => s.clone(),
                 Some(_) => {
                     self.error(

@@ -35,6 +35,9 @@ pub(crate) fn translate(
     let mut t = Tr {
         diags,
         scope: BTreeMap::new(),
+        module_scope: BTreeMap::new(),
+        module: 0,
+        module_names: Vec::new(),
         items: Vec::new(),
         helpers: BTreeSet::new(),
         locals: Vec::new(),
@@ -48,16 +51,19 @@ pub(crate) fn translate(
         ordered: BTreeSet::new(),
         grip_parts: Vec::new(),
     };
+    t.module_names = modules.iter().map(|m| m.name.clone()).collect();
     t.collect(modules);
     t.collect_connects(modules);
-    for m in modules {
+    for (k, m) in modules.iter().enumerate() {
+        t.module = k;
         for it in &m.items {
             if let r::Item::Data(d) = it {
                 t.module_data(d);
             }
         }
     }
-    for m in modules {
+    for (k, m) in modules.iter().enumerate() {
+        t.module = k;
         for it in &m.items {
             if let r::Item::Routine(rt) = it {
                 t.routine(rt);
@@ -138,8 +144,15 @@ impl Val {
 
 pub(crate) struct Tr<'d> {
     pub(crate) diags: &'d mut Vec<Diagnostic>,
-    /// Module-level names (lower case) of every module of the task.
+    /// Module-level names (lower case) of every module of the task, but `LOCAL` ones.
     pub(crate) scope: BTreeMap<String, Sym>,
+    /// `LOCAL` names by (module index, name): seen only in their own module, where they
+    /// hide a task-wide name of the same spelling.
+    pub(crate) module_scope: BTreeMap<(usize, String), Sym>,
+    /// The module being translated (its index in the task).
+    pub(crate) module: usize,
+    /// The modules' names, by index.
+    pub(crate) module_names: Vec<r::Name>,
     pub(crate) items: Vec<w::Item>,
     /// Generated helper functions already emitted.
     pub(crate) helpers: BTreeSet<String>,
@@ -198,38 +211,88 @@ impl Tr<'_> {
         self.diags.push(d);
     }
 
-    /// Module-level names first, so routines may be called before they are declared.
+    /// Module-level names first, so routines may be called before they are declared. A
+    /// name is declared once in its module, and a task-wide name once in the task; a
+    /// `LOCAL` name may repeat in other modules.
     fn collect(&mut self, modules: &[r::RapidModule]) {
-        for m in modules {
+        let mut seen: BTreeMap<(usize, String), Span> = BTreeMap::new();
+        let mut task_wide: BTreeMap<String, Span> = BTreeMap::new();
+        for (mi, m) in modules.iter().enumerate() {
+            self.module = mi;
             for it in &m.items {
-                let (name, span) = match it {
-                    r::Item::Data(d) => (&d.name, d.span),
-                    r::Item::Routine(rt) => (&rt.name, rt.span),
+                let (name, local) = match it {
+                    r::Item::Data(d) => (&d.name, d.local),
+                    r::Item::Routine(rt) => (&rt.name, rt.local),
                 };
+                let key = name.key();
                 self.spelled
-                    .entry(name.key())
+                    .entry(key.clone())
                     .or_insert_with(|| name.text.clone());
-                if let Some(prev) = self.scope.get(&name.key()) {
-                    let prev_span = match prev {
-                        Sym::Data(d) => d.span,
-                        Sym::Routine(s) => s.span,
-                    };
+                let in_module = seen.get(&(mi, key.clone())).map(|s| (*s, "module"));
+                let in_task = || (!local).then(|| task_wide.get(&key)).flatten();
+                if let Some((prev_span, scope)) =
+                    in_module.or_else(|| in_task().map(|s| (*s, "task")))
+                {
                     let d = Diagnostic::error(
                         Code::E0012,
-                        format!("`{}` is declared twice in this task", name.text),
+                        format!("`{}` is declared twice in this {scope}", name.text),
                         name.span,
                     )
                     .with_related(prev_span, "first declared here")
-                    .with_note("RAPID names are case-insensitive");
+                    .with_note("RAPID names are case-insensitive; a LOCAL name may repeat in another module");
                     self.diags.push(d);
                     continue;
                 }
+                seen.insert((mi, key.clone()), name.span);
+                if !local {
+                    task_wide.insert(key.clone(), name.span);
+                }
                 if let r::Item::Routine(rt) = it {
                     let sig = self.signature(rt);
-                    self.scope.insert(name.key(), Sym::Routine(sig));
+                    self.declare(local, key, Sym::Routine(sig));
                 }
-                let _ = span;
             }
+        }
+    }
+
+    /// Declares a module-level name of the current module: task-wide, or `LOCAL`.
+    pub(crate) fn declare(&mut self, local: bool, key: String, sym: Sym) {
+        if local {
+            self.module_scope.insert((self.module, key), sym);
+        } else {
+            self.scope.insert(key, sym);
+        }
+    }
+
+    /// The module-level symbol `key` declared by the current module (`LOCAL`) or the task.
+    fn declared(&self, local: bool, key: &str) -> Option<&Sym> {
+        if local {
+            self.module_scope.get(&(self.module, key.to_string()))
+        } else {
+            self.scope.get(key)
+        }
+    }
+
+    /// A note for a name the current module does not see but another module declares
+    /// `LOCAL`.
+    pub(crate) fn local_elsewhere(&self, key: &str) -> Option<String> {
+        let (m, _) = self
+            .module_scope
+            .keys()
+            .find(|(m, k)| *m != self.module && k == key)?;
+        let module = &self.module_names.get(*m)?.text;
+        Some(format!(
+            "it is LOCAL to module `{module}`, which alone sees it; drop LOCAL to share it with the task's other modules"
+        ))
+    }
+
+    /// The WSL name of a module-level name: a `LOCAL` one is prefixed with its module's
+    /// name (`moves:init`), so that `LOCAL`s of several modules do not meet.
+    fn module_level_name(&self, n: &r::Name, local: bool) -> String {
+        let name = wsl_name(n);
+        match self.module_names.get(self.module) {
+            Some(m) if local => format!("{}:{name}", m.key()),
+            _ => name,
         }
     }
 
@@ -243,7 +306,7 @@ impl Tr<'_> {
             kind: rt.kind,
             params,
             ret,
-            wsl: wsl_name(&rt.name),
+            wsl: self.module_level_name(&rt.name, rt.local),
             span: rt.name.span,
         }
     }
@@ -349,7 +412,11 @@ impl Tr<'_> {
                 return Some(Sym::Data(d.clone()));
             }
         }
-        if let Some(s) = self.scope.get(key) {
+        if let Some(s) = self
+            .module_scope
+            .get(&(self.module, key.to_string()))
+            .or_else(|| self.scope.get(key))
+        {
             return Some(s.clone());
         }
         predefined(key).map(Sym::Data)
@@ -393,14 +460,14 @@ impl Tr<'_> {
         };
         let Ok(len) = self.dims(d) else { return };
         let key = d.name.key();
-        if matches!(self.scope.get(&key), Some(Sym::Routine(_))) {
+        if matches!(self.declared(d.local, &key), Some(Sym::Routine(_))) {
             return; // Reported as a duplicate.
         }
         let mut data = Data {
             ty,
             len,
             storage: d.storage,
-            base: wsl_name(&d.name),
+            base: self.module_level_name(&d.name, d.local),
             span: d.name.span,
             text: None,
             inline: None,
@@ -409,12 +476,12 @@ impl Tr<'_> {
         };
         if ty == Ty::Str {
             self.string_data(d, &mut data);
-            self.scope.insert(key, Sym::Data(data));
+            self.declare(d.local, key, Sym::Data(data));
             return;
         }
         if ty == Ty::Syncident {
             self.syncident(d, &data);
-            self.scope.insert(key, Sym::Data(data));
+            self.declare(d.local, key, Sym::Data(data));
             return;
         }
         let inits = self.initial_values(d, ty, len);
@@ -427,8 +494,11 @@ impl Tr<'_> {
         {
             data.inline = Some(v.parts.clone());
         }
-        let scalar_global =
-            d.storage == Storage::Pers && len.is_none() && matches!(ty, Ty::Num | Ty::Bool);
+        // A LOCAL PERS is its module's own: not shared with other tasks.
+        let scalar_global = d.storage == Storage::Pers
+            && !d.local
+            && len.is_none()
+            && matches!(ty, Ty::Num | Ty::Bool);
         for (decl, _) in Self::leaf_decls(d, &data, inits.as_deref()) {
             self.items.push(match d.storage {
                 Storage::Const => w::Item::Const(decl),
@@ -439,7 +509,7 @@ impl Tr<'_> {
         if len.is_some() && !ty.leaves().is_empty() {
             self.array_accessors(&data);
         }
-        self.scope.insert(key, Sym::Data(data));
+        self.declare(d.local, key, Sym::Data(data));
     }
 
     /// One WSL declaration per element and leaf of `data` (declared by `d`), with the
@@ -609,7 +679,7 @@ impl Tr<'_> {
     }
 
     fn routine(&mut self, rt: &r::Routine) {
-        let Some(Sym::Routine(sig)) = self.scope.get(&rt.name.key()).cloned() else {
+        let Some(Sym::Routine(sig)) = self.declared(rt.local, &rt.name.key()).cloned() else {
             return; // A duplicate, reported.
         };
         if sig.span != rt.name.span {

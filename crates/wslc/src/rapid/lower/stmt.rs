@@ -718,11 +718,13 @@ impl Tr<'_> {
                                     .cloned()
                                     .unwrap_or_else(|| m.to_string())
                             });
+                        let elsewhere = self.local_elsewhere(&key);
                         let d = self.error(
                             Code::E0011,
                             format!("unknown instruction or procedure `{}`", name.text),
                             name.span,
                         );
+                        d.notes.extend(elsewhere);
                         d.help = Some(match near {
                         Some(n) => format!("did you mean `{n}`?"),
                         None => "declare it with PROC; docs/rapid.md lists the instructions vworks runs".into(),
