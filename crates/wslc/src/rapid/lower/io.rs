@@ -10,7 +10,8 @@
 //! whole task (found before any routine is translated, so the order of the routines does
 //! not matter). `ISignalDI`/`ISignalDO`/`ISignalGI`/`ISignalGO` enable a condition handler
 //! on the signal reaching the value (a false→true edge, as the controller's interrupt on a
-//! change), `ITimer` a periodic or single timer, and `IDelete`/`ISleep` disable the trap.
+//! change), `ITimer` a periodic or single timer, `IDelete`/`ISleep` disable the trap, and
+//! `IWatch` orders it again as the task's one order of it does.
 
 use vworks_vm::Dim;
 
@@ -28,7 +29,7 @@ impl Tr<'_> {
     pub(crate) fn collect_connects(&mut self, modules: &[r::RapidModule]) {
         type Found = (
             Vec<(r::Name, r::Name, Span, usize)>,
-            Vec<(String, bool)>,
+            Vec<(String, bool, r::Name, Vec<Arg>)>,
             Vec<String>,
         );
         let mut found: Found = (Vec::new(), Vec::new(), Vec::new());
@@ -62,7 +63,7 @@ impl Tr<'_> {
                                 ..
                             }) = last
                             {
-                                found.1.push((n.key(), single));
+                                found.1.push((n.key(), single, name.clone(), args.clone()));
                             }
                         }
                     }
@@ -145,7 +146,11 @@ impl Tr<'_> {
                 }
             }
         }
-        for (intno, single) in orders {
+        for (intno, single, instr, args) in orders {
+            self.orders
+                .entry(intno.clone())
+                .or_default()
+                .push((instr, args));
             if let Some(sig) = self.connects.get(&intno) {
                 let handler = if single {
                     format!("_{}_single", sig.wsl)
@@ -429,22 +434,23 @@ impl Tr<'_> {
                 if let Some((p, _)) = self.split_args(f, args, 1..=1, &[], span)
                     && let Some(trap) = self.connected(p[0])
                 {
-                    for name in [trap.wsl.clone(), format!("_{}_single", trap.wsl)] {
-                        if self.ordered.contains(&name) {
-                            out.push(w::Stmt {
-                                kind: w::StmtKind::Disable(b::ident(&name, span)),
-                                span,
-                            });
-                        }
-                    }
+                    self.disable_trap(&trap, span, out);
+                }
+            }
+            "iwatch" => {
+                if let Some((p, _)) = self.split_args(f, args, 1..=1, &[], span)
+                    && let Some(trap) = self.connected(p[0])
+                    && let r::ExprKind::Name(n) = &p[0].kind
+                {
+                    self.watch(n, &trap, span, out);
                 }
             }
             "gripload" => self.grip_load(f, args, span, out),
-            "iwatch" | "ienable" | "idisable" => {
+            "ienable" | "idisable" => {
                 self.unsupported(
                     &format!("`{}`", f.text),
                     f.span,
-                    "delete the interrupt with IDelete and order it again with ISignalDI or ITimer",
+                    "IDisable holds every interrupt of the task back until IEnable, then runs them; put the interrupts to sleep one by one with ISleep and wake them with IWatch (which discards, not holds, what happens meanwhile)",
                 );
             }
             _ => return false,
@@ -540,6 +546,51 @@ impl Tr<'_> {
                 ));
                 None
             }
+        }
+    }
+
+    /// `disable` of each handler an interrupt's TRAP is ordered with (itself, or its
+    /// `\Single` wrapper).
+    fn disable_trap(&mut self, trap: &Sig, span: Span, out: &mut Vec<w::Stmt>) {
+        for name in [trap.wsl.clone(), format!("_{}_single", trap.wsl)] {
+            if self.ordered.contains(&name) {
+                out.push(w::Stmt {
+                    kind: w::StmtKind::Disable(b::ident(&name, span)),
+                    span,
+                });
+            }
+        }
+    }
+
+    /// `IWatch i;`: the interrupt ordered again as the task's one order of it (its
+    /// `ISignalDI …` or `ITimer …`, translated here), after a `disable`, so that waking
+    /// an interrupt that is not asleep leaves one handler, not two.
+    fn watch(&mut self, intno: &r::Name, trap: &Sig, span: Span, out: &mut Vec<w::Stmt>) {
+        let orders = self.orders.get(&intno.key()).cloned().unwrap_or_default();
+        match orders.as_slice() {
+            [(instr, args)] => {
+                self.disable_trap(trap, span, out);
+                self.io_instruction(&instr.key(), instr, args, span, out);
+            }
+            [] => {
+                self.error(
+                    Code::E0303,
+                    format!(
+                        "`IWatch {}` wakes an interrupt that is never ordered",
+                        intno.text
+                    ),
+                    intno.span,
+                )
+                .help = Some(format!(
+                    "order it first, e.g. `ISignalDI diSignal, 1, {};` or `ITimer 1, {};`",
+                    intno.text, intno.text
+                ));
+            }
+            _ => self.unsupported(
+                &format!("`IWatch` of `{}`, which is ordered in several places", intno.text),
+                intno.span,
+                "order each interrupt in one place (IWatch orders it again the same way), or delete it with IDelete and order it again",
+            ),
         }
     }
 

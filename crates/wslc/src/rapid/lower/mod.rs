@@ -49,6 +49,7 @@ pub(crate) fn translate(
         signals: BTreeMap::new(),
         connects: BTreeMap::new(),
         ordered: BTreeSet::new(),
+        orders: BTreeMap::new(),
         grip_parts: Vec::new(),
     };
     t.module_names = modules.iter().map(|m| m.name.clone()).collect();
@@ -170,6 +171,9 @@ pub(crate) struct Tr<'d> {
     pub(crate) signals: BTreeMap<String, i64>,
     /// Each interrupt variable (lower case) and the TRAP its `CONNECT` names.
     pub(crate) connects: BTreeMap<String, Sig>,
+    /// Each interrupt variable's orders (`ISignalDI …`, `ITimer …`: the instruction and
+    /// its arguments), for `IWatch` to order it again.
+    pub(crate) orders: BTreeMap<String, Vec<(r::Name, Vec<r::Arg>)>>,
     /// The handlers some interrupt order enables (a TRAP, or its `'single` wrapper).
     pub(crate) ordered: BTreeSet<String>,
     /// The workcell parts the task's `GripLoad`s name (loaddata names, lower case), sorted.
