@@ -70,6 +70,8 @@ pub trait Reader {
     fn joints(&self) -> [f64; crate::MAX_AXES];
     /// The robot's TCP now: x, y, z, rx, ry, rz.
     fn tcp(&self) -> [f64; 6];
+    /// The robot's active tool now (its TCP in the tool link's frame): x, y, z, rx, ry, rz.
+    fn tool(&self) -> [f64; 6];
     /// The robot's number of axes.
     fn axes(&self) -> usize;
 }
@@ -483,6 +485,10 @@ impl Thread {
                 }
                 Instr::CurrentPose => {
                     let p = r.tcp();
+                    self.stack.extend(p.iter().map(|x| b(*x)));
+                }
+                Instr::CurrentTool => {
+                    let p = r.tool();
                     self.stack.extend(p.iter().map(|x| b(*x)));
                 }
                 _ => {

@@ -335,6 +335,8 @@ instruction_set! {
     0x6b CurrentJoints;
     /// Pushes the robot's current TCP pose in the base frame.
     0x6c CurrentPose;
+    /// Pushes the robot's active tool: its TCP in the tool link's frame (the tool the motion now moving or last moved uses, else the workcell's).
+    0x6d CurrentTool;
     /// EVENT `motion_start`: joint move. Pops tool, zone, accel and speed (when flagged), then the target.
     0x70 MoveJ(f: MoveFlags);
     /// EVENT `motion_start`: straight-line move. Pops tool, zone, orient, accel and speed (when flagged), then the target.
@@ -432,7 +434,7 @@ impl Instr {
             Instr::RetVal => eff(proc.ret.map_or(0, |t| u32::from(t.width())), 0),
             Instr::Now | Instr::Cycle | Instr::TimedOut => eff(0, 1),
             Instr::CurrentJoints => eff(0, J),
-            Instr::CurrentPose => eff(0, P),
+            Instr::CurrentPose | Instr::CurrentTool => eff(0, P),
             Instr::MoveJ(f) | Instr::MoveL(f) | Instr::MoveC(f) => {
                 let target = if f.has(MoveFlags::TARGET_JOINTS) {
                     J

@@ -474,6 +474,11 @@ impl Reader for View<'_> {
         let rpy = tcp.rpy();
         [tcp.t[0], tcp.t[1], tcp.t[2], rpy[0], rpy[1], rpy[2]]
     }
+    fn tool(&self) -> [f64; 6] {
+        let tool = self.vm.tool_at(self.t);
+        let rpy = tool.rpy();
+        [tool.t[0], tool.t[1], tool.t[2], rpy[0], rpy[1], rpy[2]]
+    }
     fn axes(&self) -> usize {
         self.vm.model.dof()
     }

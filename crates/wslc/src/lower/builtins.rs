@@ -13,6 +13,7 @@ pub(crate) enum Builtin {
     TimedOut,
     CurrentJoints,
     CurrentPose,
+    CurrentTool,
     Offset,
     ToolOffset,
     PoseMul,
@@ -69,6 +70,13 @@ pub(crate) const BUILTINS: &[BuiltinInfo] = &[
         "current_pose()",
         "pose",
         &[Instr::CurrentPose],
+    ),
+    row(
+        "current_tool",
+        Builtin::CurrentTool,
+        "current_tool()",
+        "pose",
+        &[Instr::CurrentTool],
     ),
     row(
         "offset",
@@ -211,7 +219,8 @@ impl Compiler<'_> {
             | Builtin::Cycle
             | Builtin::TimedOut
             | Builtin::CurrentJoints
-            | Builtin::CurrentPose => {
+            | Builtin::CurrentPose
+            | Builtin::CurrentTool => {
                 if self.fk() == FnKind::Init {
                     return self.not_const(n, "known only during the run", sp);
                 }

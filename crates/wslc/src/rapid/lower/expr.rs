@@ -786,6 +786,35 @@ impl Tr<'_> {
 
     /// The positional arguments and the optional ones of a built-in, checked against
     /// `count` and the optional names it takes.
+    /// The TCP now (`current_pose()`), or with `\Tool:=t` among `opts` the TCP of tool
+    /// `t`: the flange (the TCP less the active tool) · t's `tframe`.
+    fn tcp_with_tool(
+        &mut self,
+        opts: &[(String, &r::Name, Option<&r::Expr>)],
+        span: Span,
+    ) -> Option<w::Expr> {
+        let pose = b::call("current_pose", vec![], span);
+        let Some((_, n, v)) = opts.iter().find(|(k, _, _)| k == "tool") else {
+            return Some(pose);
+        };
+        let Some(e) = v else {
+            self.error(Code::E0301, "`\\Tool` is written `\\Tool:=tool1`", n.span);
+            return None;
+        };
+        let tool = self.value(e, Ty::Tool)?;
+        let active = b::call(
+            "pose_inv",
+            vec![b::call("current_tool", vec![], span)],
+            span,
+        );
+        let flange = b::call("pose_mul", vec![pose, active], span);
+        Some(b::call(
+            "pose_mul",
+            vec![flange, tool.parts[0].clone()],
+            span,
+        ))
+    }
+
     pub(crate) fn split_args<'a>(
         &mut self,
         f: &r::Name,
@@ -931,7 +960,7 @@ impl Tr<'_> {
                     &["Tool", "WObj", "TaskRef", "TaskName"],
                     span,
                 )?;
-                let mut pose = b::call("current_pose", vec![], span);
+                let mut pose = self.tcp_with_tool(&opts, span)?;
                 // In a work object: (uframe · oframe)⁻¹ · the TCP.
                 if let Some((_, n, v)) = opts.iter().find(|(k, _, _)| k == "wobj") {
                     let Some(e) = v else {
@@ -960,8 +989,8 @@ impl Tr<'_> {
                 ))
             })(),
             "cpos" => (|| {
-                self.split_args(f, args, 0..=0, &["Tool", "WObj"], span)?;
-                let p = b::call("current_pose", vec![], span);
+                let (_, opts) = self.split_args(f, args, 0..=0, &["Tool", "WObj"], span)?;
+                let p = self.tcp_with_tool(&opts, span)?;
                 Some(Val::one(Ty::Pos, self.pos_of(p, span, |e| e)))
             })(),
             "abs" | "sqrt" => (|| {
