@@ -15,6 +15,9 @@ pub struct World {
     pub(crate) joints: Vec<[f64; MAX_AXES]>,
     /// Per robot: every link's frame in the cell.
     pub(crate) frames: Vec<Vec<Iso>>,
+    /// Per robot: its active tool (the TCP in its tool link's frame: the tool of the
+    /// motion it is making or made last, else the workcell's `tool`).
+    pub(crate) tools: Vec<Iso>,
     /// Per part: the robot holding it and the part's pose in that robot's tool-link frame.
     pub(crate) held: Vec<Option<(usize, Iso)>>,
     /// Per part: its pose in the cell when not held.
@@ -32,6 +35,7 @@ impl World {
                 .iter()
                 .map(|r| r.model.frames_buffer())
                 .collect(),
+            tools: cell.robots.iter().map(|r| r.tool).collect(),
             held: vec![None; cell.parts.len()],
             part_pose: cell.parts.iter().map(|p| p.pose).collect(),
         }
@@ -45,6 +49,23 @@ impl World {
     /// Every robot's link frames in the cell.
     pub fn frames(&self) -> &[Vec<Iso>] {
         &self.frames
+    }
+
+    /// Every robot's active tool: its TCP in its tool link's frame.
+    pub fn tools(&self) -> &[Iso] {
+        &self.tools
+    }
+
+    /// Robot `r`'s TCP in the cell (identity if there is no robot `r`).
+    pub fn tcp(&self, cell: &Cell, r: usize) -> Iso {
+        match (cell.robots.get(r), self.frames.get(r), self.tools.get(r)) {
+            (Some(robot), Some(f), Some(tool)) => f
+                .get(robot.model.tool_link)
+                .copied()
+                .unwrap_or(Iso::IDENTITY)
+                .mul(tool),
+            _ => Iso::IDENTITY,
+        }
     }
 
     /// The robot holding part `p`, if one does.

@@ -779,3 +779,87 @@ fn a_record_longer_than_its_chunk_is_damage() {
         "{why}"
     );
 }
+
+#[test]
+fn the_logged_tcp_is_the_tool_the_robot_moves_with() {
+    // A RAPID robot moves with tGun (its TCP 100 mm along the flange's z), then with
+    // tool0. /state's TCP and the `r1:tcp` frame are base × FK × the tool of the motion
+    // under way (tGun until the second motion starts, then tool0), not the workcell's.
+    let dir = std::env::temp_dir().join(format!("vworks-log-tools-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("cell.toml"),
+        "name = \"tools\"\n[[robot]]\nname = \"r1\"\nmodel = \"irb120\"\nprogram = \"r1.mod\"\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("r1.mod"),
+        "MODULE R1
+  PERS tooldata tGun := [TRUE, [[0, 0, 100], [1, 0, 0, 0]], [1, [0, 0, 1], [1, 0, 0, 0], 0, 0, 0]];
+  CONST jointtarget j1 := [[0, 0, 0, 0, 90, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+  CONST jointtarget j2 := [[30, 0, 0, 0, 90, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+  PROC main()
+    MoveAbsJ j1, v1000, fine, tGun;
+    MoveAbsJ j2, v1000, fine, tool0;
+  ENDPROC
+ENDMODULE
+",
+    )
+    .unwrap();
+    let cell = Arc::new(load(&dir.join("cell.toml")).unwrap());
+    let (r, bytes) = run_logged(&cell, 1, None, "tools");
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(r.outcome, Outcome::Completed);
+    let starts: Vec<u64> = r
+        .trace
+        .iter()
+        .filter(|e| e.kind == Kind::MotionStart)
+        .map(|e| e.time as u64)
+        .collect();
+    assert_eq!(starts.len(), 2);
+    let gun = Iso {
+        r: Iso::IDENTITY.r,
+        t: [0.0, 0.0, 0.1],
+    };
+    let robot = &cell.robots[0];
+    let states = states(&bytes);
+    let mut latest: BTreeMap<String, (String, Iso)> = BTreeMap::new();
+    let all = transforms(&bytes);
+    let (mut with_gun, mut with_tool0) = (0, 0);
+    for (i, (t, parent, child, p, q)) in all.iter().enumerate() {
+        latest.insert(child.clone(), (parent.clone(), iso(*p, *q)));
+        if all.get(i + 1).is_some_and(|next| next.0 == *t) {
+            continue;
+        }
+        let tool = if *t < starts[1] {
+            with_gun += 1;
+            gun
+        } else {
+            with_tool0 += 1;
+            Iso::IDENTITY
+        };
+        let (_, q, tcp_p, tcp_q) = &states[t][0];
+        let want = robot
+            .base
+            .mul(&robot.model.fk(q)[robot.model.tool_link])
+            .mul(&tool);
+        let mut framed = Iso::IDENTITY;
+        let mut at = vworks_se::mcaplog::tcp_frame(&robot.name);
+        while at != "world" {
+            let (parent, local) = &latest[&at];
+            framed = local.mul(&framed);
+            at = parent.clone();
+        }
+        for got in [iso(*tcp_p, *tcp_q), framed] {
+            for (w, g) in want
+                .t
+                .iter()
+                .chain(want.r.iter().flatten())
+                .zip(got.t.iter().chain(got.r.iter().flatten()))
+            {
+                assert!((w - g).abs() < 1e-9, "TCP at {t}: {want:?} != {got:?}");
+            }
+        }
+    }
+    assert!(with_gun > 10 && with_tool0 > 10, "{with_gun} {with_tool0}");
+}

@@ -549,6 +549,10 @@ impl Collider {
             let changed = moving[r] || q != self.world.joints[r];
             if changed {
                 self.world.joints[r] = q;
+                // The tool changes only with a motion, so only while the robot moves.
+                if let Some(tool) = self.world.tools.get_mut(r) {
+                    *tool = vm.tool_at(t);
+                }
             }
             any |= changed;
             if r < update.len() {

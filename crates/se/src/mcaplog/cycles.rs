@@ -10,10 +10,11 @@
 //!
 //! The `/tf` tree: `world` → each robot's root link (its base pose) → each link through
 //! its joint (parent link → child link, the joint's own transform) → the robot's TCP
-//! (`robot:tcp`, under its tool link: the workcell's tool); devices and parts under
+//! (`robot:tcp`, under its tool link: the tool the robot moves with — the workcell's
+//! `tool`, or a motion's `tool`, a RAPID tooldata); devices and parts under
 //! `world`. Between keyframes a joint's transform is sent only when its axis value
-//! changed, a device or part only when its pose changed; at a keyframe (t = 0, then at
-//! least every [`KEYFRAME_NS`]) every frame is sent.
+//! changed, a TCP when its tool changed, a device or part only when its pose changed; at
+//! a keyframe (t = 0, then at least every [`KEYFRAME_NS`]) every frame is sent.
 
 use std::sync::Arc;
 
@@ -34,16 +35,18 @@ fn append_pose(b: &mut Vec<u8>, p: &Iso) {
 }
 
 /// Appends the payload of one cycle record: for each robot its axis values (its `dof` of
-/// them) and its TCP in the cell (`frames[r]`: its link frames in the cell), then each
-/// part's pose. [`CycleEncoder::payload_len`] bytes.
+/// them), its TCP in the cell (`frames[r]`: its link frames in the cell; `tools[r]`: its
+/// active tool) and that tool, then each part's pose. [`CycleEncoder::payload_len`]
+/// bytes.
 pub(crate) fn append_cycle(
     b: &mut Vec<u8>,
     cell: &Cell,
     joints: &[[f64; MAX_AXES]],
     frames: &[Vec<Iso>],
+    tools: &[Iso],
     parts: &[Iso],
 ) {
-    for ((robot, q), f) in cell.robots.iter().zip(joints).zip(frames) {
+    for (((robot, q), f), tool) in cell.robots.iter().zip(joints).zip(frames).zip(tools) {
         for v in &q[..robot.model.dof()] {
             b.extend_from_slice(&v.to_le_bytes());
         }
@@ -51,7 +54,8 @@ pub(crate) fn append_cycle(
             .get(robot.model.tool_link)
             .copied()
             .unwrap_or(Iso::IDENTITY);
-        append_pose(b, &flange.mul(&robot.tool));
+        append_pose(b, &flange.mul(tool));
+        append_pose(b, tool);
     }
     for p in parts {
         append_pose(b, p);
@@ -91,7 +95,7 @@ pub fn tcp_frame(robot: &str) -> String {
 struct RobotFrames {
     model: Arc<RobotModel>,
     base: Iso,
-    /// The TCP in the tool link (the workcell's tool).
+    /// The TCP in the tool link last published (NaN before the first keyframe).
     tool: Iso,
     /// Its name as `/state` writes it (JSON: quoted).
     name: String,
@@ -145,7 +149,10 @@ impl CycleEncoder {
             .map(|r| RobotFrames {
                 model: Arc::clone(&r.model),
                 base: r.base,
-                tool: r.tool,
+                tool: Iso {
+                    r: [[f64::NAN; 3]; 3],
+                    t: [f64::NAN; 3],
+                },
                 name: match encoding {
                     Encoding::Json => json::quoted(&r.name),
                     Encoding::Protobuf => r.name.clone(),
@@ -168,7 +175,7 @@ impl CycleEncoder {
     /// Bytes of a cycle record's payload ([`append_cycle`]).
     pub(crate) fn payload_len(&self) -> usize {
         let axes: usize = self.robots.iter().map(|r| r.model.dof()).sum();
-        axes * 8 + (self.robots.len() + self.parts) * POSE_BYTES
+        axes * 8 + (2 * self.robots.len() + self.parts) * POSE_BYTES
     }
 
     /// Encodes the boundary at `time` (the `cycle`-th) from its record `payload`: `/state`
@@ -212,6 +219,7 @@ impl CycleEncoder {
                 *v = take_f64(&mut payload);
             }
             let tcp = take_pose(&mut payload);
+            let tool = take_pose(&mut payload);
             if json {
                 json::robot_state(state, i == 0, &robot.name, &q[..dof], &tcp);
             } else {
@@ -236,10 +244,11 @@ impl CycleEncoder {
             } else {
                 joint_ids.for_each(drop);
             }
-            // The TCP in its tool link never changes either.
+            // The TCP in its tool link changes only with the tool a motion moves with.
             let tcp_id = ids.next().unwrap_or_default();
-            if keyframe {
-                emit(tf, tcp_id, &robot.tool);
+            if keyframe || tool != robot.tool {
+                emit(tf, tcp_id, &tool);
+                robot.tool = tool;
             }
         }
         self.part_poses.clear();

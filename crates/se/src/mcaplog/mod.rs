@@ -487,8 +487,9 @@ impl RunSink for McapLog {
             return Ok(());
         }
         world.part_poses_into(cell, &mut self.parts);
-        let (joints, frames, parts) = (world.joints(), world.frames(), &self.parts);
-        let payload = |b: &mut Vec<u8>| cycles::append_cycle(b, cell, joints, frames, parts);
+        let (joints, frames, tools) = (world.joints(), world.frames(), world.tools());
+        let parts = &self.parts;
+        let payload = |b: &mut Vec<u8>| cycles::append_cycle(b, cell, joints, frames, tools, parts);
         let done = self.sink.cycle(t.max(0) as u64, k, payload);
         done.map_err(|reason| self.failed(reason).to_string())
     }
