@@ -663,6 +663,7 @@ impl Parser<'_, '_> {
         let mut zone = None;
         let mut tool = None;
         let mut orient = None;
+        let mut duration = None;
         loop {
             if self.at_ident("zone") {
                 let t = self.bump();
@@ -686,6 +687,8 @@ impl Parser<'_, '_> {
                 &mut tool
             } else if self.at_ident("orient") {
                 &mut orient
+            } else if self.at_ident("duration") {
+                &mut duration
             } else {
                 break;
             };
@@ -703,7 +706,7 @@ impl Parser<'_, '_> {
                 format!("unknown motion option `{}`", self.text(t.span)),
                 t.span,
             )
-            .with_help("the options are `speed`, `accel`, `orient`, `zone` and `tool`");
+            .with_help("the options are `speed`, `accel`, `orient`, `duration`, `zone` and `tool`");
             return Err(self.report(d));
         }
         self.end(&format!("`{}`", kind.keyword()))?;
@@ -716,6 +719,7 @@ impl Parser<'_, '_> {
             orient,
             zone,
             tool,
+            duration,
         })
     }
 

@@ -238,6 +238,8 @@ pub enum StmtKind {
         zone: Option<Zone>,
         /// `tool e`: the TCP (a pose in the tool link's frame) from this motion on.
         tool: Option<Expr>,
+        /// `duration e`: how long the motion takes, instead of a speed.
+        duration: Option<Expr>,
     },
     /// `delay t;`
     Delay(Expr),

@@ -251,6 +251,9 @@ fn operands(m: &Module, ins: &Instr) -> String {
             if f.has(MoveFlags::TOOL) {
                 parts.push("tool");
             }
+            if f.has(MoveFlags::DURATION) {
+                parts.push("duration");
+            }
             parts.join(" ")
         }
         Instr::WaitUntil(c, t) => format!("c{c}{}", if t { " timeout" } else { "" }),

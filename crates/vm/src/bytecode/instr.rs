@@ -68,32 +68,35 @@ impl Cmp {
 
 /// The operand of the motion instructions: what the stack holds for them.
 #[derive(Clone, Copy, PartialEq, Eq, Debug, Hash, Default)]
-pub struct MoveFlags(pub u8);
+pub struct MoveFlags(pub u16);
 
 impl MoveFlags {
     /// The target is a `joints` value (else a `pose`).
-    pub const TARGET_JOINTS: u8 = 1;
+    pub const TARGET_JOINTS: u16 = 1;
     /// The `via` point of `move_c` is a `joints` value (else a `pose`).
-    pub const VIA_JOINTS: u8 = 2;
+    pub const VIA_JOINTS: u16 = 2;
     /// A `speed` operand is on the stack.
-    pub const SPEED: u8 = 4;
+    pub const SPEED: u16 = 4;
     /// An `accel` operand is on the stack.
-    pub const ACCEL: u8 = 8;
+    pub const ACCEL: u16 = 8;
     /// A `zone` operand (radius in m; 0 for `zone fine`) is on the stack.
-    pub const ZONE: u8 = 16;
+    pub const ZONE: u16 = 16;
     /// A `tool` operand (a pose: the TCP in the tool link's frame) is on the stack, on top;
     /// it becomes the robot's TCP from this motion on.
-    pub const TOOL: u8 = 32;
+    pub const TOOL: u16 = 32;
     /// The `speed` operand of a `move_j` is a TCP speed (m/s), not a ratio.
-    pub const TCP_SPEED: u8 = 64;
+    pub const TCP_SPEED: u16 = 64;
     /// An `orient` operand (rad/s: how fast a `move_l`/`move_c` may turn the TCP) is on the
     /// stack, above `accel`.
-    pub const ORIENT: u8 = 128;
-    /// Every flag: all eight bits are in use.
-    pub const ALL: u8 = 255;
+    pub const ORIENT: u16 = 128;
+    /// A `duration` operand (s: how long the motion takes, instead of its speed) is on
+    /// the stack, on top (above `tool`).
+    pub const DURATION: u16 = 256;
+    /// Every flag.
+    pub const ALL: u16 = 511;
 
     /// True if every bit of `bit` is set.
-    pub fn has(self, bit: u8) -> bool {
+    pub fn has(self, bit: u16) -> bool {
         self.0 & bit == bit
     }
 }
@@ -143,11 +146,16 @@ impl Operand for Cmp {
 
 impl Operand for MoveFlags {
     fn write(self, out: &mut Vec<u8>) {
-        out.push(self.0);
+        out.extend_from_slice(&self.0.to_le_bytes());
     }
     fn read(r: &mut super::encode::Reader<'_>) -> Result<Self, super::LoadError> {
-        // Every bit has a meaning (`MoveFlags::ALL`).
-        let b = r.u8()?;
+        let b = r.u16()?;
+        if b & !MoveFlags::ALL != 0 {
+            return Err(r.error(format!(
+                "motion flags 0x{b:04x} set bits that mean nothing (0x{:04x} are defined)",
+                MoveFlags::ALL
+            )));
+        }
         Ok(MoveFlags(b))
     }
 }
@@ -337,11 +345,11 @@ instruction_set! {
     0x6c CurrentPose;
     /// Pushes the robot's active tool: its TCP in the tool link's frame (the tool the motion now moving or last moved uses, else the workcell's).
     0x6d CurrentTool;
-    /// EVENT `motion_start`: joint move. Pops tool, zone, accel and speed (when flagged), then the target.
+    /// EVENT `motion_start`: joint move. Pops duration, tool, zone, accel and speed (when flagged), then the target.
     0x70 MoveJ(f: MoveFlags);
-    /// EVENT `motion_start`: straight-line move. Pops tool, zone, orient, accel and speed (when flagged), then the target.
+    /// EVENT `motion_start`: straight-line move. Pops duration, tool, zone, orient, accel and speed (when flagged), then the target.
     0x71 MoveL(f: MoveFlags);
-    /// EVENT `motion_start`: circular move. Pops tool, zone, orient, accel and speed (when flagged), then the target and the via point.
+    /// EVENT `motion_start`: circular move. Pops duration, tool, zone, orient, accel and speed (when flagged), then the target and the via point.
     0x72 MoveC(f: MoveFlags);
     /// EVENT: pops a time; the robot holds still that long.
     0x73 Delay;
@@ -450,6 +458,7 @@ impl Instr {
                     + u32::from(f.has(MoveFlags::ACCEL))
                     + u32::from(f.has(MoveFlags::ZONE))
                     + u32::from(f.has(MoveFlags::ORIENT))
+                    + u32::from(f.has(MoveFlags::DURATION))
                     + if f.has(MoveFlags::TOOL) { P } else { 0 };
                 eff(target + via + extra, 0)
             }

@@ -60,6 +60,8 @@ pub(super) struct MotionOperands {
     tcp_speed: bool,
     /// `orient`: the largest orientation speed of a Cartesian motion (rad/s).
     orient: Option<f64>,
+    /// `duration`: how long the motion takes (s), instead of a speed.
+    duration: Option<f64>,
     /// Slots they take on the stack.
     pub(super) width: usize,
 }
@@ -315,6 +317,10 @@ impl Vm {
         };
         let s = &self.main.stack;
         let mut k = 0;
+        let duration = f.has(MoveFlags::DURATION).then(|| {
+            k += 1;
+            f64::from_bits(s[s.len() - k])
+        });
         let tool = f.has(MoveFlags::TOOL).then(|| {
             k += 6;
             to_iso(&s[s.len() - k..s.len() - k + 6])
@@ -360,6 +366,7 @@ impl Vm {
             zone,
             tool,
             orient,
+            duration,
             tcp_speed: f.has(MoveFlags::TCP_SPEED),
             width: k,
         }
@@ -473,6 +480,24 @@ impl Vm {
         )
     }
 
+    /// A warning that a motion asked to take `want` ns takes `lasts` ns, the fastest it
+    /// can (`how`).
+    fn warn_if_longer(&mut self, lasts: i64, want: i64, how: &str) {
+        if lasts > want {
+            let pos = self.m.pos_of(self.main.pc);
+            self.warnings.push(Warning {
+                time: self.time,
+                pos,
+                kind: "duration",
+                message: format!(
+                    "the motion takes {}, longer than the {} asked: it cannot be faster {how}",
+                    fmt_quantity(lasts as f64 / NS, Dim::TIME),
+                    fmt_quantity(want as f64 / NS, Dim::TIME)
+                ),
+            });
+        }
+    }
+
     /// Plans the path and profile of `ins` from the robot's state now (from the corner
     /// of a zoned motion still finishing: see `blend`); returns it and its duration.
     pub(super) fn plan_path(&mut self, ins: Instr) -> Result<(Trajectory, i64), String> {
@@ -483,8 +508,19 @@ impl Vm {
             accel,
             tcp_speed,
             orient,
+            duration,
             ..
         } = self.motion_operands(ins);
+        let duration_ns = match duration {
+            None => None,
+            Some(t) if t.is_finite() && t > 0.0 && t * NS < 1e18 => Some((t * NS).round() as i64),
+            Some(t) => {
+                return Err(format!(
+                    "the duration of a motion must be greater than zero (got {})",
+                    fmt_quantity(t, Dim::TIME)
+                ));
+            }
+        };
         let from = self.rest;
         let target = target_slots.get();
         let n = self.model.dof();
@@ -538,7 +574,16 @@ impl Vm {
                         1.0
                     }
                 }
-                _ => speed.unwrap_or(1.0),
+                _ => match duration_ns {
+                    // The slowest ratio at which the motion takes at most the duration.
+                    Some(t) => {
+                        let lasts = |r: f64| self.plan_joint(from, goal, r, aratio).1;
+                        let ratio = slowest_within(t, 1e-9, 1.0, lasts);
+                        self.warn_if_longer(lasts(ratio), t, "with its slowest axis at full speed");
+                        ratio
+                    }
+                    None => speed.unwrap_or(1.0),
+                },
             };
             if !(ratio > 0.0 && ratio <= 1.0 && aratio > 0.0 && aratio <= 1.0) {
                 return Err(format!(
@@ -565,7 +610,7 @@ impl Vm {
                 Path::arc(start.t, via_t, goal.t).ok_or_else(|| "move_c: the via point lies on the line from start to target; give a point off that line".to_string())?
             }
         };
-        let v = speed.unwrap_or(self.cfg.default_speed);
+        let mut v = speed.unwrap_or(self.cfg.default_speed);
         if v.is_nan() || v <= 0.0 {
             return Err(format!(
                 "the speed must be greater than zero (got {})",
@@ -585,23 +630,53 @@ impl Vm {
                 fmt_quantity(w, Dim::ANGSPEED)
             ));
         }
-        let wa = w / vworks_model::model::DEFAULT_ACCEL_TIME;
+        let mut w = w;
         // With jerk limits, the path's jerk ramps as long as the slowest axis's does.
         let ramp = self.jerk_ramp_time();
-        let mut vs = f64::INFINITY;
-        let mut as_ = f64::INFINITY;
-        let mut js = f64::INFINITY;
-        // Below 0.1 µm and 0.1 µrad a move is a rounding error, not a motion.
-        if len > 1e-7 {
-            vs = vs.min(v / len);
-            as_ = as_.min(a / len);
-            js = js.min(a / ramp / len);
+        // The profile's limits along the path (per unit of its fraction) at TCP speed `v`
+        // and acceleration `a`, orientation speed `w`.
+        let limits = |v: f64, a: f64, w: f64| {
+            let wa = w / vworks_model::model::DEFAULT_ACCEL_TIME;
+            let (mut vs, mut as_, mut js) = (f64::INFINITY, f64::INFINITY, f64::INFINITY);
+            // Below 0.1 µm and 0.1 µrad a move is a rounding error, not a motion.
+            if len > 1e-7 {
+                vs = vs.min(v / len);
+                as_ = as_.min(a / len);
+                js = js.min(a / ramp / len);
+            }
+            if angle > 1e-7 {
+                vs = vs.min(w / angle);
+                as_ = as_.min(wa / angle);
+                js = js.min(wa / ramp / angle);
+            }
+            (vs, as_, js)
+        };
+        let mut a = a;
+        if let Some(t) = duration_ns
+            && (len > 1e-7 || angle > 1e-7)
+        {
+            // The slowest fraction of the fastest TCP and orientation speeds (the TCP's
+            // acceleration with them, unless given; `orient`, if given, stays the
+            // orientation's bound) at which the motion takes at most the duration.
+            let at = |k: f64| {
+                let v = k * MAX_TCP_SPEED;
+                let a = accel.unwrap_or(v / vworks_model::model::DEFAULT_ACCEL_TIME);
+                (v, a, orient.unwrap_or(k * MAX_ORIENT_SPEED))
+            };
+            let lasts = |k: f64| {
+                let (v, a, w) = at(k);
+                let (vs, as_, js) = limits(v, a, w);
+                Profile::with_jerk(1.0, vs, as_, js).duration_ns()
+            };
+            let k = slowest_within(t, 1e-12, 1.0, lasts);
+            (v, a, w) = at(k);
+            self.warn_if_longer(
+                lasts(k),
+                t,
+                "at 7 m/s and 500°/s, the fastest TCP and orientation speeds",
+            );
         }
-        if angle > 1e-7 {
-            vs = vs.min(w / angle);
-            as_ = as_.min(wa / angle);
-            js = js.min(wa / ramp / angle);
-        }
+        let (mut vs, mut as_, mut js) = limits(v, a, w);
         if !vs.is_finite() {
             let traj = Trajectory::Cartesian {
                 path,
@@ -688,4 +763,34 @@ impl Vm {
             dur,
         ))
     }
+}
+
+/// The fastest TCP speed a motion given a `duration` may use (m/s): RAPID's `v7000`.
+const MAX_TCP_SPEED: f64 = 7.0;
+
+/// The fastest orientation speed a motion given a `duration` may use (rad/s): 500°/s, the
+/// `v_ori` of RAPID's speeds.
+const MAX_ORIENT_SPEED: f64 = 500.0 * std::f64::consts::PI / 180.0;
+
+/// The smallest rate in `lo..=hi` at which a motion lasts at most `want` ns (`lasts`:
+/// its duration at a rate, not increasing with it), found by bisection; `hi` if even it
+/// lasts longer.
+fn slowest_within(want: i64, lo: f64, hi: f64, lasts: impl Fn(f64) -> i64) -> f64 {
+    if lasts(hi) > want {
+        return hi;
+    }
+    let (mut lo, mut hi) = (lo, hi);
+    if lasts(lo) <= want {
+        return lo;
+    }
+    // 80 halvings take the interval below f64's resolution around the answer.
+    for _ in 0..80 {
+        let mid = 0.5 * (lo + hi);
+        if lasts(mid) <= want {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    hi
 }

@@ -161,6 +161,7 @@ impl Compiler<'_> {
                 orient,
                 zone,
                 tool,
+                duration,
             } => self.move_stmt(
                 *kind,
                 via.as_ref(),
@@ -171,6 +172,7 @@ impl Compiler<'_> {
                     orient: orient.as_ref(),
                     zone: zone.as_ref(),
                     tool: tool.as_ref(),
+                    duration: duration.as_ref(),
                 },
                 sp,
             ),
@@ -779,6 +781,7 @@ impl Compiler<'_> {
             orient,
             zone,
             tool,
+            duration,
         }: MoveOptions<'_>,
         sp: Span,
     ) {
@@ -871,6 +874,24 @@ impl Compiler<'_> {
             let what = format!("the tool of `{}`", kind.keyword());
             self.coerce(out, Ty::Pose, t.span, &what);
         }
+        if let Some(d) = duration {
+            flags |= MoveFlags::DURATION;
+            if let Some(s) = speed {
+                self.err(
+                    Diagnostic::error(
+                        Code::E0022,
+                        format!(
+                            "`{}` is given both a `speed` and a `duration`: the duration sets the speed",
+                            kind.keyword()
+                        ),
+                        d.span,
+                    )
+                    .with_related(s.span, "the speed")
+                    .with_help("keep one of them"),
+                );
+            }
+            self.motion_rate(kind, d, Dim::TIME, "duration");
+        }
         let f = MoveFlags(flags);
         self.emit(
             match kind {
@@ -888,7 +909,7 @@ impl Compiler<'_> {
         let out = self.expr(e);
         let what = format!("the {what} of `{}`", kind.keyword());
         let tcp_speed = kind == MoveKind::J && dim == Dim::SPEED && out.ty == Ty::Num(Dim::SPEED);
-        if kind == MoveKind::J && !tcp_speed {
+        if kind == MoveKind::J && !tcp_speed && (dim == Dim::SPEED || dim == Dim::ACCEL) {
             self.ratio(out, e.span, &what, "50%");
             return false;
         }
@@ -1058,4 +1079,5 @@ pub(super) struct MoveOptions<'a> {
     pub(super) orient: Option<&'a Expr>,
     pub(super) zone: Option<&'a Zone>,
     pub(super) tool: Option<&'a Expr>,
+    pub(super) duration: Option<&'a Expr>,
 }

@@ -3,7 +3,7 @@ MODULE m
   PROC main()
     SearchL \Stop, diSensor, pFound, pEnd, v100, tool0;
     GOTO done;
-    MoveL pEnd, v100 \T:=3, fine, tool0;
+    MoveL pEnd, v100 \Inpos:=inpos50, fine, tool0;
   ERROR
     RETRY;
   ENDPROC

@@ -744,10 +744,11 @@ impl Tr<'_> {
         let (p, opts) = self.split_args(f, args, n..=n, opts_ok, span)?;
         let mut v_override = None;
         let mut z_override = None;
+        let mut duration = None;
         let mut wobj = None;
         for (k, name, v) in &opts {
             match k.as_str() {
-                "v" | "z" => {
+                "v" | "z" | "t" => {
                     let Some(e) = v else {
                         self.error(
                             Code::E0301,
@@ -757,10 +758,10 @@ impl Tr<'_> {
                         return None;
                     };
                     let x = self.value(e, Ty::Num)?.leaf();
-                    if k == "v" {
-                        v_override = Some(b::with_unit(x, Dim::SPEED));
-                    } else {
-                        z_override = Some(b::with_unit(x, Dim::LENGTH));
+                    match k.as_str() {
+                        "v" => v_override = Some(b::with_unit(x, Dim::SPEED)),
+                        "z" => z_override = Some(b::with_unit(x, Dim::LENGTH)),
+                        _ => duration = Some(b::with_unit(x, Dim::TIME)),
                     }
                 }
                 "wobj" => {
@@ -774,11 +775,16 @@ impl Tr<'_> {
                     };
                     wobj = Some(self.value(e, Ty::Wobj)?);
                 }
-                "t" | "inpos" | "corr" => {
+                "inpos" | "corr" => {
+                    let help = if k == "inpos" {
+                        "vworks's robot is at a `fine` point exactly when its motion ends: use `fine` without `\\Inpos`"
+                    } else {
+                        "path correction needs a sensor vworks does not simulate: remove `\\Corr`"
+                    };
                     self.unsupported(
                         &format!("the motion option `\\{}`", name.text),
                         name.span,
-                        "give the motion its speed instead",
+                        help,
                     );
                     return None;
                 }
@@ -829,16 +835,19 @@ impl Tr<'_> {
             _ => w::MoveKind::J,
         };
         // MoveJ and MoveAbsJ take the TCP speed too (WSL's `move_j … speed 250mm/s`).
+        // `\T` replaces the speeddata: the motion takes that long.
+        let timed = duration.is_some();
         Some(w::StmtKind::Move {
             kind,
             via,
             target,
-            speed: Some(v_tcp),
+            speed: (!timed).then_some(v_tcp),
             accel: None,
             // The orientation speed of the speeddata, for the Cartesian motions.
-            orient: (kind != w::MoveKind::J).then(|| speed.parts[1].clone()),
+            orient: (kind != w::MoveKind::J && !timed).then(|| speed.parts[1].clone()),
             zone: Some(zone),
             tool: Some(tool),
+            duration,
         })
     }
 
