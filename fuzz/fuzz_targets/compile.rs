@@ -10,7 +10,7 @@ fuzz_target!(|data: &[u8]| {
         Ok(out) => {
             let back = vworks_vm::Module::decode(&out.module.encode()).expect("a compiled module round-trips");
             assert_eq!(back, out.module);
-            let _ = vworks_vm::bytecode::disassemble(&out.module, Some(src));
+            let _ = vworks_vm::bytecode::disassemble(&out.module, &[src]);
         }
         Err(e) => {
             assert!(!e.diagnostics.is_empty());

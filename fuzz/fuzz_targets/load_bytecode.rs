@@ -13,7 +13,7 @@ fuzz_target!(|data: &[u8]| {
         b[12..16].copy_from_slice(&crc.to_le_bytes());
     }
     if let Ok(m) = vworks_vm::Module::decode(&b) {
-        let _ = vworks_vm::bytecode::disassemble(&m, None);
+        let _ = vworks_vm::bytecode::disassemble(&m, &[]);
         // A module that loads re-encodes to bytes that load to the same module.
         let again = vworks_vm::Module::decode(&m.encode()).expect("re-encoded module loads");
         assert_eq!(again, m);
