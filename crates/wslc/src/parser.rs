@@ -765,6 +765,23 @@ impl Parser<'_, '_> {
     }
 
     fn expr_stmt(&mut self) -> PResult<StmtKind> {
+        // `pulse g for t;` — `pulse` is special only there, so it stays usable as a name.
+        let kind_at = |k: usize| self.toks.get(self.pos + k).map(|t| &t.kind);
+        if self.at_ident("pulse")
+            && kind_at(1) == Some(&TokKind::Ident)
+            && kind_at(2) == Some(&TokKind::Kw(Kw::For))
+        {
+            self.bump();
+            let name = self.bump();
+            let global = Ident {
+                name: self.text(name.span).to_string(),
+                span: name.span,
+            };
+            self.bump();
+            let length = self.expr()?;
+            self.end("the pulse")?;
+            return Ok(StmtKind::Pulse { global, length });
+        }
         let target = self.expr()?;
         let op = match self.kind() {
             TokKind::P(Punct::Assign) => Some(None),

@@ -243,6 +243,13 @@ pub enum StmtKind {
     },
     /// `delay t;`
     Delay(Expr),
+    /// `pulse g for t;`: global `g` to 1 now, back to 0 after `t`.
+    Pulse {
+        /// The global.
+        global: Ident,
+        /// How long.
+        length: Expr,
+    },
     /// `wait_until c [timeout t];`
     WaitUntil {
         /// Condition over globals.

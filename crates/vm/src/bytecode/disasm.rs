@@ -215,7 +215,9 @@ fn operands(m: &Module, ins: &Instr) -> String {
             format!("v{s}{}", var_name(m, s))
         }
         Instr::LoadVarN(s, n) | Instr::StoreVarN(s, n) => format!("v{s} {n}{}", var_name(m, s)),
-        Instr::LoadGlobal(g) | Instr::StoreGlobal(g) => format!("g{g} ({})", global_name(m, g)),
+        Instr::LoadGlobal(g) | Instr::StoreGlobal(g) | Instr::PulseGlobal(g) => {
+            format!("g{g} ({})", global_name(m, g))
+        }
         Instr::CmpI(c) | Instr::CmpF(c) | Instr::CmpB(c) => c.symbol().to_string(),
         Instr::Jump(t) | Instr::JumpIfFalse(t) | Instr::JumpIfTrue(t) => format!("-> {t}"),
         Instr::Call(p) | Instr::Disable(p) => proc_name(m, p).to_string(),

@@ -251,6 +251,8 @@ instruction_set! {
     0x20 LoadGlobal(g: u32);
     /// EVENT `set`: pops a value and assigns it to global `g`.
     0x21 StoreGlobal(g: u32);
+    /// EVENT `set`: pops a time and sets global `g` (an int or a bool) to 1 now and back to 0 that time later, as a controller's I/O ends a pulse: whatever the program does meanwhile, even after it has ended.
+    0x22 PulseGlobal(g: u32);
     /// int `a + b` (overflow is a run-time error).
     0x30 AddI;
     /// int `a - b`.
@@ -413,7 +415,10 @@ impl Instr {
             Instr::PushConst(k) => eff(0, u32::from(m.consts.get(k as usize)?.ty.width())),
             Instr::Pop(n) => eff(u32::from(n), 0),
             Instr::LoadLocal(_) | Instr::LoadVar(_) | Instr::LoadGlobal(_) => eff(0, 1),
-            Instr::StoreLocal(_) | Instr::StoreVar(_) | Instr::StoreGlobal(_) => eff(1, 0),
+            Instr::StoreLocal(_)
+            | Instr::StoreVar(_)
+            | Instr::StoreGlobal(_)
+            | Instr::PulseGlobal(_) => eff(1, 0),
             Instr::LoadLocalN(_, n) | Instr::LoadVarN(_, n) => eff(0, u32::from(n)),
             Instr::StoreLocalN(_, n) | Instr::StoreVarN(_, n) => eff(u32::from(n), 0),
             Instr::StoreLocalJoint(_) | Instr::StoreVarJoint(_) => eff(2, 0),
@@ -479,6 +484,7 @@ impl Instr {
         matches!(
             self,
             Instr::StoreGlobal(_)
+                | Instr::PulseGlobal(_)
                 | Instr::MoveJ(_)
                 | Instr::MoveL(_)
                 | Instr::MoveC(_)

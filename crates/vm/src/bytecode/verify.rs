@@ -258,6 +258,13 @@ impl Module {
                 }
                 Instr::LoadGlobal(g) => (g as usize) < self.globals.len(),
                 Instr::StoreGlobal(g) => (g as usize) < self.globals.len() && !zero_time,
+                Instr::PulseGlobal(g) => {
+                    !zero_time
+                        && self
+                            .globals
+                            .get(g as usize)
+                            .is_some_and(|x| matches!(x.ty, Type::Int | Type::Bool))
+                }
                 Instr::PushConst(k) => (k as usize) < self.consts.len(),
                 Instr::MakeJoints(c) => c >= 1 && c as usize <= MAX_AXES,
                 Instr::PoseGet(f) => f < 6,

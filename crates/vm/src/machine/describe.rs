@@ -23,6 +23,21 @@ impl Vm {
                 value: self.top(in_handler, 0),
                 ty: self.m.globals[g as usize].ty,
             },
+            Instr::PulseGlobal(g) => {
+                let secs = f64::from_bits(self.top(in_handler, 0));
+                if secs.is_nan() || secs < 0.0 {
+                    return Err(format!(
+                        "a pulse must last 0 s or more (got {})",
+                        fmt_quantity(secs, Dim::TIME)
+                    ));
+                }
+                span_ns(secs, t, "the pulse")?;
+                EventKind::Set {
+                    global: g,
+                    value: 1,
+                    ty: self.m.globals[g as usize].ty,
+                }
+            }
             Instr::When(h) => {
                 if self.m.handlers[h as usize].trigger.has_operand() {
                     self.check_trigger(h, self.top(in_handler, 0), t)?;

@@ -22,6 +22,10 @@ mod blend;
 mod describe;
 mod handlers;
 mod plan;
+mod pulses;
+mod view;
+
+use view::View;
 mod waits;
 
 use blend::{Fading, Planned};
@@ -358,6 +362,8 @@ enum Source {
     Main,
     Handler,
     Fire(usize),
+    /// The end of a pulse (an index into `pulses`).
+    Pulse(usize),
     None,
 }
 
@@ -404,6 +410,8 @@ pub struct Vm {
     enabled: Vec<Enabled>,
     /// Condition handlers whose edge was seen: (time, enabled index).
     fires: Vec<(i64, usize)>,
+    /// Pulses under way, in the order they started.
+    pulses: Vec<pulses::PulseEnd>,
     /// Outstanding remote requests: (parallel depth, request number).
     join: Vec<(u32, u64)>,
     par_depth: u32,
@@ -434,54 +442,6 @@ struct ReadLog {
     at: Vec<i64>,
     /// The globals first read at their instant since the SE last took them, and where.
     new: Vec<(u32, SrcPos)>,
-}
-
-struct View<'a> {
-    vm: &'a Vm,
-    t: i64,
-    /// Where reads of globals are noted for race warnings: those of the main program and
-    /// of handlers, not of conditions (which `check_wait`/`check_when` re-test).
-    reads: Option<&'a std::cell::RefCell<ReadLog>>,
-}
-
-impl Reader for View<'_> {
-    fn global(&self, g: u32, pc: u32) -> u64 {
-        if let Some(log) = self.reads {
-            let log = &mut *log.borrow_mut();
-            if let Some(at) = log.at.get_mut(g as usize)
-                && *at != self.t
-            {
-                *at = self.t;
-                log.new.push((g, self.vm.m.pos_of(pc)));
-            }
-        }
-        self.vm.globals.get(g as usize).copied().unwrap_or(0)
-    }
-    fn now_s(&self) -> f64 {
-        self.t as f64 / NS
-    }
-    fn cycle(&self) -> i64 {
-        self.t / self.vm.cfg.cycle_ns.max(1)
-    }
-    fn timed_out(&self) -> bool {
-        self.vm.timed_out
-    }
-    fn joints(&self) -> [f64; MAX_AXES] {
-        self.vm.joints_at(self.t)
-    }
-    fn tcp(&self) -> [f64; 6] {
-        let tcp = self.vm.tcp_at(self.t);
-        let rpy = tcp.rpy();
-        [tcp.t[0], tcp.t[1], tcp.t[2], rpy[0], rpy[1], rpy[2]]
-    }
-    fn tool(&self) -> [f64; 6] {
-        let tool = self.vm.tool_at(self.t);
-        let rpy = tool.rpy();
-        [tool.t[0], tool.t[1], tool.t[2], rpy[0], rpy[1], rpy[2]]
-    }
-    fn axes(&self) -> usize {
-        self.vm.model.dof()
-    }
 }
 
 /// `secs` seconds from instant `t` in whole nanoseconds (rounded), if they end by
@@ -556,6 +516,7 @@ impl Vm {
             hrun_handler: 0,
             enabled: Vec::new(),
             fires: Vec::new(),
+            pulses: Vec::new(),
             join: Vec::new(),
             par_depth: 0,
             next_req: 0,
@@ -688,6 +649,9 @@ impl Vm {
         }
         let main = self.main_event();
         let fire = self.next_fire();
+        if let Some(pulse_end) = self.pulse_event(&main, fire) {
+            return pulse_end;
+        }
         match (main, fire) {
             (Next::Event(e), Some((t, i))) if t <= e.time => self.fire_event(t, i),
             (Next::Event(e), _) => {
@@ -873,6 +837,7 @@ impl Vm {
             Source::Main => self.perform_main(),
             Source::Handler => self.perform_handler(),
             Source::Fire(i) => self.perform_fire(i),
+            Source::Pulse(i) => self.perform_pulse_end(i),
             Source::None => return,
         }
         if self.fading.as_ref().is_some_and(|f| self.time >= f.end()) {
@@ -891,8 +856,11 @@ impl Vm {
         };
         match &e.kind {
             EventKind::Set { global, value, .. } => {
-                th.stack.pop();
+                let top = th.stack.pop();
                 self.set_global(*global, *value);
+                if let (Instr::PulseGlobal(g), Some(secs)) = (ins, top) {
+                    self.start_pulse(g, f64::from_bits(secs), e.time, e.pos);
+                }
             }
             EventKind::Log { .. } => {
                 if let Instr::Log(f) = ins {

@@ -362,25 +362,12 @@ impl Tr<'_> {
                         }
                     }
                 }
-                // The pulse's end is a handler after PLength: the program goes on at once.
-                let end = format!("_pulse_end_{g}");
-                if self.helpers.insert(end.clone()) {
-                    let body = vec![assign(&g, b::expr(w::ExprKind::Int(0), span), span)];
-                    self.items.push(w::Item::Proc(w::ProcDecl {
-                        is_func: false,
-                        name: b::ident(&end, span),
-                        params: Vec::new(),
-                        ret: None,
-                        body: block(body, span),
-                        span,
-                    }));
-                }
-                out.push(assign(&g, b::expr(w::ExprKind::Int(1), span), span));
+                // WSL's pulse: 1 now, 0 after PLength by the robot's I/O; the program goes on
+                // at once, and the pulse ends even if the program ends first.
                 out.push(w::Stmt {
-                    kind: w::StmtKind::When {
-                        trigger: w::TriggerExpr::After(length),
-                        handler: b::ident(&end, span),
-                        args: Vec::new(),
+                    kind: w::StmtKind::Pulse {
+                        global: b::ident(&g, span),
+                        length,
                     },
                     span,
                 });
