@@ -161,6 +161,8 @@ def test_compile_files_makes_one_program_of_a_tasks_modules():
     assert "tools.mod:4:10" in first.rendered
     with pytest.raises(ValueError, match="at least one"):
         vworks.compile_files([])
+    with pytest.raises(ValueError, match="one language"):
+        vworks.compile_files([("main.mod", main), ("lib.wsl", "proc f() {}\n")])
 
 
 def test_a_rapid_cell_runs_from_python():

@@ -570,7 +570,12 @@ fn program_files(
         .iter()
         .map(|n| dir.join(n).display().to_string())
         .collect();
-    let language = vworks_wslc::Language::of_path(&paths[0]);
+    if let Err((k, why)) = vworks_wslc::Language::of_files(&names) {
+        return Err(cx.bad(
+            &format!("{at}[{k}]"),
+            format!("{why} (give a robot of each language its own program)"),
+        ));
+    }
     // The same file however it is written (`main.mod`, `./main.mod`).
     let same: Vec<PathBuf> = names
         .iter()
@@ -581,25 +586,11 @@ fn program_files(
                 .collect()
         })
         .collect();
-    for (k, p) in paths.iter().enumerate().skip(1) {
-        if same[..k].contains(&same[k]) {
-            return Err(cx.bad(
-                &format!("{at}[{k}]"),
-                format!("lists `{}` a second time; name each file once", names[k]),
-            ));
-        }
-        if vworks_wslc::Language::of_path(p) != language {
-            return Err(cx.bad(
-                &format!("{at}[{k}]"),
-                format!(
-                    "`{}` is {} but `{}` is {}: a robot's program files are all in one language (give a robot of each language its own program)",
-                    names[k],
-                    vworks_wslc::Language::of_path(p).name(),
-                    names[0],
-                    language.name()
-                ),
-            ));
-        }
+    if let Some(k) = (1..same.len()).find(|&k| same[..k].contains(&same[k])) {
+        return Err(cx.bad(
+            &format!("{at}[{k}]"),
+            format!("lists `{}` a second time; name each file once", names[k]),
+        ));
     }
     Ok(paths)
 }

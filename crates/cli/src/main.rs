@@ -215,17 +215,8 @@ fn compile_program(
     for p in paths {
         texts.push((display(p), read(p)?));
     }
-    let Some((first, _)) = texts.first() else {
-        return Err("name at least one program file".into());
-    };
-    let language = Language::of_path(first);
-    if let Some((other, _)) = texts.iter().find(|(p, _)| Language::of_path(p) != language) {
-        return Err(format!(
-            "`{other}` is {} but `{first}` is {}: one program's files are all in one language",
-            Language::of_path(other).name(),
-            language.name()
-        ));
-    }
+    let names: Vec<&str> = texts.iter().map(|(p, _)| p.as_str()).collect();
+    let language = Language::of_files(&names).map_err(|(_, why)| why)?;
     let mut sources = Sources::new();
     for (name, src) in &texts {
         sources.add(name, src);

@@ -145,11 +145,13 @@ impl Module {
     }
 }
 
-/// The language named `language` (`"wsl"` or `"rapid"`, any case), else by `path`'s
-/// extension, else WSL.
-fn language_of(language: Option<&str>, path: Option<&str>) -> PyResult<vworks_wslc::Language> {
+/// The language named `language` (`"wsl"` or `"rapid"`, any case), else by the
+/// extensions of `paths` (all of one language), else WSL.
+fn language_of(language: Option<&str>, paths: &[&str]) -> PyResult<vworks_wslc::Language> {
     Ok(match language.map(str::to_ascii_lowercase).as_deref() {
-        None => path.map_or(vworks_wslc::Language::Wsl, vworks_wslc::Language::of_path),
+        None => {
+            vworks_wslc::Language::of_files(paths).map_err(|(_, why)| PyValueError::new_err(why))?
+        }
         Some("wsl") => vworks_wslc::Language::Wsl,
         Some("rapid") => vworks_wslc::Language::Rapid,
         Some(other) => {
@@ -172,7 +174,7 @@ pub(crate) fn compile(
     path: Option<&str>,
     language: Option<&str>,
 ) -> PyResult<Module> {
-    let lang = language_of(language, path)?;
+    let lang = language_of(language, path.as_slice())?;
     let path = path.unwrap_or(match lang {
         vworks_wslc::Language::Rapid => "x.mod",
         vworks_wslc::Language::Wsl => "x.wsl",
@@ -182,9 +184,9 @@ pub(crate) fn compile(
 
 /// Compiles one program of several files, `files` as (path, text) in order: a RAPID
 /// task's modules, or a WSL program and its library files. The language is `language`,
-/// or else the first path's extension. Raises `CompileError` (with `.diagnostics`, each
-/// naming its file) if it does not compile, `ValueError` for an unknown language or no
-/// files.
+/// or else the paths' extensions. Raises `CompileError` (with `.diagnostics`, each naming
+/// its file) if it does not compile, `ValueError` for an unknown language, files of two
+/// languages without `language`, or no files.
 #[pyfunction]
 #[pyo3(signature = (files, language = None))]
 pub(crate) fn compile_files(
@@ -192,12 +194,13 @@ pub(crate) fn compile_files(
     files: Vec<(String, String)>,
     language: Option<&str>,
 ) -> PyResult<Module> {
-    let Some((first, _)) = files.first() else {
+    if files.is_empty() {
         return Err(PyValueError::new_err(
             "compile_files needs at least one (path, text) pair",
         ));
-    };
-    let lang = language_of(language, Some(first))?;
+    }
+    let paths: Vec<&str> = files.iter().map(|(p, _)| p.as_str()).collect();
+    let lang = language_of(language, &paths)?;
     compile_program(py, lang, &files)
 }
 

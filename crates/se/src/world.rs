@@ -56,18 +56,6 @@ impl World {
         &self.tools
     }
 
-    /// Robot `r`'s TCP in the cell (identity if there is no robot `r`).
-    pub fn tcp(&self, cell: &Cell, r: usize) -> Iso {
-        match (cell.robots.get(r), self.frames.get(r), self.tools.get(r)) {
-            (Some(robot), Some(f), Some(tool)) => f
-                .get(robot.model.tool_link)
-                .copied()
-                .unwrap_or(Iso::IDENTITY)
-                .mul(tool),
-            _ => Iso::IDENTITY,
-        }
-    }
-
     /// The robot holding part `p`, if one does.
     pub fn holder(&self, p: usize) -> Option<usize> {
         self.held.get(p).copied().flatten().map(|(r, _)| r)

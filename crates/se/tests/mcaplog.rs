@@ -505,6 +505,29 @@ fn protobuf_and_json_logs_carry_the_same_states_and_poses() {
     assert_eq!(tf_pb.iter().filter(|t| t.0 == 0).count(), frames);
 }
 
+/// The latest `/tf` transforms replayed: each frame's parent and pose in it.
+type Latest = BTreeMap<String, (String, Iso)>;
+
+/// Frame `frame`'s pose in `world`: its chain of latest transforms.
+fn in_world(latest: &Latest, frame: &str) -> Iso {
+    let mut pose = Iso::IDENTITY;
+    let mut at = frame.to_string();
+    while at != "world" {
+        let (parent, local) = &latest[&at];
+        pose = local.mul(&pose);
+        at = parent.clone();
+    }
+    pose
+}
+
+/// True if every rotation and translation entry of `a` and `b` is within 1e-9.
+fn close(a: &Iso, b: &Iso) -> bool {
+    a.t.iter()
+        .chain(a.r.iter().flatten())
+        .zip(b.t.iter().chain(b.r.iter().flatten()))
+        .all(|(x, y)| (x - y).abs() < 1e-9)
+}
+
 #[test]
 fn frame_transforms_are_the_forward_kinematics_of_the_logged_joints() {
     // /tf is a tree (world → each robot's root link → its links by joint; devices and parts
@@ -516,17 +539,7 @@ fn frame_transforms_are_the_forward_kinematics_of_the_logged_joints() {
         let (r, bytes) = run_logged(&cell, 1, Some(20_000_000_000), &format!("fk-{name}"));
         assert!(r.log_error.is_none());
         let states = states(&bytes);
-        let mut latest: BTreeMap<String, (String, Iso)> = BTreeMap::new();
-        let world = |latest: &BTreeMap<String, (String, Iso)>, frame: &str| {
-            let mut pose = Iso::IDENTITY;
-            let mut at = frame.to_string();
-            while at != "world" {
-                let (parent, local) = &latest[&at];
-                pose = local.mul(&pose);
-                at = parent.clone();
-            }
-            pose
-        };
+        let mut latest = Latest::new();
         let all = transforms(&bytes);
         let mut checked = 0;
         for (i, (t, parent, child, p, q)) in all.iter().enumerate() {
@@ -539,35 +552,21 @@ fn frame_transforms_are_the_forward_kinematics_of_the_logged_joints() {
                 let (_, q, tcp_p, tcp_q) = &states[t][r];
                 let fk = robot.model.fk(q);
                 for (l, link) in robot.model.links.iter().enumerate() {
-                    let got = world(&latest, &format!("{}.{}", robot.name, link.name));
+                    let got = in_world(&latest, &format!("{}.{}", robot.name, link.name));
                     let want = robot.base.mul(&fk[l]);
-                    for (w, g) in want
-                        .t
-                        .iter()
-                        .chain(want.r.iter().flatten())
-                        .zip(got.t.iter().chain(got.r.iter().flatten()))
-                    {
-                        assert!(
-                            (w - g).abs() < 1e-9,
-                            "{name} {}.{} at {t}",
-                            robot.name,
-                            link.name
-                        );
-                    }
+                    assert!(
+                        close(&want, &got),
+                        "{name} {}.{} at {t}",
+                        robot.name,
+                        link.name
+                    );
                     checked += 1;
                 }
                 let tcp = robot.base.mul(&fk[robot.model.tool_link]).mul(&robot.tool);
                 let logged = iso(*tcp_p, *tcp_q);
-                let framed = world(&latest, &vworks_se::mcaplog::tcp_frame(&robot.name));
+                let framed = in_world(&latest, &vworks_se::mcaplog::tcp_frame(&robot.name));
                 for got in [logged, framed] {
-                    for (w, g) in tcp
-                        .t
-                        .iter()
-                        .chain(tcp.r.iter().flatten())
-                        .zip(got.t.iter().chain(got.r.iter().flatten()))
-                    {
-                        assert!((w - g).abs() < 1e-9, "{name} {} TCP at {t}", robot.name);
-                    }
+                    assert!(close(&tcp, &got), "{name} {} TCP at {t}", robot.name);
                 }
             }
         }
@@ -823,7 +822,7 @@ ENDMODULE
     };
     let robot = &cell.robots[0];
     let states = states(&bytes);
-    let mut latest: BTreeMap<String, (String, Iso)> = BTreeMap::new();
+    let mut latest = Latest::new();
     let all = transforms(&bytes);
     let (mut with_gun, mut with_tool0) = (0, 0);
     for (i, (t, parent, child, p, q)) in all.iter().enumerate() {
@@ -843,22 +842,9 @@ ENDMODULE
             .base
             .mul(&robot.model.fk(q)[robot.model.tool_link])
             .mul(&tool);
-        let mut framed = Iso::IDENTITY;
-        let mut at = vworks_se::mcaplog::tcp_frame(&robot.name);
-        while at != "world" {
-            let (parent, local) = &latest[&at];
-            framed = local.mul(&framed);
-            at = parent.clone();
-        }
+        let framed = in_world(&latest, &vworks_se::mcaplog::tcp_frame(&robot.name));
         for got in [iso(*tcp_p, *tcp_q), framed] {
-            for (w, g) in want
-                .t
-                .iter()
-                .chain(want.r.iter().flatten())
-                .zip(got.t.iter().chain(got.r.iter().flatten()))
-            {
-                assert!((w - g).abs() < 1e-9, "TCP at {t}: {want:?} != {got:?}");
-            }
+            assert!(close(&want, &got), "TCP at {t}: {want:?} != {got:?}");
         }
     }
     assert!(with_gun > 10 && with_tool0 > 10, "{with_gun} {with_tool0}");

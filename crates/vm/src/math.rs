@@ -36,7 +36,7 @@ fn frame(p: Pose6) -> ([[f64; 3]; 3], [f64; 3]) {
 }
 
 /// A pose from a rotation matrix and a translation (angles as the robot models read them).
-fn pose_of(r: [[f64; 3]; 3], t: [f64; 3]) -> Pose6 {
+pub(crate) fn pose_of(r: [[f64; 3]; 3], t: [f64; 3]) -> Pose6 {
     let rpy = vworks_model::math::Iso { r, t }.rpy();
     [t[0], t[1], t[2], rpy[0], rpy[1], rpy[2]]
 }

@@ -128,30 +128,12 @@ pub fn compile_files(files: &[(&str, &str)]) -> Result<Compiled, CompileError> {
     let mut diags = Vec::new();
     let mut ast = syntax::SourceModule { items: Vec::new() };
     for (_, start, text) in program.files() {
-        let first_new = diags.len();
-        let mut toks = lexer::lex(text, &mut diags);
-        for t in &mut toks {
-            t.span = t.span.shifted(start);
-        }
-        shift_diagnostics(&mut diags[first_new..], start);
+        let toks = program::ProgramText::lex(start, text, &mut diags, lexer::lex, |t| &mut t.span);
         ast.items
             .extend(parser::parse(program.text(), toks, &mut diags).items);
     }
     let syntax_ok = !diags.iter().any(Diagnostic::is_error);
     finish(&program, syntax_ok.then_some(&ast), diags)
-}
-
-/// Moves the spans of diagnostics made on one file's text by `by` bytes: onto the joined
-/// text of a program of several files.
-pub(crate) fn shift_diagnostics(diags: &mut [Diagnostic], by: usize) {
-    for d in diags {
-        let places = std::iter::once(&mut d.at).chain(d.related.iter_mut().map(|n| &mut n.at));
-        for loc in places {
-            if let Some(s) = loc.span.as_mut() {
-                *s = s.shifted(by);
-            }
-        }
-    }
 }
 
 /// The language of a program file, from its extension: RAPID for `.mod`, `.modx`, `.sys`,
@@ -171,6 +153,28 @@ impl Language {
             Language::Rapid
         } else {
             Language::Wsl
+        }
+    }
+
+    /// The language of a program of several files: the first file's, which every other
+    /// must share; else the index of the first file in another language and a message
+    /// naming both. (WSL for no files.)
+    pub fn of_files(paths: &[&str]) -> Result<Language, (usize, String)> {
+        let Some(first) = paths.first() else {
+            return Ok(Language::Wsl);
+        };
+        let language = Language::of_path(first);
+        match paths.iter().position(|p| Language::of_path(p) != language) {
+            None => Ok(language),
+            Some(k) => Err((
+                k,
+                format!(
+                    "`{}` is {} but `{first}` is {}: one program's files are all in one language",
+                    paths[k],
+                    Language::of_path(paths[k]).name(),
+                    language.name()
+                ),
+            )),
         }
     }
 

@@ -69,6 +69,31 @@ impl ProgramText {
             .map(|(i, f)| (i, f.start, &self.text[f.start..f.start + f.len]))
     }
 
+    /// Lexes a file's `text` (at byte `start` of the joined text) with its front-end's
+    /// `lex`, moving the spans of its tokens (`span_of`) and of the diagnostics it adds
+    /// onto the joined text.
+    pub(crate) fn lex<T>(
+        start: usize,
+        text: &str,
+        diags: &mut Vec<Diagnostic>,
+        lex: impl FnOnce(&str, &mut Vec<Diagnostic>) -> Vec<T>,
+        span_of: impl Fn(&mut T) -> &mut Span,
+    ) -> Vec<T> {
+        let first_new = diags.len();
+        let mut toks = lex(text, diags);
+        for t in &mut toks {
+            let s = span_of(t);
+            *s = s.shifted(start);
+        }
+        for d in &mut diags[first_new..] {
+            let places = std::iter::once(&mut d.at).chain(d.related.iter_mut().map(|n| &mut n.at));
+            for s in places.filter_map(|loc| loc.span.as_mut()) {
+                *s = s.shifted(start);
+            }
+        }
+        toks
+    }
+
     /// The index of the file that holds byte `offset` of the joined text (the last file
     /// for an offset past the end; the first for a program without files).
     fn file_at(&self, offset: usize) -> usize {

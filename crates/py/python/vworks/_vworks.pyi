@@ -113,8 +113,9 @@ def compile_files(
     language: Optional[Literal["wsl", "rapid"]] = None,
 ) -> Module:
     """Compiles one program of several files, `files` as (path, text) in order: a RAPID
-    task's modules, or a WSL program and its library files (`language`, else the first
-    path's extension); raises `CompileError` if it does not compile."""
+    task's modules, or a WSL program and its library files (`language`, else the paths'
+    extensions, all of one language: else `ValueError`); raises `CompileError` if it does
+    not compile."""
 
 def load_cell(path: Union[str, os.PathLike[str]]) -> Cell:
     """Loads a workcell file; raises `CellError`, `CompileError` or `LinkError`."""

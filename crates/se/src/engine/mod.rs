@@ -411,11 +411,8 @@ impl Simulation {
 
     /// The file of robot `r`'s program that `pos` is in, as messages name it (its file
     /// name).
-    fn short(&self, r: usize, pos: SrcPos) -> String {
-        let f = self.cell.robots[r].module.file_of(pos);
-        std::path::Path::new(f)
-            .file_name()
-            .map_or(f.to_string(), |n| n.to_string_lossy().into_owned())
+    fn short(&self, r: usize, pos: SrcPos) -> &str {
+        self.cell.robots[r].module.file_name_of(pos)
     }
 
     fn record(

@@ -1,9 +1,10 @@
 //! The per-cycle topics `/state` and `/tf`, built on the log's writer thread.
 //!
 //! At each logged boundary the simulation hands over what it already has: every robot's
-//! joints and TCP (from the collision check's link frames) and every part's pose
-//! ([`append_cycle`], a few hundred bytes). The writer thread's [`CycleEncoder`] turns that
-//! into the two messages: it computes the transforms of the joints that moved
+//! joints, its tool link's frame (from the collision check's link frames) and active tool,
+//! and every part's pose ([`append_cycle`], a few hundred bytes). The writer thread's
+//! [`CycleEncoder`] turns that into the two messages: it computes each TCP (tool link ×
+//! tool), the transforms of the joints that moved
 //! ([`RobotModel::joint_transform`]: no forward kinematics needed) and encodes `/state`
 //! and the `/tf` tree. So the simulation's thread pays a copy per boundary, and the
 //! rotations, quaternions and encoding run beside it.
@@ -35,9 +36,9 @@ fn append_pose(b: &mut Vec<u8>, p: &Iso) {
 }
 
 /// Appends the payload of one cycle record: for each robot its axis values (its `dof` of
-/// them), its TCP in the cell (`frames[r]`: its link frames in the cell; `tools[r]`: its
-/// active tool) and that tool, then each part's pose. [`CycleEncoder::payload_len`]
-/// bytes.
+/// them), its tool link's frame in the cell (from `frames[r]`, its link frames) and its
+/// active tool (`tools[r]`; the encoder makes the TCP of the two), then each part's pose.
+/// [`CycleEncoder::payload_len`] bytes.
 pub(crate) fn append_cycle(
     b: &mut Vec<u8>,
     cell: &Cell,
@@ -54,7 +55,7 @@ pub(crate) fn append_cycle(
             .get(robot.model.tool_link)
             .copied()
             .unwrap_or(Iso::IDENTITY);
-        append_pose(b, &flange.mul(tool));
+        append_pose(b, &flange);
         append_pose(b, tool);
     }
     for p in parts {
@@ -218,8 +219,9 @@ impl CycleEncoder {
             for v in q.iter_mut().take(dof) {
                 *v = take_f64(&mut payload);
             }
-            let tcp = take_pose(&mut payload);
+            let flange = take_pose(&mut payload);
             let tool = take_pose(&mut payload);
+            let tcp = flange.mul(&tool);
             if json {
                 json::robot_state(state, i == 0, &robot.name, &q[..dof], &tcp);
             } else {

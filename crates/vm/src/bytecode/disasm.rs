@@ -14,9 +14,7 @@ pub fn disassemble(m: &Module, sources: &[&str]) -> String {
     let lines: Vec<Vec<&str>> = sources.iter().map(|s| s.lines().collect()).collect();
     let at = |p: SrcPos| -> String {
         if m.files.len() > 1 {
-            let f = m.file_of(p);
-            let name = f.rsplit(['/', '\\']).next().unwrap_or(f);
-            format!("{name}:{p}")
+            format!("{}:{p}", m.file_name_of(p))
         } else {
             p.to_string()
         }

@@ -405,6 +405,16 @@ impl Module {
             .map_or(self.source_path(), String::as_str)
     }
 
+    /// The name (last path component) of the file a position refers to, as messages and
+    /// listings show it.
+    pub fn file_name_of(&self, pos: SrcPos) -> &str {
+        let path = self.file_of(pos);
+        std::path::Path::new(path)
+            .file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or(path)
+    }
+
     /// The string at index `i` (empty if out of range; verified modules never are).
     pub fn str(&self, i: u32) -> &str {
         self.strings.get(i as usize).map_or("", String::as_str)

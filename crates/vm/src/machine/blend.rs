@@ -230,7 +230,7 @@ impl Vm {
                 format!(
                     "this motion cannot start inside the zone of the motion at line {} of {} within the zone and the axes' limits: the robot stops at that point first (a corner path failure); a larger zone, a lower speed or a jerk limit can let it fly by",
                     at.line,
-                    self.file_name(at)
+                    self.m.file_name_of(at)
                 ),
             );
         }
@@ -261,14 +261,6 @@ impl Vm {
             blend,
             tool: self.tool,
         })
-    }
-
-    /// The name of the program file `at` is in, for messages about another line of it.
-    fn file_name(&self, at: SrcPos) -> String {
-        let path = self.m.file_of(at);
-        std::path::Path::new(path)
-            .file_name()
-            .map_or(path.to_string(), |n| n.to_string_lossy().into_owned())
     }
 
     /// A warning about the statement at `pc`, at `time`, once per statement (a loop
@@ -535,7 +527,7 @@ impl Vm {
             format!(
                 "{what} makes the zoned point of the motion at line {} of {} a stop point: the robot reaches it first; make that motion stop at its point to say so (`zone fine`; in RAPID, `fine`)",
                     at.line,
-                    self.file_name(at)
+                    self.m.file_name_of(at)
             ),
         );
         end

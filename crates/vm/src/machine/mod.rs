@@ -24,12 +24,11 @@ mod handlers;
 mod plan;
 mod pulses;
 mod view;
-
-use view::View;
 mod waits;
 
 use blend::{Fading, Planned};
 use plan::Trajectory;
+use view::View;
 
 /// The latest simulated time an event may have: 2^62 ns, about 146 years. A delay, a
 /// timeout, a motion or a handler period that would end later is a runtime error at its

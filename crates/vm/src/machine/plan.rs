@@ -513,7 +513,7 @@ impl Vm {
         } = self.motion_operands(ins);
         let duration_ns = match duration {
             None => None,
-            Some(t) if t.is_finite() && t > 0.0 && t * NS < 1e18 => Some((t * NS).round() as i64),
+            Some(t) if t > 0.0 => Some(span_ns(t, self.time, "the motion's duration")?),
             Some(t) => {
                 return Err(format!(
                     "the duration of a motion must be greater than zero (got {})",
@@ -617,20 +617,19 @@ impl Vm {
                 fmt_quantity(v, Dim::SPEED)
             ));
         }
-        let a = accel.unwrap_or(v / vworks_model::model::DEFAULT_ACCEL_TIME);
+        let mut a = accel.unwrap_or(v / vworks_model::model::DEFAULT_ACCEL_TIME);
         let len = path.length();
         let angle = vworks_model::math::norm(vworks_model::math::rotation_vector(
             &vworks_model::math::mat_mul(&vworks_model::math::transpose(&start.r), &goal.r),
         ));
         // Orientation moves at most `orient` (180°/s without it), with the same ramp time.
-        let w = orient.unwrap_or(std::f64::consts::PI);
+        let mut w = orient.unwrap_or(std::f64::consts::PI);
         if w.is_nan() || w <= 0.0 {
             return Err(format!(
                 "the orientation speed must be greater than zero (got {})",
                 fmt_quantity(w, Dim::ANGSPEED)
             ));
         }
-        let mut w = w;
         // With jerk limits, the path's jerk ramps as long as the slowest axis's does.
         let ramp = self.jerk_ramp_time();
         // The profile's limits along the path (per unit of its fraction) at TCP speed `v`
@@ -651,7 +650,6 @@ impl Vm {
             }
             (vs, as_, js)
         };
-        let mut a = a;
         if let Some(t) = duration_ns
             && (len > 1e-7 || angle > 1e-7)
         {

@@ -19,7 +19,7 @@ impl Vm {
     /// (checked when the event was described); a new pulse of the same global replaces the
     /// one under way.
     pub(super) fn start_pulse(&mut self, g: u32, secs: f64, t: i64, pos: SrcPos) {
-        let end = t.saturating_add((secs * NS).round() as i64);
+        let end = t.saturating_add(span_ns(secs, t, "the pulse").unwrap_or(0));
         self.pulses.retain(|p| p.global != g);
         self.pulses.push(PulseEnd {
             end,

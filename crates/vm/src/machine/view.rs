@@ -38,13 +38,11 @@ impl Reader for View<'_> {
     }
     fn tcp(&self) -> [f64; 6] {
         let tcp = self.vm.tcp_at(self.t);
-        let rpy = tcp.rpy();
-        [tcp.t[0], tcp.t[1], tcp.t[2], rpy[0], rpy[1], rpy[2]]
+        crate::math::pose_of(tcp.r, tcp.t)
     }
     fn tool(&self) -> [f64; 6] {
         let tool = self.vm.tool_at(self.t);
-        let rpy = tool.rpy();
-        [tool.t[0], tool.t[1], tool.t[2], rpy[0], rpy[1], rpy[2]]
+        crate::math::pose_of(tool.r, tool.t)
     }
     fn axes(&self) -> usize {
         self.vm.model.dof()

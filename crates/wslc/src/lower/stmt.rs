@@ -774,69 +774,38 @@ impl Compiler<'_> {
     /// `pulse g for t;`: the global (an int or a bool) to 1 now and back to 0 after `t`
     /// (not negative), whatever the program does meanwhile.
     fn pulse_stmt(&mut self, global: &Ident, length: &Expr, sp: Span) {
-        let local = self.lookup_local(&global.name).is_some();
-        let g = match self.symbols.get(&global.name).map(|s| s.0.clone()) {
-            _ if local => {
+        let name = &global.name;
+        let sym = match self.lookup_local(name) {
+            Some(_) => Err(format!("`pulse` needs a global, and `{name}` is a local")),
+            None => match self.symbols.get(name).map(|s| s.0.clone()) {
+                Some(Sym::Global(g, Ty::Int | Ty::Bool)) => Ok(Some(g)),
+                Some(Sym::Global(_, ty)) => Err(format!(
+                    "`pulse` sets a global to 1 and back to 0, but `{name}` is {}",
+                    ty.described()
+                )),
+                Some(_) => Err(format!("`pulse` needs a global, and `{name}` is not one")),
+                None => Ok(None),
+            },
+        };
+        let g = match sym {
+            Ok(Some(g)) => Some(g),
+            Ok(None) => {
+                self.unknown_name(name, global.span);
+                None
+            }
+            Err(message) => {
                 self.err(
-                    Diagnostic::error(
-                        Code::E0020,
-                        format!("`pulse` needs a global, and `{}` is a local", global.name),
-                        global.span,
-                    )
-                    .with_help(
-                        "pulse a global (`global name = 0;`): a pulse is a `set` other robots see",
+                    Diagnostic::error(Code::E0020, message, global.span).with_help(
+                        "pulse an int or a bool global (`global name = 0;`): a pulse is a `set` other robots see",
                     ),
                 );
-                None
-            }
-            Some(Sym::Global(g, Ty::Int | Ty::Bool)) => Some(g),
-            Some(Sym::Global(_, ty)) => {
-                self.err(
-                    Diagnostic::error(
-                        Code::E0020,
-                        format!(
-                            "`pulse` sets a global to 1 and back to 0, but `{}` is {}",
-                            global.name,
-                            ty.described()
-                        ),
-                        global.span,
-                    )
-                    .with_help("pulse an int or a bool global (a signal)"),
-                );
-                None
-            }
-            Some(_) => {
-                self.err(
-                    Diagnostic::error(
-                        Code::E0020,
-                        format!("`pulse` needs a global, and `{}` is not one", global.name),
-                        global.span,
-                    )
-                    .with_help(
-                        "declare it with `global name = 0;`: a pulse is a `set` other robots see",
-                    ),
-                );
-                None
-            }
-            None => {
-                self.unknown_name(&global.name, global.span);
                 None
             }
         };
         if !self.not_in_func("pulse a global (that is a `set` event)", sp) {
             return;
         }
-        let out = self.expr(length);
-        let out = self.coerce(out, Ty::Num(Dim::TIME), length.span, "the pulse's length");
-        if let Some(ConstValue::Num(x)) = out.k
-            && x < 0.0
-        {
-            self.err(Diagnostic::error(
-                Code::E0025,
-                "a pulse cannot last less than 0 s",
-                length.span,
-            ));
-        }
+        self.time_operand(length, "the pulse's length");
         if let Some(g) = g {
             self.emit(Instr::PulseGlobal(g), sp);
         }

@@ -119,12 +119,8 @@ pub fn compile_files(
     let mut modules = Vec::new();
     let mut empty = Vec::new();
     for (_, start, text) in program.files() {
-        let first_new = diags.len();
-        let mut toks = lexer::lex(text, &mut diags);
-        for t in &mut toks {
-            t.span = t.span.shifted(start);
-        }
-        crate::shift_diagnostics(&mut diags[first_new..], start);
+        let toks =
+            crate::program::ProgramText::lex(start, text, &mut diags, lexer::lex, |t| &mut t.span);
         let found = parser::parse(program.text(), toks, &mut diags);
         if found.is_empty() {
             empty.push(start);

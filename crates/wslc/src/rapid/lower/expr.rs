@@ -784,8 +784,28 @@ impl Tr<'_> {
         Some(out)
     }
 
-    /// The positional arguments and the optional ones of a built-in, checked against
-    /// `count` and the optional names it takes.
+    /// The value of the optional argument `key` (lower case) among `opts`: `Ok(None)` if
+    /// it is not given, E0301 (`Err`) if it is given without `:=` (`example` shows one).
+    pub(crate) fn opt_value<'e>(
+        &mut self,
+        opts: &[(String, &r::Name, Option<&'e r::Expr>)],
+        key: &str,
+        example: &str,
+    ) -> Result<Option<&'e r::Expr>, ()> {
+        match opts.iter().find(|(k, _, _)| k == key) {
+            None => Ok(None),
+            Some((_, _, Some(e))) => Ok(Some(*e)),
+            Some((_, n, None)) => {
+                self.error(
+                    Code::E0301,
+                    format!("`\\{}` is written `\\{}:={example}`", n.text, n.text),
+                    n.span,
+                );
+                Err(())
+            }
+        }
+    }
+
     /// The TCP now (`current_pose()`), or with `\Tool:=t` among `opts` the TCP of tool
     /// `t`: the flange (the TCP less the active tool) · t's `tframe`.
     fn tcp_with_tool(
@@ -794,12 +814,8 @@ impl Tr<'_> {
         span: Span,
     ) -> Option<w::Expr> {
         let pose = b::call("current_pose", vec![], span);
-        let Some((_, n, v)) = opts.iter().find(|(k, _, _)| k == "tool") else {
+        let Some(e) = self.opt_value(opts, "tool", "tool1").ok()? else {
             return Some(pose);
-        };
-        let Some(e) = v else {
-            self.error(Code::E0301, "`\\Tool` is written `\\Tool:=tool1`", n.span);
-            return None;
         };
         let tool = self.value(e, Ty::Tool)?;
         let active = b::call(
@@ -815,6 +831,8 @@ impl Tr<'_> {
         ))
     }
 
+    /// The positional arguments and the optional ones of a built-in, checked against
+    /// `count` and the optional names it takes.
     pub(crate) fn split_args<'a>(
         &mut self,
         f: &r::Name,
@@ -915,16 +933,8 @@ impl Tr<'_> {
                 let mut out = b::call("tool_offset", a, span);
                 // Rotations about the tool's x, then the new y, then the new z.
                 for axis in ["rx", "ry", "rz"] {
-                    let Some((_, n, v)) = opts.iter().find(|(k, _, _)| k == axis) else {
+                    let Some(e) = self.opt_value(&opts, axis, "degrees").ok()? else {
                         continue;
-                    };
-                    let Some(e) = v else {
-                        self.error(
-                            Code::E0301,
-                            format!("`\\{}` is written `\\{}:=degrees`", n.text, n.text),
-                            n.span,
-                        );
-                        return None;
                     };
                     let angle = b::with_unit(self.value(e, Ty::Num)?.leaf(), Dim::ANGLE);
                     let zero_l = || b::quantity(0.0, Dim::LENGTH, span);
@@ -962,11 +972,7 @@ impl Tr<'_> {
                 )?;
                 let mut pose = self.tcp_with_tool(&opts, span)?;
                 // In a work object: (uframe · oframe)⁻¹ · the TCP.
-                if let Some((_, n, v)) = opts.iter().find(|(k, _, _)| k == "wobj") {
-                    let Some(e) = v else {
-                        self.error(Code::E0301, "`\\WObj` is written `\\WObj:=wobj1`", n.span);
-                        return None;
-                    };
+                if let Some(e) = self.opt_value(&opts, "wobj", "wobj1").ok()? {
                     let w = self.value(e, Ty::Wobj)?;
                     let frame = b::call(
                         "pose_mul",

@@ -23,22 +23,23 @@ use crate::rapid::syntax::{self as r, Arg};
 use crate::syntax::{self as w, Span};
 
 impl Tr<'_> {
-    /// Finds every `CONNECT` of the task.
-    /// Finds every `CONNECT` of the task, and how each interrupt is ordered (`\Single` or
-    /// not), so that `IDelete` knows which handlers it disables wherever it stands.
+    /// Finds every `CONNECT` of the task (with the module it stands in, whose names it
+    /// sees), and every order of an interrupt (`ISignalDI …`, `ITimer …`), so that
+    /// `IDelete` knows which handlers it disables and `IWatch` how to order it again,
+    /// wherever they stand.
     pub(crate) fn collect_connects(&mut self, modules: &[r::RapidModule]) {
         type Found = (
             Vec<(r::Name, r::Name, Span, usize)>,
-            Vec<(String, bool, r::Name, Vec<Arg>)>,
+            Vec<(String, r::Name, Vec<Arg>)>,
             Vec<String>,
         );
         let mut found: Found = (Vec::new(), Vec::new(), Vec::new());
-        fn walk(ss: &[r::Stmt], found: &mut Found) {
+        fn walk(ss: &[r::Stmt], module: usize, found: &mut Found) {
             for s in ss {
                 match &s.kind {
                     r::StmtKind::Connect { intno, trap } => {
                         if let r::ExprKind::Name(n) = &intno.kind {
-                            found.0.push((n.clone(), trap.clone(), s.span, usize::MAX));
+                            found.0.push((n.clone(), trap.clone(), s.span, module));
                         }
                     }
                     r::StmtKind::Call { name, args } => {
@@ -53,7 +54,6 @@ impl Tr<'_> {
                             found.2.push(n.key());
                         }
                         if k.starts_with("isignal") || k == "itimer" {
-                            let single = args.iter().any(|a| matches!(a, Arg::Opt(..)));
                             let last = args.iter().rev().find_map(|a| match a {
                                 Arg::Pos(e) => Some(e),
                                 Arg::Opt(..) => None,
@@ -63,27 +63,27 @@ impl Tr<'_> {
                                 ..
                             }) = last
                             {
-                                found.1.push((n.key(), single, name.clone(), args.clone()));
+                                found.1.push((n.key(), name.clone(), args.clone()));
                             }
                         }
                     }
                     r::StmtKind::If { branches, els } => {
                         for (_, body) in branches {
-                            walk(body, found);
+                            walk(body, module, found);
                         }
                         if let Some(e) = els {
-                            walk(e, found);
+                            walk(e, module, found);
                         }
                     }
                     r::StmtKind::While { body, .. } | r::StmtKind::For { body, .. } => {
-                        walk(body, found)
+                        walk(body, module, found)
                     }
                     r::StmtKind::Test { cases, default, .. } => {
                         for (_, body) in cases {
-                            walk(body, found);
+                            walk(body, module, found);
                         }
                         if let Some(d) = default {
-                            walk(d, found);
+                            walk(d, module, found);
                         }
                     }
                     _ => {}
@@ -91,15 +91,10 @@ impl Tr<'_> {
             }
         }
         for (mi, m) in modules.iter().enumerate() {
-            let first = found.0.len();
             for it in &m.items {
                 if let r::Item::Routine(rt) = it {
-                    walk(&rt.body, &mut found);
+                    walk(&rt.body, mi, &mut found);
                 }
-            }
-            // Each CONNECT names its TRAP as its own module sees names.
-            for c in &mut found.0[first..] {
-                c.3 = mi;
             }
         }
         let (connects, orders, mut parts) = found;
@@ -146,7 +141,8 @@ impl Tr<'_> {
                 }
             }
         }
-        for (intno, single, instr, args) in orders {
+        for (intno, instr, args) in orders {
+            let single = args.iter().any(|a| matches!(a, Arg::Opt(..)));
             self.orders
                 .entry(intno.clone())
                 .or_default()
@@ -345,23 +341,14 @@ impl Tr<'_> {
                 let Some(g) = self.signal_arg(p[0], digital_out) else {
                     return true;
                 };
-                let mut length = b::quantity(0.2, Dim::TIME, span);
-                for (k, n, v) in &opts {
-                    if k == "plength" {
-                        let Some(e) = v else {
-                            self.error(
-                                Code::E0301,
-                                "`\\PLength` is written `\\PLength:=seconds`",
-                                n.span,
-                            );
-                            return true;
-                        };
-                        match self.value(e, Ty::Num) {
-                            Some(v) => length = b::with_unit(v.leaf(), Dim::TIME),
-                            None => return true,
-                        }
-                    }
-                }
+                let length = match self.opt_value(&opts, "plength", "seconds") {
+                    Err(()) => return true,
+                    Ok(None) => b::quantity(0.2, Dim::TIME, span),
+                    Ok(Some(e)) => match self.value(e, Ty::Num) {
+                        Some(v) => b::with_unit(v.leaf(), Dim::TIME),
+                        None => return true,
+                    },
+                };
                 // WSL's pulse: 1 now, 0 after PLength by the robot's I/O; the program goes on
                 // at once, and the pulse ends even if the program ends first.
                 out.push(w::Stmt {

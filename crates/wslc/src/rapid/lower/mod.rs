@@ -37,7 +37,7 @@ pub(crate) fn translate(
         scope: BTreeMap::new(),
         module_scope: BTreeMap::new(),
         module: 0,
-        module_names: Vec::new(),
+        module_names: modules.iter().map(|m| m.name.clone()).collect(),
         items: Vec::new(),
         helpers: BTreeSet::new(),
         locals: Vec::new(),
@@ -52,7 +52,6 @@ pub(crate) fn translate(
         orders: BTreeMap::new(),
         grip_parts: Vec::new(),
     };
-    t.module_names = modules.iter().map(|m| m.name.clone()).collect();
     t.collect(modules);
     t.collect_connects(modules);
     for (k, m) in modules.iter().enumerate() {
