@@ -69,18 +69,20 @@ fn a_set_queues_check_when_behind_events_already_due() {
             )
         })
         .collect();
-    // A's set comes after B's handler was already due and running: B's own due events (its
-    // log) run first, then the check_when the set queued, then the edge fires.
+    // A's entry was due first, and its whole zero-time work at 1 s is one turn (delay_end,
+    // set, end: "One instant, one serial order"). Then B's handler, already due before the
+    // set, runs to its end in B's turn; then the check_when the set queued behind it
+    // (figure 3), and the edge fires.
     assert_eq!(
         at_1s,
         [
             "a delay_end ",
-            "b when_fire tick",
             "a set g=1",
-            "b log \"tick\"",
-            "b check_when g",
             "a end ",
+            "b when_fire tick",
+            "b log \"tick\"",
             "b when_end tick",
+            "b check_when g",
             "b when_fire on",
             "b log \"on\"",
             "b when_end on",

@@ -783,7 +783,8 @@ fn a_record_longer_than_its_chunk_is_damage() {
 fn the_logged_tcp_is_the_tool_the_robot_moves_with() {
     // A RAPID robot moves with tGun (its TCP 100 mm along the flange's z), then with
     // tool0. /state's TCP and the `r1:tcp` frame are base × FK × the tool of the motion
-    // under way (tGun until the second motion starts, then tool0), not the workcell's.
+    // under way (tGun from the first motion's start until the second's, then tool0), not
+    // the workcell's.
     let dir = std::env::temp_dir().join(format!("vworks-log-tools-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(
@@ -830,7 +831,11 @@ ENDMODULE
         if all.get(i + 1).is_some_and(|next| next.0 == *t) {
             continue;
         }
-        let tool = if *t < starts[1] {
+        // At the boundary at 0 s the first motion has not started (a boundary comes before
+        // the events at its time): the workcell's tool.
+        let tool = if *t <= starts[0] {
+            robot.tool
+        } else if *t < starts[1] {
             with_gun += 1;
             gun
         } else {

@@ -103,6 +103,9 @@ pub struct Simulation {
     swept: i64,
     /// Whether to sweep between boundaries at all (see [`Simulation::with_sweep`]).
     sweep: bool,
+    /// The robot whose turn it is at `time`: the entries it queues for itself at that
+    /// instant go before every other (see `queue`).
+    turn: Option<usize>,
     /// Set from outside to stop the run between two events.
     stop: Option<Arc<AtomicBool>>,
     /// The instant being simulated, the queue entries handled at it, and how many the
@@ -232,6 +235,7 @@ impl Simulation {
             swept: 0,
             sweep: true,
             stop: None,
+            turn: None,
             instant: -1,
             instant_entries: 0,
             instant_limit: INSTANT_LIMIT,
@@ -524,11 +528,14 @@ impl Simulation {
         };
         // A stale entry (the robot's next event changed since) is dropped unseen: it must
         // not move the clock (a wait released early leaves its deadline behind).
-        if let Entry::Vm(r, g) = Entry::unpack(entry)
+        if let Entry::Vm(r, g) | Entry::Resume(r, g) = Entry::unpack(entry)
             && g != self.generation[r]
         {
             return true;
         }
+        // The turn ends with the entry before: the boundaries before this one belong to
+        // no robot.
+        self.turn = None;
         if let Some(u) = until
             && t > u
         {
@@ -554,7 +561,15 @@ impl Simulation {
             self.livelock(t);
             return false;
         }
-        match Entry::unpack(entry) {
+        let entry = Entry::unpack(entry);
+        self.turn = Some(entry.robot());
+        match entry {
+            Entry::Resume(r, _) => {
+                // The robot's code runs now, in its turn; the event it stops before is
+                // the next entry if it is due at once.
+                self.queued_at[r] = None;
+                self.requeue(r);
+            }
             Entry::Vm(r, _) => {
                 self.queued_at[r] = None;
                 self.perform(r);
@@ -562,8 +577,13 @@ impl Simulation {
             Entry::CheckWait(r, cg) => {
                 self.record(t, Some(r), Kind::CheckWait, Detail::Global(cg), None);
                 if self.vms[r].check_wait(t) {
-                    // What r does next follows the set that released it.
-                    self.merge_clock(r, Seen::Set(cg as usize));
+                    // What r does next follows the sets whose values released it: the
+                    // condition read every global on its wait list.
+                    for g in 0..self.wait_list.len() {
+                        if self.wait_list[g].contains(&r) {
+                            self.merge_clock(r, Seen::Set(g));
+                        }
+                    }
                     self.requeue(r);
                 } else if let Some(poll) = self.vms[r].take_poll_check() {
                     // A polled wait whose condition holds between polls: tested again at
@@ -574,8 +594,13 @@ impl Simulation {
             Entry::CheckWhen(r, cg) => {
                 self.record(t, Some(r), Kind::CheckWhen, Detail::Global(cg), None);
                 if self.vms[r].check_when(t) > 0 {
-                    // The handlers it fires follow the set that made them fire.
-                    self.merge_clock(r, Seen::Set(cg as usize));
+                    // The handlers it fires follow the sets of every global their
+                    // conditions read (all of r's condition handlers were tested).
+                    for g in 0..self.when_list.len() {
+                        if self.when_list[g].0.iter().any(|(q, _)| *q == r) {
+                            self.merge_clock(r, Seen::Set(g));
+                        }
+                    }
                     self.requeue(r);
                 }
             }

@@ -1,6 +1,14 @@
-//! The event queue: 24-byte entries ordered by (time, tie rank, sequence), a robot's
+//! The event queue: 24-byte entries ordered by (time, turn, tie rank, sequence), a robot's
 //! entry made stale by a generation number when its next event changes, and the small
 //! sorted sets behind the WAIT and WHEN lists.
+//!
+//! **Turns.** The zero-time work robots do at one instant runs as one serial order of the
+//! robots, never interleaved (docs/engine.md, "One instant, one serial order"): the robot
+//! whose entry the engine took last has the *turn*, and whatever it queues for itself at
+//! that instant (its next event, its own `check_wait`/`check_when`) goes before every other
+//! entry of the instant. A robot that must run code before it knows its next event (at the
+//! start; see [`Vm::needs_turn`]) and is queued by another robot's turn gets a `Resume`
+//! entry instead: its code runs when that entry comes up, in its own turn.
 
 use std::cmp::Reverse;
 
@@ -16,6 +24,9 @@ pub(super) enum Entry {
     CheckWait(usize, u32),
     /// Re-test the robot's condition handlers after a set of a global (cell index).
     CheckWhen(usize, u32),
+    /// Run the robot's zero-time code in its own turn, then queue the event it stops
+    /// before (robot, generation).
+    Resume(usize, u64),
 }
 
 impl Entry {
@@ -26,6 +37,7 @@ impl Entry {
             Entry::Vm(r, g) => (0, r, g),
             Entry::CheckWait(r, g) => (1, r, u64::from(g)),
             Entry::CheckWhen(r, g) => (2, r, u64::from(g)),
+            Entry::Resume(r, g) => (3, r, g),
         };
         (payload << 24) | ((r as u64 & 0x3f_ffff) << 2) | kind
     }
@@ -35,17 +47,27 @@ impl Entry {
         match x & 3 {
             0 => Entry::Vm(r, payload),
             1 => Entry::CheckWait(r, payload as u32),
-            _ => Entry::CheckWhen(r, payload as u32),
+            2 => Entry::CheckWhen(r, payload as u32),
+            _ => Entry::Resume(r, payload),
+        }
+    }
+
+    /// The robot the entry is for.
+    pub(super) fn robot(self) -> usize {
+        match self {
+            Entry::Vm(r, _) | Entry::CheckWait(r, _) | Entry::CheckWhen(r, _) => r,
+            Entry::Resume(r, _) => r,
         }
     }
 }
 
-/// An event-queue entry: the earliest time first, then by `key` (the robot's tie rank,
-/// then the order queued), 24 bytes.
+/// An event-queue entry: the earliest time first, then by `key` (the turn's own entries
+/// first, then the robot's tie rank, then the order queued), 24 bytes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub(super) struct Queued {
     pub(super) time: i64,
-    /// Tie rank (high 20 bits) and sequence number (low 44 bits).
+    /// Not the turn's (top bit: 0 for an entry the robot whose turn it is queued for itself
+    /// at the current instant), tie rank (19 bits) and sequence number (low 44 bits).
     pub(super) key: u64,
     pub(super) entry: u64,
 }
@@ -68,6 +90,10 @@ impl<T: Ord + Copy> SortedSet<T> {
         }
     }
 
+    pub(super) fn contains(&self, x: &T) -> bool {
+        self.0.binary_search(x).is_ok()
+    }
+
     pub(super) fn remove(&mut self, x: &T) {
         if let Ok(i) = self.0.binary_search(x) {
             self.0.remove(i);
@@ -86,12 +112,11 @@ impl<T: Ord + Copy> SortedSet<T> {
 impl Simulation {
     pub(super) fn push(&mut self, time: i64, entry: Entry) {
         self.seq += 1;
-        let robot = match entry {
-            Entry::Vm(r, _) | Entry::CheckWait(r, _) | Entry::CheckWhen(r, _) => r,
-        };
+        let robot = entry.robot();
+        let others = u64::from(!(self.turn == Some(robot) && time == self.time));
         self.queue.push(Reverse(Queued {
             time,
-            key: (self.rank[robot] << 44) | (self.seq & ((1 << 44) - 1)),
+            key: (others << 63) | (self.rank[robot] << 44) | (self.seq & ((1 << 44) - 1)),
             entry: entry.pack(),
         }));
     }
@@ -100,7 +125,7 @@ impl Simulation {
     /// queueing order. Each robot's own entries keep their order. For testing that no
     /// result depends on tie order.
     pub fn set_tie_ranks(&mut self, rank: Vec<u64>) {
-        if rank.len() == self.rank.len() && rank.iter().all(|r| *r < 1 << 20) {
+        if rank.len() == self.rank.len() && rank.iter().all(|r| *r < 1 << 19) {
             self.rank = rank;
         }
     }
@@ -109,6 +134,14 @@ impl Simulation {
     pub(super) fn requeue(&mut self, r: usize) {
         self.generation[r] += 1;
         self.queued_at[r] = None;
+        if self.turn != Some(r) && self.vms[r].needs_turn() {
+            // Its code reads the cell's globals: it runs in the robot's own turn.
+            let g = self.generation[r];
+            self.queued_at[r] = Some(self.time);
+            self.pending[r] = None;
+            self.push(self.time, Entry::Resume(r, g));
+            return;
+        }
         let next = self.vms[r].next_event();
         self.note_reads(r);
         if let Next::Event(e) = next {
@@ -136,6 +169,7 @@ mod tests {
             Entry::CheckWait(7, u32::MAX),
             Entry::CheckWhen(63, 5),
             Entry::CheckWait(0, 0),
+            Entry::Resume(9, 1 << 39),
         ] {
             assert_eq!(Entry::unpack(e.pack()), e);
         }

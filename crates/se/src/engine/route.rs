@@ -45,6 +45,12 @@ impl Simulation {
                 let stamp = self.tick(r);
                 for g in &cell.robots[r].module.conds[*cond as usize].globals {
                     let cg = cell.linked.robots[r].globals[*g as usize] as usize;
+                    if passed {
+                        // A wait that passes on a value set earlier at this instant would,
+                        // in the other order, have blocked and been released by that set's
+                        // check_wait at the same instant: it follows the set either way.
+                        self.merge_clock(r, Seen::Set(cg));
+                    }
                     self.check_race(cg, r, t, e.pos, false);
                     if passed {
                         self.last_read[cg] = Some((t, r, e.pos, stamp));

@@ -112,6 +112,13 @@ impl Vm {
         value
     }
 
+    /// Whether the next `next_event` would run zero-time code (the main program's or a
+    /// running handler's) before it knows the event: that code reads the cell's globals,
+    /// so the engine calls it only in the robot's own turn at the instant.
+    pub fn needs_turn(&self) -> bool {
+        matches!(self.state, State::Run) || (self.hrun.is_some() && self.hstate == State::Run)
+    }
+
     /// Whether the VM is blocked in a `wait_until` or `wait_signal` (not released yet).
     pub fn waits(&self) -> bool {
         matches!(self.state, State::Waiting { .. })
