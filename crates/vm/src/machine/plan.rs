@@ -617,6 +617,16 @@ impl Vm {
                 fmt_quantity(v, Dim::SPEED)
             ));
         }
+        if let Some(a) = accel
+            && !(a > 0.0)
+        {
+            // (A param, `--set` or a sweep can make it so at run time; 0 would make the
+            // motion take no time at all.)
+            return Err(format!(
+                "the acceleration must be greater than zero (got {})",
+                fmt_quantity(a, Dim::ACCEL)
+            ));
+        }
         let mut a = accel.unwrap_or(v / vworks_model::model::DEFAULT_ACCEL_TIME);
         let len = path.length();
         let angle = vworks_model::math::norm(vworks_model::math::rotation_vector(
