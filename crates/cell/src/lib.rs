@@ -172,6 +172,10 @@ pub struct Robot {
     pub default_zone: Option<f64>,
     /// Joints at the start.
     pub home: Vec<f64>,
+    /// A RAPID robot's wired I/O signals as (cell global, the name its program gives the
+    /// signal), sorted: messages name what the program wrote (`diFromR2`), not the wire's
+    /// global (`dotor1`). Empty for WSL robots, whose programs name the globals.
+    pub signal_names: Vec<(String, String)>,
 }
 
 /// A static or movable body: a device or a part.
@@ -937,6 +941,12 @@ fn load_parsed(
                 (z > 0.0).then_some(z)
             }
         };
+        let mut signal_names: Vec<(String, String)> = signals
+            .unwrap_or_default()
+            .iter()
+            .map(|sg| (sg.global.clone(), sg.name.clone()))
+            .collect();
+        signal_names.sort();
         let entry_name = r.entry.clone().unwrap_or_else(|| "main".into());
         let entry = if serve_only {
             None
@@ -955,6 +965,7 @@ fn load_parsed(
                 default_speed,
                 default_zone,
                 home,
+                signal_names,
             },
             entry_name,
             serve_only,

@@ -833,9 +833,12 @@ impl Simulation {
         }
         let mut parts = Vec::new();
         for r in &blocked {
-            let (what, pos) = self.vms[*r]
+            let (mut what, pos) = self.vms[*r]
                 .waiting_for()
                 .unwrap_or_else(|| ("something".into(), SrcPos::default()));
+            if let Some(globals) = self.vms[*r].waiting_condition_globals() {
+                what = format!("a condition on {}", self.names_in_program(*r, globals));
+            }
             parts.push(format!(
                 "{} waits for {what} ({}:{pos})",
                 self.cell.robots[*r].name,
@@ -845,6 +848,31 @@ impl Simulation {
         let m = format!("deadlock: {}", parts.join("; "));
         self.error(self.time, None, None, "deadlock", m);
         self.outcome = Some(Outcome::Deadlock);
+    }
+
+    /// Module globals of robot `r` as its program names them: a RAPID robot's wired
+    /// signal by the name its program gives it (`diFromR2`), not the wire's global.
+    fn names_in_program(&self, r: usize, globals: &[u32]) -> String {
+        let robot = &self.cell.robots[r];
+        let m = &robot.module;
+        let names: Vec<&str> = globals
+            .iter()
+            .map(|g| {
+                let global = m.str(m.globals[*g as usize].name);
+                // Several of the robot's signals on one wire: the first, by name.
+                match robot.signal_names.binary_search_by(|(w, _)| w.as_str().cmp(global)) {
+                    Ok(i) => {
+                        let first = robot.signal_names[..=i]
+                            .iter()
+                            .rposition(|(w, _)| w != global)
+                            .map_or(0, |k| k + 1);
+                        robot.signal_names[first].1.as_str()
+                    }
+                    Err(_) => global,
+                }
+            })
+            .collect();
+        names.join(", ")
     }
 
     fn finish(mut self) -> RunResult {

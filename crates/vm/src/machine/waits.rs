@@ -112,6 +112,15 @@ impl Vm {
         value
     }
 
+    /// The module globals the condition this VM waits on reads (`None` unless it waits
+    /// for a condition).
+    pub fn waiting_condition_globals(&self) -> Option<&[u32]> {
+        match &self.state {
+            State::Waiting { cond: Some(c), .. } => Some(&self.m.conds[*c as usize].globals),
+            _ => None,
+        }
+    }
+
     /// Whether the next `next_event` would run zero-time code (the main program's or a
     /// running handler's) before it knows the event: that code reads the cell's globals,
     /// so the engine calls it only in the robot's own turn at the instant.
