@@ -97,6 +97,7 @@ struct RobotFile {
     /// One file, or a list of files (a RAPID task's modules).
     program: Option<toml::Value>,
     entry: Option<String>,
+    task: Option<String>,
     serve_only: Option<bool>,
     default_speed: Option<toml::Value>,
     default_zone: Option<toml::Value>,
@@ -172,6 +173,8 @@ pub struct Robot {
     pub default_zone: Option<f64>,
     /// Joints at the start.
     pub home: Vec<f64>,
+    /// The task it runs, as sync points' task lists name it (`task`; default: its name).
+    pub task: String,
     /// A RAPID robot's wired I/O signals as (cell global, the name its program gives the
     /// signal), sorted: messages name what the program wrote (`diFromR2`), not the wire's
     /// global (`dotor1`). Empty for WSL robots, whose programs name the globals.
@@ -781,6 +784,33 @@ fn load_parsed(
             cache.keep_model(model_key, Arc::new(model), urdf)
         };
         let serve_only = r.serve_only.unwrap_or(false);
+        let task = match &r.task {
+            None => r.name.clone(),
+            Some(t) => {
+                let ok = !t.is_empty()
+                    && t.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+                    && !t.starts_with(|c: char| c.is_ascii_digit());
+                if !ok {
+                    return Err(cx.bad(
+                        &format!("{key}.task"),
+                        format!("`{t}` is not a task name: write a name of letters, digits and `_` (`task = \"T_ROB1\"`)"),
+                    ));
+                }
+                t.clone()
+            }
+        };
+        if let Some((other, _, _)) = robots
+            .iter()
+            .find(|(o, _, _): &&(Robot, String, bool)| o.task.eq_ignore_ascii_case(&task))
+        {
+            return Err(cx.bad(
+                &format!("{key}.task"),
+                format!(
+                    "robot `{}` already runs the task `{}`: give each robot a task name of its own",
+                    other.name, other.task
+                ),
+            ));
+        }
         let Some(program) = &r.program else {
             return Err(cx.bad(
                 &format!("{key}.program"),
@@ -965,6 +995,7 @@ fn load_parsed(
                 default_speed,
                 default_zone,
                 home,
+                task,
                 signal_names,
             },
             entry_name,
@@ -999,6 +1030,7 @@ fn load_parsed(
             .iter()
             .map(|(r, entry, serve)| RobotSpec {
                 name: &r.name,
+                task: &r.task,
                 module: &r.module,
                 axes: r.model.dof(),
                 linear_axes: r.model.linear_axes(),

@@ -157,7 +157,9 @@ impl Kind {
             EventKind::Delay { .. } => Kind::Delay,
             EventKind::DelayEnd => Kind::DelayEnd,
             EventKind::Set { .. } => Kind::Set,
-            EventKind::WaitUntil { .. } | EventKind::WaitSignal { .. } => Kind::WaitUntil,
+            EventKind::WaitUntil { .. }
+            | EventKind::WaitSignal { .. }
+            | EventKind::WaitSync { .. } => Kind::WaitUntil,
             EventKind::WaitEnd { .. } => Kind::WaitEnd,
             EventKind::Signal { .. } => Kind::Signal,
             EventKind::Grip { .. } => Kind::Grip,
@@ -357,6 +359,16 @@ pub enum Data {
     WaitSignal {
         /// The signal's name.
         signal: String,
+        /// Absolute deadline (ns), with a timeout.
+        deadline_ns: Option<i64>,
+    },
+    /// `wait_until` at a sync point: its name, the tasks that meet there, and the
+    /// deadline if any.
+    WaitSync {
+        /// The sync point's name.
+        sync: String,
+        /// The tasks of its list, as the program names them.
+        tasks: Vec<String>,
         /// Absolute deadline (ns), with a timeout.
         deadline_ns: Option<i64>,
     },
@@ -565,6 +577,11 @@ impl Data {
                 signal,
                 deadline_ns,
             } => format!("signal={signal}{}", deadline(deadline_ns)),
+            Data::WaitSync {
+                sync,
+                tasks,
+                deadline_ns,
+            } => format!("sync={sync}({}){}", tasks.join(","), deadline(deadline_ns)),
             Data::WaitEnd { timed_out } => (if *timed_out { "timeout" } else { "released" }).into(),
             Data::Signal { robot, signal } => format!("{robot}.{signal}"),
             Data::Remote { robot, procedure } => format!("{robot}.{procedure}"),
@@ -621,6 +638,11 @@ impl Data {
                 signal,
                 deadline_ns,
             } => json!({"signal": signal, "deadline_ns": deadline_ns}),
+            Data::WaitSync {
+                sync,
+                tasks,
+                deadline_ns,
+            } => json!({"sync": sync, "tasks": tasks, "deadline_ns": deadline_ns}),
             Data::WaitEnd { timed_out } => json!({"timed_out": timed_out}),
             Data::Signal { robot, signal } => json!({"robot": robot, "signal": signal}),
             Data::Part { part } => json!({"part": part}),
@@ -667,6 +689,16 @@ impl Data {
                 global: s("global")?,
                 old: Value::from_json(d.get("old")?)?,
                 new: Value::from_json(d.get("new")?)?,
+            },
+            Kind::WaitUntil if d.get("sync").is_some() => Data::WaitSync {
+                sync: s("sync")?,
+                tasks: d
+                    .get("tasks")?
+                    .as_array()?
+                    .iter()
+                    .map(|t| t.as_str().map(str::to_string))
+                    .collect::<Option<Vec<String>>>()?,
+                deadline_ns: opt_i("deadline_ns")?,
             },
             Kind::WaitUntil if d.get("signal").is_some() => Data::WaitSignal {
                 signal: s("signal")?,
@@ -885,6 +917,14 @@ fn vm_data(kind: &EventKind, m: &Module) -> Data {
             signal: m.str(*name).to_string(),
             deadline_ns: *deadline,
         },
+        EventKind::WaitSync { site, deadline } => {
+            let y = &m.syncs[*site as usize];
+            Data::WaitSync {
+                sync: m.str(y.name).to_string(),
+                tasks: y.tasks.iter().map(|t| m.str(*t).to_string()).collect(),
+                deadline_ns: *deadline,
+            }
+        }
         EventKind::WaitEnd { timed_out } => Data::WaitEnd {
             timed_out: *timed_out,
         },
@@ -994,6 +1034,14 @@ mod tests {
                 Data::WaitSignal {
                     signal: "go".into(),
                     deadline_ns: None,
+                },
+            ),
+            (
+                Kind::WaitUntil,
+                Data::WaitSync {
+                    sync: "sstart".into(),
+                    tasks: vec!["r1".into(), "r2".into()],
+                    deadline_ns: Some(9),
                 },
             ),
             (

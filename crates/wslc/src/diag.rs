@@ -84,6 +84,7 @@ codes! {
     E0104 = "unknown part",
     E0105 = "joint count does not match the robot",
     E0106 = "entry procedure missing",
+    E0107 = "sync point's task list does not match the cell",
     E0300 = "RAPID construct not supported",
     E0301 = "RAPID optional argument not accepted",
     E0302 = "unknown I/O signal",

@@ -24,6 +24,9 @@ use crate::diag::{Code, Diagnostic};
 pub struct RobotSpec<'a> {
     /// The robot's name in the workcell.
     pub name: &'a str,
+    /// The name of the task it runs, as sync points' task lists name it (RAPID's
+    /// `T_ROB1`; the workcell's `task`, else the robot's name). Matched ignoring case.
+    pub task: &'a str,
     /// The module it runs.
     pub module: &'a Module,
     /// Number of axes.
@@ -41,6 +44,7 @@ impl<'a> RobotSpec<'a> {
     pub fn new(name: &'a str, module: &'a Module, axes: usize) -> RobotSpec<'a> {
         RobotSpec {
             name,
+            task: name,
             module,
             axes,
             linear_axes: 0,
@@ -70,6 +74,15 @@ pub struct CellGlobal {
     pub init: ConstValue,
 }
 
+/// A sync point of the cell: a barrier where the robots of its task list meet.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CellSync {
+    /// Its name, as the first program (in robot order) wrote it.
+    pub name: String,
+    /// The robots that meet there (robot indices, ascending).
+    pub members: Vec<u32>,
+}
+
 /// The resolved cross-references of one robot, indexed like its module's tables.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct RobotLinks {
@@ -81,6 +94,8 @@ pub struct RobotLinks {
     pub signals: Vec<u32>,
     /// Part site → part index.
     pub parts: Vec<u32>,
+    /// Sync site → index in [`Linked::syncs`].
+    pub syncs: Vec<u32>,
     /// The entry procedure's index, or `None` for a serve-only robot.
     pub entry: Option<u32>,
 }
@@ -92,6 +107,8 @@ pub struct Linked {
     pub globals: Vec<CellGlobal>,
     /// Per robot, in workcell order.
     pub robots: Vec<RobotLinks>,
+    /// The cell's sync points (barriers), sorted by name.
+    pub syncs: Vec<CellSync>,
     /// Warnings (never errors).
     pub warnings: Vec<Diagnostic>,
 }
@@ -384,12 +401,100 @@ pub fn link(cell: &CellSpec<'_>) -> Result<Linked, LinkError> {
         }
         robots.push(links);
     }
+    let syncs = link_syncs(cell, &mut robots, &mut diags);
     if diags.iter().any(Diagnostic::is_error) {
         return Err(LinkError { diagnostics: diags });
     }
     Ok(Linked {
         globals,
         robots,
+        syncs,
         warnings: diags,
     })
+}
+
+/// Sync points: every task a site's list names is a robot's task (ignoring case), the
+/// list holds the robot's own task, and every site of one sync point (by name, ignoring
+/// case) lists the same robots. Fills each robot's `syncs` and returns the cell's sync
+/// points, sorted by name.
+fn link_syncs(
+    cell: &CellSpec<'_>,
+    robots: &mut [RobotLinks],
+    diags: &mut Vec<Diagnostic>,
+) -> Vec<CellSync> {
+    let tasks = || {
+        cell.robots
+            .iter()
+            .map(|r| format!("{} (robot {})", r.task, r.name))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    // Per sync point (lower-case name): its name as first written, its members, where.
+    let mut points: BTreeMap<String, (String, Vec<u32>)> = BTreeMap::new();
+    let mut sites: Vec<Vec<String>> = Vec::new();
+    for (ri, r) in cell.robots.iter().enumerate() {
+        let m = r.module;
+        let shared = cell.robots[..ri].iter().any(|q| std::ptr::eq(q.module, m));
+        let mut keys = Vec::new();
+        for site in &m.syncs {
+            let name = m.str(site.name);
+            let mut members = Vec::new();
+            for t in &site.tasks {
+                let t = m.str(*t);
+                match cell.robots.iter().position(|q| q.task.eq_ignore_ascii_case(t)) {
+                    Some(q) => members.push(q as u32),
+                    // (Robots that run one program report its unknown tasks once.)
+                    None if shared => {}
+                    None => diags.push(
+                        at(m, Code::E0107, format!("sync point `{name}`: no robot of the cell runs the task `{t}`"), site.pos)
+                            .with_help(format!("the tasks are: {}; a RAPID task's name goes in its robot's `task` key of the workcell (`task = \"T_ROB1\"`)", tasks())),
+                    ),
+                }
+            }
+            members.sort_unstable();
+            members.dedup();
+            let all_known = members.len() == site.tasks.len();
+            if all_known && !members.contains(&(ri as u32)) {
+                diags.push(
+                    at(m, Code::E0107, format!("sync point `{name}`: the task list does not hold this robot's own task `{}`", r.task), site.pos)
+                        .with_help("a task meets the others at a sync point only if its list names it too"),
+                );
+            }
+            let key = name.to_lowercase();
+            let listed = |members: &[u32]| {
+                members
+                    .iter()
+                    .map(|q| cell.robots[*q as usize].task)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            match points.get(&key) {
+                Some((_, have)) if *have != members => diags.push(
+                    at(m, Code::E0107, format!("sync point `{name}` lists the tasks {} here, but {} where another task meets there", listed(&members), listed(have)), site.pos)
+                        .with_help("every task that meets at one sync point must list the same tasks"),
+                ),
+                Some(_) => {}
+                None => {
+                    points.insert(key.clone(), (name.to_string(), members));
+                }
+            }
+            keys.push(key);
+        }
+        sites.push(keys);
+    }
+    let index: BTreeMap<&String, u32> = points
+        .keys()
+        .enumerate()
+        .map(|(i, k)| (k, i as u32))
+        .collect();
+    for (links, keys) in robots.iter_mut().zip(&sites) {
+        links.syncs = keys
+            .iter()
+            .map(|k| index.get(k).copied().unwrap_or(0))
+            .collect();
+    }
+    points
+        .into_values()
+        .map(|(name, members)| CellSync { name, members })
+        .collect()
 }

@@ -782,6 +782,29 @@ impl Parser<'_, '_> {
             self.end("the pulse")?;
             return Ok(StmtKind::Pulse { global, length });
         }
+        // `sync s with r1, r2 [timeout t];` — `sync` and `with` are special only there.
+        if self.at_ident("sync")
+            && kind_at(1) == Some(&TokKind::Ident)
+            && self
+                .toks
+                .get(self.pos + 2)
+                .is_some_and(|t| t.kind == TokKind::Ident && self.text(t.span) == "with")
+        {
+            self.bump();
+            let name = self.ident("a sync point's name")?;
+            self.bump();
+            let mut tasks = vec![self.ident("a task (`sync s with r1, r2;`)")?];
+            while self.eat_p(Punct::Comma) {
+                tasks.push(self.ident("a task (`sync s with r1, r2;`)")?);
+            }
+            let timeout = self.timeout()?;
+            self.end("the sync")?;
+            return Ok(StmtKind::Sync {
+                name,
+                tasks,
+                timeout,
+            });
+        }
         let target = self.expr()?;
         let op = match self.kind() {
             TokKind::P(Punct::Assign) => Some(None),

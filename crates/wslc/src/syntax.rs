@@ -266,6 +266,16 @@ pub enum StmtKind {
         /// Signal name.
         name: Ident,
     },
+    /// `sync name with task, task… [timeout t];`: this robot arrives at sync point `name`
+    /// and waits until every task of the list has arrived as often.
+    Sync {
+        /// The sync point (cell-wide).
+        name: Ident,
+        /// The tasks that meet there (the workcell robots' `task` names).
+        tasks: Vec<Ident>,
+        /// Optional timeout.
+        timeout: Option<Expr>,
+    },
     /// `wait_signal name [timeout t];`
     WaitSignal {
         /// Signal name.

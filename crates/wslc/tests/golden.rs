@@ -226,6 +226,7 @@ fn link_cases() -> BTreeSet<String> {
                 .iter()
                 .map(|(n, f, axes, linear, entry, serve)| RobotSpec {
                     name: n,
+                    task: n,
                     module: &modules
                         .iter()
                         .find(|(mf, _)| mf == f)

@@ -122,6 +122,7 @@ fn every_statement_compiles() {
         robots: vec![
             RobotSpec {
                 name: "r1",
+                task: "r1",
                 module: &m,
                 axes: 6,
                 linear_axes: 0,

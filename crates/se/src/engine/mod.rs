@@ -123,6 +123,10 @@ pub struct Simulation {
     signal_timeout: Vec<Option<(i64, SrcPos)>>,
     /// Per cell global: the last wait on it that timed out (time, robot, position).
     last_timeout: Vec<Option<(i64, usize, SrcPos)>>,
+    /// Per sync point of the cell (`Linked::syncs`), per member: whether it has arrived
+    /// at the meeting under way; per robot, the sync point it waits at.
+    sync_arrived: Vec<Vec<bool>>,
+    at_sync: Vec<Option<usize>>,
 }
 
 /// How many queue entries the cell may handle at one simulated instant by default: far
@@ -244,6 +248,13 @@ impl Simulation {
             last_signal: vec![None; n],
             signal_timeout: vec![None; n],
             last_timeout: vec![None; cell.linked.globals.len()],
+            sync_arrived: cell
+                .linked
+                .syncs
+                .iter()
+                .map(|s| vec![false; s.members.len()])
+                .collect(),
+            at_sync: vec![None; n],
             cell,
         }
     }
@@ -839,6 +850,9 @@ impl Simulation {
             if let Some(globals) = self.vms[*r].waiting_condition_globals() {
                 what = format!("a condition on {}", self.names_in_program(*r, globals));
             }
+            if let Some(cs) = self.at_sync[*r] {
+                what = self.sync_missing(cs);
+            }
             parts.push(format!(
                 "{} waits for {what} ({}:{pos})",
                 self.cell.robots[*r].name,
@@ -848,6 +862,30 @@ impl Simulation {
         let m = format!("deadlock: {}", parts.join("; "));
         self.error(self.time, None, None, "deadlock", m);
         self.outcome = Some(Outcome::Deadlock);
+    }
+
+    /// A sync point and the tasks of its list that have not arrived at its meeting.
+    fn sync_missing(&self, cs: usize) -> String {
+        let sync = &self.cell.linked.syncs[cs];
+        let missing: Vec<String> = sync
+            .members
+            .iter()
+            .zip(&self.sync_arrived[cs])
+            .filter(|(_, arrived)| !**arrived)
+            .map(|(q, _)| {
+                let robot = &self.cell.robots[*q as usize];
+                if robot.task == robot.name {
+                    format!("`{}`", robot.name)
+                } else {
+                    format!("`{}` (robot {})", robot.task, robot.name)
+                }
+            })
+            .collect();
+        format!(
+            "the other tasks at sync point `{}`; never arrived: {}",
+            sync.name,
+            missing.join(", ")
+        )
     }
 
     /// Module globals of robot `r` as its program names them: a RAPID robot's wired
@@ -860,7 +898,10 @@ impl Simulation {
             .map(|g| {
                 let global = m.str(m.globals[*g as usize].name);
                 // Several of the robot's signals on one wire: the first, by name.
-                match robot.signal_names.binary_search_by(|(w, _)| w.as_str().cmp(global)) {
+                match robot
+                    .signal_names
+                    .binary_search_by(|(w, _)| w.as_str().cmp(global))
+                {
                     Ok(i) => {
                         let first = robot.signal_names[..=i]
                             .iter()

@@ -63,7 +63,15 @@ impl Simulation {
                     self.timed_out_race(r, t, e.pos);
                 }
                 self.clear_waits(r);
+                // A wait at a sync point that timed out: the task leaves the meeting.
+                if let Some(cs) = self.at_sync[r].take() {
+                    let members = &self.cell.linked.syncs[cs].members;
+                    if let Some(k) = members.iter().position(|q| *q as usize == r) {
+                        self.sync_arrived[cs][k] = false;
+                    }
+                }
             }
+            EventKind::WaitSync { site, .. } => self.arrive(r, *site as usize, t),
             EventKind::EnableWhen { handler } => {
                 let m = self.vms[r].module();
                 let h = &m.handlers[*handler as usize];
@@ -227,6 +235,36 @@ impl Simulation {
             if last != Some(q) {
                 last = Some(q);
                 self.push(t, Entry::CheckWhen(q, cg as u32));
+            }
+        }
+    }
+
+    /// Robot `r` arrives at the sync point of its sync site `site`: when every task of the
+    /// list has arrived, the meeting is complete and all of them go on at `t` (each has
+    /// seen every other's arrival).
+    fn arrive(&mut self, r: usize, site: usize, t: i64) {
+        let cs = self.cell.linked.robots[r].syncs[site] as usize;
+        let cell = Arc::clone(&self.cell);
+        let members = &cell.linked.syncs[cs].members;
+        if let Some(k) = members.iter().position(|q| *q as usize == r) {
+            self.sync_arrived[cs][k] = true;
+        }
+        self.at_sync[r] = Some(cs);
+        self.tick(r);
+        if !self.sync_arrived[cs].iter().all(|a| *a) {
+            return;
+        }
+        self.sync_arrived[cs].iter_mut().for_each(|a| *a = false);
+        for q in members {
+            for p in members {
+                self.merge_clock(*q as usize, Seen::Robot(*p as usize));
+            }
+        }
+        for q in members {
+            let q = *q as usize;
+            self.at_sync[q] = None;
+            if self.vms[q].release_sync(t) {
+                self.requeue(q);
             }
         }
     }

@@ -121,6 +121,19 @@ pub fn disassemble(m: &Module, sources: &[&str]) -> String {
             let _ = writeln!(o, "     awaits {}", awaited.join(", "));
         }
     }
+    if !m.syncs.is_empty() {
+        let _ = writeln!(o, "\n; sync points");
+        for (i, x) in m.syncs.iter().enumerate() {
+            let tasks: Vec<&str> = x.tasks.iter().map(|t| m.str(*t)).collect();
+            let _ = writeln!(
+                o,
+                "y{i:<3} {} with {}  ; {}",
+                m.str(x.name),
+                tasks.join(", "),
+                at(x.pos)
+            );
+        }
+    }
     if !m.parts.is_empty() {
         let _ = writeln!(o, "\n; part sites");
         for (i, x) in m.parts.iter().enumerate() {
@@ -259,6 +272,9 @@ fn operands(m: &Module, ins: &Instr) -> String {
         Instr::WaitUntil(c, t) => format!("c{c}{}", if t { " timeout" } else { "" }),
         Instr::WaitPoll(c, t) => format!("c{c} poll{}", if t { " timeout" } else { "" }),
         Instr::WaitSignal(s, t) => format!("{}{}", m.str(s), if t { " timeout" } else { "" }),
+        Instr::WaitSync(s, t) => m.syncs.get(s as usize).map_or("?".into(), |x| {
+            format!("y{s} {}{}", m.str(x.name), if t { " timeout" } else { "" })
+        }),
         Instr::Signal(s) => m.signals_sent.get(s as usize).map_or("?".into(), |x| {
             format!("{}.{}", m.str(x.robot), m.str(x.name))
         }),

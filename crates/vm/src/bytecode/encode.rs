@@ -19,7 +19,7 @@ use crate::types::{ConstValue, Dim, MAX_AXES, Type};
 /// The first four bytes of every `.wslb` file.
 pub const MAGIC: [u8; 4] = *b"WSLB";
 /// The format version this build writes and reads.
-pub const FORMAT_VERSION: u16 = 3;
+pub const FORMAT_VERSION: u16 = 4;
 
 const SECTIONS: [&[u8; 4]; 15] = [
     b"SRC_", b"STRS", b"CNST", b"GLOB", b"VARS", b"PROC", b"CODE", b"COND", b"WHEN", b"RMTE",
@@ -231,6 +231,13 @@ impl Module {
             }
             w.len(self.signals_awaited.len());
             self.signals_awaited.iter().for_each(|s| w.u32(*s));
+            w.len(self.syncs.len());
+            for x in &self.syncs {
+                w.u32(x.name);
+                w.len(x.tasks.len());
+                x.tasks.iter().for_each(|t| w.u32(*t));
+                w.pos(x.pos);
+            }
         });
         w.section(SECTIONS[11], |w| {
             w.len(self.parts.len());
@@ -441,6 +448,13 @@ impl Module {
                         })
                     })?;
                     m.signals_awaited = s.list(4, Reader::u32)?;
+                    m.syncs = s.list(16, |s| {
+                        Ok(SyncSite {
+                            name: s.u32()?,
+                            tasks: s.list(4, Reader::u32)?,
+                            pos: s.pos()?,
+                        })
+                    })?;
                 }
                 11 => {
                     m.parts = s.list(12, |s| {

@@ -361,6 +361,8 @@ instruction_set! {
     0x75 WaitSignal(s: u32, t: bool);
     /// EVENT `signal`: sends the signal of signal site `s`.
     0x76 Signal(s: u32);
+    /// EVENT `wait_until` at the sync point of sync site `s` (a barrier of named tasks): the robot arrives and waits until every task of its list has arrived as often; pops a timeout if `t`.
+    0x82 WaitSync(s: u32, t: bool);
     /// Opens a `parallel` block: the interpreter stops at it so that the machine opens a join group (no event).
     0x77 ParBegin;
     /// EVENT `remote_start`: pops the arguments of remote site `r` and asks its robot to run it.
@@ -468,7 +470,9 @@ impl Instr {
                 eff(target + via + extra, 0)
             }
             Instr::Delay => eff(1, 0),
-            Instr::WaitUntil(_, t) | Instr::WaitSignal(_, t) => eff(u32::from(t), 0),
+            Instr::WaitUntil(_, t) | Instr::WaitSignal(_, t) | Instr::WaitSync(_, t) => {
+                eff(u32::from(t), 0)
+            }
             Instr::WaitPoll(_, t) => eff(1 + u32::from(t), 0),
             Instr::Remote(r) => eff(m.remotes.get(r as usize)?.arg_width(), 0),
             Instr::When(h) => eff(
@@ -492,6 +496,7 @@ impl Instr {
                 | Instr::WaitUntil(..)
                 | Instr::WaitPoll(..)
                 | Instr::WaitSignal(..)
+                | Instr::WaitSync(..)
                 | Instr::Signal(_)
                 | Instr::Remote(_)
                 | Instr::ParJoin
@@ -518,6 +523,7 @@ impl Instr {
                 | Instr::WaitUntil(..)
                 | Instr::WaitPoll(..)
                 | Instr::WaitSignal(..)
+                | Instr::WaitSync(..)
                 | Instr::Grip(_)
                 | Instr::Release(_)
                 | Instr::Remote(_)

@@ -292,6 +292,18 @@ pub struct SignalSite {
     pub pos: SrcPos,
 }
 
+/// A `sync` site: a sync point (a barrier) and the tasks that meet there.
+#[derive(Clone, PartialEq, Debug)]
+pub struct SyncSite {
+    /// The sync point's name (string index), cell-wide.
+    pub name: u32,
+    /// The tasks of its list (string indices), as the program names them: the workcell
+    /// robots' `task` names.
+    pub tasks: Vec<u32>,
+    /// Source position.
+    pub pos: SrcPos,
+}
+
 /// A `grip`/`release` site.
 #[derive(Clone, PartialEq, Debug)]
 pub struct PartSite {
@@ -381,6 +393,8 @@ pub struct Module {
     pub signals_sent: Vec<SignalSite>,
     /// Names (string indices) of the signals this module waits for, without repeats.
     pub signals_awaited: Vec<u32>,
+    /// `sync` sites (sync points and their task lists).
+    pub syncs: Vec<SyncSite>,
     /// `grip`/`release` sites.
     pub parts: Vec<PartSite>,
     /// `joints(…)` sites.

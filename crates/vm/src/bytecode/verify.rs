@@ -164,6 +164,12 @@ impl Module {
         for x in &self.signals_awaited {
             s(*x, "the awaited-signal list")?;
         }
+        for x in &self.syncs {
+            s(x.name, "a sync site")?;
+            for t in &x.tasks {
+                s(*t, "a sync site's task list")?;
+            }
+        }
         for x in &self.parts {
             s(x.part, "a part site")?;
         }
@@ -192,6 +198,7 @@ impl Module {
             .chain(self.handlers.iter().map(|x| x.pos))
             .chain(self.remotes.iter().map(|x| x.pos))
             .chain(self.signals_sent.iter().map(|x| x.pos))
+            .chain(self.syncs.iter().map(|x| x.pos))
             .chain(self.parts.iter().map(|x| x.pos))
             .chain(self.joints_sites.iter().map(|x| x.pos))
             .chain(self.lines.iter().map(|x| x.pos));
@@ -282,6 +289,7 @@ impl Module {
                     .is_some_and(|c| caps_fit(&c.captures)),
                 Instr::WaitSignal(sg, _) => (sg as usize) < self.strings.len(),
                 Instr::Signal(x) => (x as usize) < self.signals_sent.len(),
+                Instr::WaitSync(x, _) => (x as usize) < self.syncs.len(),
                 Instr::Remote(x) => (x as usize) < self.remotes.len(),
                 Instr::When(x) => self.handlers.get(x as usize).is_some_and(|h| {
                     caps_fit(&h.captures)

@@ -510,6 +510,7 @@ impl Vm {
             Some(Instr::Delay) => "`delay`",
             Some(Instr::WaitUntil(..) | Instr::WaitPoll(..)) => "`wait_until`",
             Some(Instr::WaitSignal(..)) => "`wait_signal`",
+            Some(Instr::WaitSync(..)) => "`sync`",
             Some(Instr::ParJoin) => "the end of a `parallel` block",
             Some(Instr::Grip(_)) => "`grip`",
             Some(Instr::Release(_)) => "`release`",

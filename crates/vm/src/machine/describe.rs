@@ -109,6 +109,10 @@ impl Vm {
                 name: s,
                 deadline: self.deadline(timeout, t)?,
             },
+            Instr::WaitSync(s, timeout) => EventKind::WaitSync {
+                site: s,
+                deadline: self.deadline(timeout, t)?,
+            },
             Instr::Signal(s) => EventKind::Signal { site: s },
             Instr::Grip(s) => EventKind::Grip { site: s },
             Instr::Release(s) => EventKind::Release { site: s },

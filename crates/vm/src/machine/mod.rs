@@ -133,6 +133,14 @@ pub enum EventKind {
         /// Deadline (absolute ns) if a timeout was given.
         deadline: Option<i64>,
     },
+    /// The robot arrives at a sync point (sync site index) and waits for the other tasks
+    /// of its list.
+    WaitSync {
+        /// The sync site (sync point and task list).
+        site: u32,
+        /// Deadline (absolute ns) if a timeout was given.
+        deadline: Option<i64>,
+    },
     /// The wait is over.
     WaitEnd {
         /// It ended by timeout.
@@ -218,7 +226,9 @@ impl EventKind {
             EventKind::Delay { .. } => "delay",
             EventKind::DelayEnd => "delay_end",
             EventKind::Set { .. } => "set",
-            EventKind::WaitUntil { .. } | EventKind::WaitSignal { .. } => "wait_until",
+            EventKind::WaitUntil { .. }
+            | EventKind::WaitSignal { .. }
+            | EventKind::WaitSync { .. } => "wait_until",
             EventKind::WaitEnd { .. } => "wait_end",
             EventKind::Signal { .. } => "signal",
             EventKind::Grip { .. } => "grip",
@@ -293,6 +303,8 @@ enum State {
     Waiting {
         cond: Option<u32>,
         signal: Option<u32>,
+        /// A sync site: waiting at its sync point until the engine releases the meeting.
+        sync: Option<u32>,
         deadline: Option<i64>,
         /// A polled wait's start and period (ns).
         poll: Option<(i64, i64)>,
@@ -970,6 +982,7 @@ impl Vm {
                             State::Waiting {
                                 cond: Some(*cond),
                                 signal: None,
+                                sync: None,
                                 deadline: *deadline,
                                 poll: poll_ns.map(|p| (e.time, p)),
                                 pos: e.pos,
@@ -988,10 +1001,26 @@ impl Vm {
                             State::Waiting {
                                 cond: None,
                                 signal: Some(*name),
+                                sync: None,
                                 deadline: *deadline,
                                 poll: None,
                                 pos: e.pos,
                             }
+                        };
+                    }
+                    EventKind::WaitSync { site, deadline } => {
+                        if deadline.is_some() {
+                            self.main.stack.pop();
+                        }
+                        // The engine keeps the sync point: it releases the meeting when
+                        // every task of the list has arrived (`release_sync`).
+                        self.state = State::Waiting {
+                            cond: None,
+                            signal: None,
+                            sync: Some(*site),
+                            deadline: *deadline,
+                            poll: None,
+                            pos: e.pos,
                         };
                     }
                     EventKind::RemoteCall { req, args, .. } => {

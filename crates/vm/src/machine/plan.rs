@@ -618,7 +618,7 @@ impl Vm {
             ));
         }
         if let Some(a) = accel
-            && !(a > 0.0)
+            && (a.is_nan() || a <= 0.0)
         {
             // (A param, `--set` or a sweep can make it so at run time; 0 would make the
             // motion take no time at all.)

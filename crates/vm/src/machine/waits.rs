@@ -23,6 +23,12 @@ impl Vm {
                 pos,
                 ..
             } => Some((format!("the signal `{}`", self.m.str(*s)), *pos)),
+            State::Waiting {
+                sync: Some(s), pos, ..
+            } => {
+                let site = &self.m.syncs[*s as usize];
+                Some((format!("the sync point `{}`", self.m.str(site.name)), *pos))
+            }
             State::Joining { pos, .. } => Some((
                 "the remote work of its `parallel` block (join)".into(),
                 *pos,
@@ -110,6 +116,31 @@ impl Vm {
         let value = matches!(r, Ok(Stop::Finished)) && th.stack.last().copied().unwrap_or(0) != 0;
         self.cond_thread = th;
         value
+    }
+
+    /// The sync site this VM waits at, if it waits at a sync point.
+    pub fn waiting_sync(&self) -> Option<u32> {
+        match self.state {
+            State::Waiting { sync, .. } => sync,
+            _ => None,
+        }
+    }
+
+    /// The engine's release of a meeting at a sync point: every task of its list has
+    /// arrived. Returns true if this VM waited there (its next event becomes `wait_end`
+    /// at `t`).
+    pub fn release_sync(&mut self, t: i64) -> bool {
+        if let State::Waiting {
+            sync: Some(_),
+            pos,
+            deadline,
+            ..
+        } = self.state
+        {
+            self.state = State::released(t, deadline, pos);
+            return true;
+        }
+        false
     }
 
     /// The module globals the condition this VM waits on reads (`None` unless it waits

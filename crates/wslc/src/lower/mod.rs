@@ -30,7 +30,7 @@ use std::collections::{BTreeSet, HashMap};
 use vworks_vm::bytecode::{
     Capture, Cmp, CondInfo, ConstInfo, GlobalInfo, HandlerInfo, Instr, JointsSite, LineEntry,
     LogFormat, LogPart, MoveFlags, ParamInfo, PartSite, ProcInfo, ProcKind, RemoteSite, SignalSite,
-    SrcPos, Trigger, VarInfo,
+    SrcPos, SyncSite, Trigger, VarInfo,
 };
 use vworks_vm::math;
 use vworks_vm::{ConstValue, Dim, MAX_AXES, Module, Type};

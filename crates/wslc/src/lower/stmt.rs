@@ -223,6 +223,22 @@ impl Compiler<'_> {
                 }
                 self.emit(Instr::WaitSignal(n, timeout.is_some()), sp);
             }
+            StmtKind::Sync {
+                name,
+                tasks,
+                timeout,
+            } => {
+                self.takes_time("wait", sp);
+                if let Some(t) = timeout {
+                    self.time_operand(t, "a timeout");
+                }
+                let name = self.str(&name.name);
+                let tasks = tasks.iter().map(|t| self.str(&t.name)).collect();
+                let pos = self.pos(sp);
+                self.m.syncs.push(SyncSite { name, tasks, pos });
+                let i = (self.m.syncs.len() - 1) as u32;
+                self.emit(Instr::WaitSync(i, timeout.is_some()), sp);
+            }
             StmtKind::Signal { robot, name } => {
                 if self.not_in_func("send signals", sp) {
                     let robot = self.str(&robot.name);

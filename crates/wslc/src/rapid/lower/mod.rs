@@ -92,6 +92,8 @@ pub(crate) struct Data {
     pub(crate) local: bool,
     /// Cannot be assigned (a `CONST`, a `FOR` variable).
     pub(crate) readonly: bool,
+    /// A task list's task names (`["T_ROB1"]`), in its order.
+    pub(crate) tasks: Vec<String>,
 }
 
 /// A routine's signature.
@@ -476,6 +478,7 @@ impl Tr<'_> {
             inline: None,
             local: false,
             readonly: d.storage == Storage::Const,
+            tasks: Vec::new(),
         };
         if ty == Ty::Str {
             self.string_data(d, &mut data);
@@ -488,6 +491,13 @@ impl Tr<'_> {
             return;
         }
         let inits = self.initial_values(d, ty, len);
+        if ty == Ty::Tasks {
+            data.tasks = inits
+                .iter()
+                .flatten()
+                .filter_map(|v| v.text.clone())
+                .collect();
+        }
         // A CONST scalar of literal leaves is folded where it is used (array sizes, …).
         if d.storage == Storage::Const
             && len.is_none()
@@ -546,8 +556,7 @@ impl Tr<'_> {
         out
     }
 
-    /// `VAR syncident s;`: the cell's count of arrivals at the sync point (a global shared
-    /// by every task that declares it) and this task's own count.
+    /// `VAR syncident s;`: a sync point, met by name (`WaitSyncTask`): nothing to declare.
     fn syncident(&mut self, d: &r::DataDecl, data: &Data) {
         if data.len.is_some() || d.init.is_some() {
             self.unsupported(
@@ -555,18 +564,7 @@ impl Tr<'_> {
                 d.span,
                 "declare `VAR syncident name;`",
             );
-            return;
         }
-        let int = |n: i64| b::expr(w::ExprKind::Int(n), d.span);
-        let decl = |name: &str| w::VarDecl {
-            name: b::ident(name, d.name.span),
-            ty: Some(b::ident("int", d.ty.span)),
-            init: Some(int(0)),
-            span: d.span,
-        };
-        self.items.push(w::Item::Global(decl(&data.base)));
-        self.items
-            .push(w::Item::Var(decl(&format!("{}#arrivals", data.base))));
     }
 
     fn string_data(&mut self, d: &r::DataDecl, data: &mut Data) {
@@ -745,6 +743,7 @@ impl Tr<'_> {
                 inline: None,
                 local: true,
                 readonly: false,
+                tasks: Vec::new(),
             };
             for (name, (_, wty)) in Self::leaf_names(&data, None).iter().zip(ty.leaves()) {
                 params.push(w::Param {
@@ -819,6 +818,7 @@ impl Tr<'_> {
             inline: None,
             local: true,
             readonly: d.storage == Storage::Const,
+            tasks: Vec::new(),
         };
         if ty == Ty::Str {
             self.string_data(d, &mut data);
@@ -866,6 +866,7 @@ fn predefined(key: &str) -> Option<Data> {
         inline: None,
         local: false,
         readonly: true,
+        tasks: Vec::new(),
     };
     if let Some((_, v, o)) = data::SPEEDS.iter().find(|(n, _, _)| *n == key) {
         d.ty = Ty::Speed;

@@ -481,6 +481,7 @@ impl Tr<'_> {
                 inline: None,
                 local: true,
                 readonly: true,
+                tasks: Vec::new(),
             },
         );
         self.locals.push(scope);
@@ -957,22 +958,22 @@ impl Tr<'_> {
     }
 
     /// `WaitSyncTask s, tasks;`: this task arrives at sync point `s` and waits until every
-    /// task of the list has arrived as many times. With n tasks, the cell's count of
-    /// arrivals at `s` reaches n·k when the k-th meeting is complete.
+    /// task of the list has arrived as often: WSL's `sync s with T_ROB1, T_ROB2;`, a
+    /// barrier the engine keeps (the tasks are the workcell robots' `task` names).
     fn wait_sync_task(&mut self, f: &r::Name, args: &[Arg], span: Span, out: &mut Vec<w::Stmt>) {
         let Some((p, opts)) = self.split_args(f, args, 2..=2, &["InPos", "TimeOut"], span) else {
             return;
         };
-        let Some((_, sync)) = self.data_arg(p[0], "a syncident declared at module level", |d| {
+        let Some((sync, _)) = self.data_arg(p[0], "a syncident declared at module level", |d| {
             d.ty == Ty::Syncident && !d.local
         }) else {
             return;
         };
+        let sync = sync.clone();
         let Some((_, list)) = self.data_arg(p[1], "a task list (`tasks`)", |d| d.ty == Ty::Tasks)
         else {
             return;
         };
-        let tasks = list.len.unwrap_or(1);
         let mut timeout = None;
         for (k, n, v) in &opts {
             if k == "timeout" {
@@ -992,39 +993,14 @@ impl Tr<'_> {
                 }
             }
         }
-        let int = |n: i64| b::expr(w::ExprKind::Int(n), span);
-        let mine = format!("{}#arrivals", sync.base);
-        let target = self.temp("sync");
-        let mut stmt = |kind| out.push(w::Stmt { kind, span });
-        stmt(w::StmtKind::Assign {
-            target: b::name(&mine, span),
-            op: Some(w::BinOp::Add),
-            value: int(1),
-        });
-        stmt(w::StmtKind::Var(w::VarDecl {
-            name: b::ident(&target, span),
-            ty: Some(b::ident("int", span)),
-            init: Some(b::bin(
-                w::BinOp::Mul,
-                b::name(&mine, span),
-                int(i64::from(tasks)),
-            )),
-            span,
-        }));
-        stmt(w::StmtKind::Assign {
-            target: b::name(&sync.base, p[0].span),
-            op: Some(w::BinOp::Add),
-            value: int(1),
-        });
         let has_timeout = timeout.is_some();
-        stmt(w::StmtKind::WaitUntil {
-            cond: b::bin(
-                w::BinOp::Ge,
-                b::name(&sync.base, p[0].span),
-                b::name(&target, span),
-            ),
-            timeout,
-            poll: None,
+        out.push(w::Stmt {
+            kind: w::StmtKind::Sync {
+                name: b::ident(&sync.text, sync.span),
+                tasks: list.tasks.iter().map(|t| b::ident(t, p[1].span)).collect(),
+                timeout,
+            },
+            span,
         });
         if has_timeout {
             let fail = w::Stmt {
@@ -1034,9 +1010,12 @@ impl Tr<'_> {
                 )]),
                 span,
             };
-            stmt(w::StmtKind::If {
-                branches: vec![(b::call("timed_out", vec![], span), block(vec![fail], span))],
-                els: None,
+            out.push(w::Stmt {
+                kind: w::StmtKind::If {
+                    branches: vec![(b::call("timed_out", vec![], span), block(vec![fail], span))],
+                    els: None,
+                },
+                span,
             });
         }
     }
