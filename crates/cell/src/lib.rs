@@ -101,6 +101,7 @@ struct RobotFile {
     serve_only: Option<bool>,
     default_speed: Option<toml::Value>,
     default_zone: Option<toml::Value>,
+    grip_distance: Option<toml::Value>,
     jerk: Option<toml::Value>,
     home: Option<Vec<toml::Value>>,
     /// Values of its program's `param`s (`[robot.params]`).
@@ -132,6 +133,7 @@ struct CellFile {
     name: Option<String>,
     cycle: Option<toml::Value>,
     clearance: Option<toml::Value>,
+    grip_distance: Option<toml::Value>,
     on_collision: Option<String>,
     #[serde(default)]
     robot: Vec<RobotFile>,
@@ -171,6 +173,9 @@ pub struct Robot {
     pub default_speed: f64,
     /// Zone radius of motions without `zone` (m; `None`: `fine`).
     pub default_zone: Option<f64>,
+    /// How far a part may be from this robot's gripper (its TCP, or a collision body of
+    /// its tool link) for `grip` to take it (m): its own `grip_distance`, else the cell's.
+    pub grip_distance: f64,
     /// Joints at the start.
     pub home: Vec<f64>,
     /// The task it runs, as sync points' task lists name it (`task`; default: its name).
@@ -207,6 +212,9 @@ pub struct Cell {
     pub cycle_ns: i64,
     /// Near-miss distance (m).
     pub clearance: f64,
+    /// The cell's `grip_distance` (m; [`DEFAULT_GRIP_DISTANCE`] unless the file sets
+    /// it): each robot's [`Robot::grip_distance`] unless the robot sets its own.
+    pub grip_distance: f64,
     /// Stop at the first collision.
     pub stop_on_collision: bool,
     /// Robots, in file order.
@@ -376,6 +384,18 @@ impl Ctx<'_> {
         }
     }
 
+    /// A `grip_distance` (the cell's or a robot's): a length, at least 0.
+    fn grip_distance(&self, v: &toml::Value, key: &str) -> Result<f64, CellError> {
+        let d = self.quantity(v, Dim::LENGTH, key)?;
+        if d < 0.0 {
+            return Err(self.bad(
+                key,
+                "cannot be negative: it is how far from the robot's gripper (its TCP and its tool link's collision bodies) a part can be gripped; write e.g. \"5mm\", or 0 for parts the gripper touches",
+            ));
+        }
+        Ok(d)
+    }
+
     fn pose(&self, p: Option<&PoseFile>, key: &str) -> Result<Iso, CellError> {
         let Some(p) = p else { return Ok(Iso::IDENTITY) };
         let vec3 =
@@ -543,6 +563,10 @@ fn with_suggestion(msg: &str) -> String {
 /// typo (a unit missing), and would break the collision geometry's arithmetic.
 const MAX_LENGTH: f64 = 1e4;
 
+/// How far a part may be from a robot's gripper for `grip` to take it when the workcell
+/// does not say (m): 5 mm, a gripper closing on a part that its fingers nearly touch.
+pub const DEFAULT_GRIP_DISTANCE: f64 = 0.005;
+
 /// The program files of robot `key` (`program`: one path, or a list of paths to files of
 /// one language), each joined to the workcell's folder `dir`.
 fn program_files(
@@ -693,6 +717,10 @@ fn load_parsed(
     if clearance < 0.0 {
         return Err(cx.bad("clearance", "cannot be negative"));
     }
+    let grip_distance = match &cf.grip_distance {
+        Some(v) => cx.grip_distance(v, "grip_distance")?,
+        None => DEFAULT_GRIP_DISTANCE,
+    };
     let stop_on_collision = match cf.on_collision.as_deref() {
         None | Some("stop") => true,
         Some("continue") => false,
@@ -971,6 +999,10 @@ fn load_parsed(
                 (z > 0.0).then_some(z)
             }
         };
+        let robot_grip_distance = match &r.grip_distance {
+            Some(v) => cx.grip_distance(v, &format!("{key}.grip_distance"))?,
+            None => grip_distance,
+        };
         let mut signal_names: Vec<(String, String)> = signals
             .unwrap_or_default()
             .iter()
@@ -994,6 +1026,7 @@ fn load_parsed(
                 entry,
                 default_speed,
                 default_zone,
+                grip_distance: robot_grip_distance,
                 home,
                 task,
                 signal_names,
@@ -1097,6 +1130,7 @@ fn load_parsed(
         file: path.to_path_buf(),
         cycle_ns: (cycle * 1e9).round() as i64,
         clearance,
+        grip_distance,
         stop_on_collision,
         robots: robots.into_iter().map(|(r, _, _)| r).collect(),
         devices,

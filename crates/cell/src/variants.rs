@@ -210,7 +210,7 @@ const NAMED: [&str; 3] = ["robot", "device", "part"];
 fn variables(table: &toml::Table, cell: &Cell) -> Vec<String> {
     let mut out = Vec::new();
     leaves("", &toml::Value::Table(table.clone()), &mut out);
-    out.extend(["cycle".to_string(), "clearance".to_string()]);
+    out.extend(["cycle", "clearance", "grip_distance"].map(String::from));
     let pose = |out: &mut Vec<String>, prefix: &str| {
         for part in ["xyz", "rpy"] {
             for k in 0..3 {
@@ -224,6 +224,7 @@ fn variables(table: &toml::Table, cell: &Cell) -> Vec<String> {
         pose(&mut out, &format!("{prefix}.tool"));
         out.push(format!("{prefix}.default_speed"));
         out.push(format!("{prefix}.default_zone"));
+        out.push(format!("{prefix}.grip_distance"));
         for (name, ..) in crate::params::declared(&r.module) {
             out.push(format!("{prefix}.params.{name}"));
             out.push(format!("params.{name}"));

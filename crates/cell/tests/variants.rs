@@ -47,6 +47,31 @@ fn overrides_change_the_values_they_name_and_nothing_else() {
 }
 
 #[test]
+fn grip_distances_are_variables_cell_wide_and_per_robot() {
+    // handoff sets no grip_distance: 5 mm for both robots; the cell's value applies to
+    // every robot, and a robot's own wins over it.
+    let loader = Loader::new(&workcell("handoff"), &Disk).unwrap();
+    for p in [
+        "grip_distance",
+        "robot.r1.grip_distance",
+        "robot.r2.grip_distance",
+    ] {
+        assert!(loader.variables().iter().any(|v| v == p), "{p}");
+    }
+    let base = loader.base();
+    assert_eq!(base.grip_distance, vworks_cell::DEFAULT_GRIP_DISTANCE);
+    assert_eq!(base.robots[1].grip_distance, 0.005);
+    let v = loader
+        .load(&[
+            Override::new("grip_distance", "20mm"),
+            Override::new("robot.r2.grip_distance", "1mm"),
+        ])
+        .unwrap();
+    assert!((v.robots[0].grip_distance - 0.02).abs() < 1e-12);
+    assert!((v.robots[1].grip_distance - 0.001).abs() < 1e-12);
+}
+
+#[test]
 fn absent_poses_are_variables_too() {
     // crash's robot `left` has no `base`, and the table has no `rpy`.
     let loader = Loader::new(&workcell("crash"), &Disk).unwrap();

@@ -457,6 +457,33 @@ impl Collider {
         self.world.holder(p)
     }
 
+    /// How far part `p`, which no robot holds, is from robot `r`'s gripper at time `t` (m;
+    /// 0 when they touch or overlap): the least distance from the part's bodies to the
+    /// robot's TCP (with the tool it moves with) or to a collision body of its tool link.
+    /// The TCP counts because a gripper is often not modelled (a tool link without
+    /// bodies, the `tool` offset standing for its fingers); the tool link's bodies count
+    /// because a modelled gripper closes on the part with them. Allocates nothing.
+    pub fn grip_gap(&self, p: usize, r: usize, vms: &[Vm], cell: &Cell, t: i64) -> f64 {
+        let (robot, vm) = (&cell.robots[r], &vms[r]);
+        let link = Collider::tool_world(cell, vm, r, t);
+        let tcp = link.mul(&vm.tool_at(t)).to_pose().translation;
+        let (link, part) = (link.to_pose(), self.world.part_pose(cell, p).to_pose());
+        let gripper = Owner::Link {
+            robot: r,
+            link: robot.model.tool_link,
+        };
+        let mut least = f64::INFINITY;
+        for b in self.bodies.iter().filter(|b| b.owner == Owner::Part(p)) {
+            let pb = part * b.local;
+            least = least.min(b.shape.distance_to_point(&pb, tcp, true));
+            for g in self.bodies.iter().filter(|g| g.owner == gripper) {
+                let d = distance(&pb, b.shape.as_ref(), &(link * g.local), g.shape.as_ref());
+                least = least.min(d);
+            }
+        }
+        least.max(0.0)
+    }
+
     /// Robot `r` grips part `p` at time `t`: from now on the part moves with its tool link.
     /// Pairs of the part touching at that instant are exempt until they separate.
     pub fn grip(&mut self, p: usize, r: usize, vms: &[Vm], cell: &Cell, t: i64) {

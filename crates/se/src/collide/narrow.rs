@@ -43,9 +43,8 @@ pub(super) fn gap(
     }
 }
 
-/// The distance between two placed shapes (m; 0 when they overlap), unbounded: the
-/// tests' reference for the closed forms.
-#[cfg(test)]
+/// The distance between two placed shapes (m; 0 when they overlap), unbounded: how far
+/// a part is from a gripper, and the tests' reference for the closed forms.
 pub(super) fn distance(
     pa: &Pose,
     a: &dyn parry3d::shape::Shape,

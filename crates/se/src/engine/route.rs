@@ -5,8 +5,10 @@
 
 use std::sync::Arc;
 
+use vworks_vm::Dim;
 use vworks_vm::bytecode::SrcPos;
 use vworks_vm::machine::{Event, EventKind};
+use vworks_vm::types::fmt_quantity;
 
 use super::queue::Entry;
 use super::races::Seen;
@@ -157,7 +159,21 @@ impl Simulation {
                 let part = self.cell.linked.robots[r].parts[*site as usize] as usize;
                 let name = &self.cell.parts[part].name;
                 match self.collider.holder(part) {
-                    None => self.collider.grip(part, r, &self.vms, &self.cell, t),
+                    None => {
+                        let gap = self.collider.grip_gap(part, r, &self.vms, &self.cell, t);
+                        let robot = &self.cell.robots[r];
+                        if gap <= robot.grip_distance {
+                            self.collider.grip(part, r, &self.vms, &self.cell, t);
+                        } else {
+                            let m = format!(
+                                "cannot grip `{name}`: it is {:.2} mm from {}'s gripper (its TCP and its tool link's collision bodies), farther than grip_distance {}; move the tool to the part first, or set a larger `grip_distance` in the workcell",
+                                gap * 1e3,
+                                robot.name,
+                                fmt_quantity(robot.grip_distance, Dim::LENGTH)
+                            );
+                            self.runtime_error(r, t, e.pos, m);
+                        }
+                    }
                     Some(h) if h == r => {
                         let m = format!(
                             "`{name}` is already in this robot's gripper; release it before gripping it again"
