@@ -577,9 +577,13 @@ impl Simulation {
         match entry {
             Entry::Resume(r, _) => {
                 // The robot's code runs now, in its turn; the event it stops before is
-                // the next entry if it is due at once.
+                // the next entry if it is due at once, and this step handles it too (a
+                // step is never only a resume, which records nothing).
                 self.queued_at[r] = None;
                 self.requeue(r);
+                if self.queued_at[r] == Some(t) {
+                    return self.outcome.is_none() && self.step(until);
+                }
             }
             Entry::Vm(r, _) => {
                 self.queued_at[r] = None;
