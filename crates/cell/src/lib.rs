@@ -338,7 +338,7 @@ impl Ctx<'_> {
             _ => "a number",
         };
         let x = self.quantity_unchecked(v, dim, key, &unit_hint)?;
-        if !x.is_finite() || (dim == Dim::LENGTH && x.abs() > MAX_LENGTH) {
+        if dim == Dim::LENGTH && x.abs() > MAX_LENGTH {
             return Err(self.bad(
                 key,
                 format!(
@@ -350,7 +350,34 @@ impl Ctx<'_> {
         Ok(x)
     }
 
+    /// A quantity of dimension `dim`, finite (`nan`, `inf` and `"1e999mm"` are errors),
+    /// not checked against any range.
     fn quantity_unchecked(
+        &self,
+        v: &toml::Value,
+        dim: Dim,
+        key: &str,
+        unit_hint: &dyn Fn() -> &'static str,
+    ) -> Result<f64, CellError> {
+        let x = self.quantity_any(v, dim, key, unit_hint)?;
+        if !x.is_finite() {
+            return Err(self.bad(
+                key,
+                format!(
+                    "{} is not a finite number; write {}",
+                    match v {
+                        toml::Value::String(s) => format!("`{s}`"),
+                        _ => x.to_string(),
+                    },
+                    unit_hint()
+                ),
+            ));
+        }
+        Ok(x)
+    }
+
+    /// A quantity of dimension `dim`, NaN and infinities included.
+    fn quantity_any(
         &self,
         v: &toml::Value,
         dim: Dim,
@@ -359,7 +386,7 @@ impl Ctx<'_> {
     ) -> Result<f64, CellError> {
         match v {
             toml::Value::Integer(i) => Ok(*i as f64),
-            toml::Value::Float(x) if x.is_finite() => Ok(*x),
+            toml::Value::Float(x) => Ok(*x),
             toml::Value::String(s) => match parse_quantity(s) {
                 Some(q) => q.si(dim).map_err(|d| {
                     self.bad(
