@@ -184,8 +184,17 @@ fn main() -> ExitCode {
     }
 }
 
+/// A file named on the command line: a regular file within the size limit
+/// (`vworks_cell::Disk`, as the workcell's files are read).
+fn read_bytes(path: &Path) -> Result<Vec<u8>, String> {
+    use vworks_cell::Files as _;
+    vworks_cell::Disk
+        .read(path)
+        .map_err(|e| cannot_read(path, &e))
+}
+
 fn read(path: &Path) -> Result<String, String> {
-    let bytes = std::fs::read(path).map_err(|e| cannot_read(path, &e))?;
+    let bytes = read_bytes(path)?;
     vworks_wslc::source_text(bytes).map_err(|e| format!("{}: {e}", path.display()))
 }
 
@@ -852,7 +861,7 @@ fn run(cmd: Command, color: bool) -> Result<ExitCode, String> {
         }
         Command::Disasm { files } => {
             let file = &files[0];
-            let bytes = std::fs::read(file).map_err(|e| cannot_read(file, &e))?;
+            let bytes = read_bytes(file)?;
             let (module, sources) = if bytes.starts_with(&vworks_vm::bytecode::MAGIC) {
                 if files.len() > 1 {
                     return Err(format!(
@@ -876,9 +885,9 @@ fn run(cmd: Command, color: bool) -> Result<ExitCode, String> {
                         let near = file
                             .parent()
                             .map(|d| d.join(Path::new(f).file_name().unwrap_or_default()));
-                        std::fs::read_to_string(f)
+                        read(Path::new(f))
                             .ok()
-                            .or_else(|| near.and_then(|p| std::fs::read_to_string(p).ok()))
+                            .or_else(|| near.and_then(|p| read(&p).ok()))
                             .unwrap_or_default()
                     })
                     .collect();

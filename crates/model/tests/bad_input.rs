@@ -170,6 +170,50 @@ fn missing_mesh() {
     );
 }
 
+/// A mesh linked to a device (`/dev/urandom`) was read until memory ran out, as was a
+/// huge file: only regular files (or links to them) within the size limit are read.
+#[cfg(unix)]
+#[test]
+fn meshes_that_are_devices_or_too_large_are_refused_unread() {
+    let d = dir();
+    let mesh = |name: &str| {
+        format!(
+            r#"<link name="a"><collision><geometry><mesh filename="{name}"/></geometry></collision></link>"#
+        )
+    };
+    let random = d.join("random.stl");
+    let _ = std::fs::remove_file(&random);
+    std::os::unix::fs::symlink("/dev/urandom", &random).unwrap();
+    expect_error(
+        "mesh linked to /dev/urandom",
+        load("random.urdf", &robot(&mesh("random.stl"))),
+        "random.urdf",
+        &[
+            "random.stl",
+            "a character device, not a regular file",
+            "name a file",
+        ],
+    );
+    // Sparse: no disk space, and never read.
+    let big = std::fs::File::create(d.join("big.stl")).unwrap();
+    big.set_len(vworks_model::files::MAX_FILE_BYTES + 1)
+        .unwrap();
+    expect_error(
+        "mesh over the limit",
+        load("big.urdf", &robot(&mesh("big.stl"))),
+        "big.urdf",
+        &["big.stl", "larger than 256 MiB"],
+    );
+    // A link to a regular file is read.
+    let stl = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 0.1 0 0\nvertex 0 0.1 0\nendloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 0 0.1 0\nvertex 0 0 0.1\nendloop\nendfacet\nendsolid t\n";
+    std::fs::write(d.join("real.stl"), stl).unwrap();
+    let linked = d.join("linked.stl");
+    let _ = std::fs::remove_file(&linked);
+    std::os::unix::fs::symlink(d.join("real.stl"), &linked).unwrap();
+    let ok = load("linked.urdf", &robot(&mesh("linked.stl")));
+    assert!(ok.is_ok(), "a link to a regular mesh: {:?}", ok.err());
+}
+
 #[test]
 fn nan_or_inf_in_an_origin() {
     let j = joint("j2", "revolute", "a", "b", "").replace(r#"xyz="0 0 0.1""#, r#"xyz="0 nan 0.1""#);

@@ -18,6 +18,7 @@ use pyo3::exceptions::{PyException, PyIndexError, PyKeyError, PyRuntimeWarning, 
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PySlice};
 use vworks_cell::CellError as WorkcellError;
+use vworks_cell::Files as _;
 use vworks_se::engine::{Issue, Outcome, RunResult, TraceEvent, Value};
 use vworks_se::mcaplog::{LoggedEvent, McapLog};
 
@@ -94,7 +95,9 @@ fn load_cell(py: Python<'_>, path: PathBuf) -> PyResult<Cell> {
         }) => {
             let mut sources = vworks_wslc::Sources::new();
             for d in &diagnostics {
-                if let Ok(text) = std::fs::read_to_string(&d.at.file) {
+                // Read as the loader read it: a regular file, within the size limit.
+                let bytes = vworks_cell::Disk.read(std::path::Path::new(&d.at.file));
+                if let Some(text) = bytes.ok().and_then(|b| String::from_utf8(b).ok()) {
                     sources.add(&d.at.file, &text);
                 }
             }

@@ -48,7 +48,8 @@ use vworks_model::math::Iso;
 pub use cycles::tcp_frame;
 pub use poses::FrameTransform;
 pub use read::{
-    LogContents, ReadOptions, read_log, read_log_bytes, read_log_bytes_with, read_log_with,
+    LogContents, MAX_LOG_BYTES, ReadOptions, read_log, read_log_bytes, read_log_bytes_with,
+    read_log_with,
 };
 
 use crate::sink::{RunEnd, RunSink};

@@ -5,6 +5,8 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use vworks_model::files::read_regular;
+
 use super::poses::{self, FrameTransform};
 use super::{LogError, LoggedEvent, RESULT_METADATA};
 
@@ -50,15 +52,22 @@ pub fn read_log(path: &Path) -> Result<LogContents, LogError> {
     read_log_with(path, ReadOptions::default())
 }
 
-/// Reads the log at `path`, decoding what `options` asks for besides.
+/// The largest log read (4 GiB): a log is read whole into memory.
+pub const MAX_LOG_BYTES: u64 = 4 << 30;
+
+/// Reads the log at `path`, decoding what `options` asks for besides. Only a regular file
+/// (or a link to one) of at most [`MAX_LOG_BYTES`] is read.
 pub fn read_log_with(path: &Path, options: ReadOptions) -> Result<LogContents, LogError> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| LogError::Read {
+    let bytes = read_regular(path, MAX_LOG_BYTES).map_err(|e| LogError::Read {
         file: file.clone(),
         reason: match e.kind() {
             std::io::ErrorKind::NotFound => format!(
                 "{e}; check the path, or write the log first: `vworks run CELL --log {file}`"
             ),
+            std::io::ErrorKind::FileTooLarge => {
+                format!("{e}; or log fewer cycles: `vworks run CELL --log {file} --log-every 10`")
+            }
             _ => e.to_string(),
         },
     })?;
