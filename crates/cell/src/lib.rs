@@ -19,6 +19,7 @@ use serde::Deserialize;
 pub use vworks_model::files::{Disk, Files, MemoryFiles};
 use vworks_model::math::Iso;
 use vworks_model::model::Geometry;
+use vworks_model::text::{escape_controls, escape_controls_owned};
 use vworks_model::urdf::{LoadOptions, load_file_with};
 use vworks_model::{RobotModel, builtin};
 use vworks_vm::{Dim, Module};
@@ -261,11 +262,13 @@ struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
+    /// The error at `key`; control characters in names the key or message quote (from
+    /// the workcell) escaped as log texts are, so they cannot drive a terminal.
     fn bad(&self, key: &str, message: impl Into<String>) -> CellError {
         CellError::Invalid {
             file: self.file.to_string(),
-            key: key.to_string(),
-            message: message.into(),
+            key: escape_controls(key).into_owned(),
+            message: escape_controls_owned(message.into()),
         }
     }
 

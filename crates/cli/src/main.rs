@@ -294,6 +294,7 @@ fn read_log(what: LogCommand) -> Result<ExitCode, String> {
         LogCommand::Info { .. } => {
             out!("{}", file.display());
             for (topic, n) in &log.counts {
+                let topic = vworks_se::trace::escape_controls(topic);
                 out!("  {topic:<10} {n:>8} messages");
             }
             if let Some((first, last)) = log.span {
@@ -689,9 +690,11 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
             serde_json::to_string_pretty(&v).map_err(|e| e.to_string())?
         );
     } else if !trace {
+        // Names and messages from the workcell, escaped as log texts are.
+        use vworks_se::trace::escape_controls as esc;
         out!(
             "cell {}: {} at {}",
-            cell.name,
+            esc(&cell.name),
             r.outcome.name(),
             secs(r.end_time_ns)
         );
@@ -706,7 +709,7 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
         for s in &r.robots {
             out!(
                 "{:<10} {:>10} {:>10} {:>10} {:>8}  {} at {}",
-                s.name,
+                esc(&s.name),
                 secs(s.moving_ns),
                 secs(s.waiting_ns),
                 secs(s.idle_ns),
@@ -719,22 +722,21 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
             out!(
                 "collision at {}: {} and {} (depth {:.1} mm)",
                 secs(c.time_ns),
-                c.a,
-                c.b,
+                esc(&c.a),
+                esc(&c.b),
                 c.depth * 1e3
             );
         }
         // (The compile and link warnings, which open the list, were printed with their
         // source lines.)
         for w in r.warnings.iter().skip(cell.warnings.len()) {
-            out!("warning[{}]: {}", w.kind, w.message);
+            out!("warning[{}]: {}", w.kind, esc(&w.message));
         }
         for e in &r.errors {
-            let at = e
-                .file
-                .as_ref()
-                .map_or(String::new(), |f| format!(" ({f}:{}:{})", e.line, e.col));
-            out!("error[{}]: {}{at}", e.kind, e.message);
+            let at = e.file.as_ref().map_or(String::new(), |f| {
+                format!(" ({}:{}:{})", esc(f), e.line, e.col)
+            });
+            out!("error[{}]: {}{at}", e.kind, esc(&e.message));
         }
         if !r.globals.is_empty() {
             let g: Vec<String> = r.globals.iter().map(|(k, v)| format!("{k}={v}")).collect();

@@ -371,6 +371,59 @@ fn a_log_cut_short_still_gives_what_was_written() {
     );
 }
 
+/// Names read from a log (robots, topics) reached the terminal raw: an escape sequence in
+/// a robot's name drove it in `log events`. They are escaped as log texts are.
+#[test]
+fn names_from_a_log_are_escaped() {
+    let dir = temp_dir("escaped-names");
+    std::fs::write(
+        dir.join("cell.toml"),
+        "name = \"c\"\n[[robot]]\nname = \"r\\u001b[31m1\"\nmodel = \"turntable\"\nprogram = \"r1.wsl\"\n",
+    )
+    .unwrap();
+    std::fs::write(dir.join("r1.wsl"), "proc main() { log \"hi\"; }\n").unwrap();
+    let log = dir.join("run.mcap");
+    let cell = dir.join("cell.toml");
+    let run = vworks(&[
+        "run",
+        cell.to_str().unwrap(),
+        "--log",
+        log.to_str().unwrap(),
+    ]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let events = vworks(&["log", "events", log.to_str().unwrap()]);
+    let out = text(&events.stdout);
+    assert!(
+        out.contains("0 r\\u{1b}[31m1 log \"hi\" r1.wsl:1:15"),
+        "{out}"
+    );
+    assert!(!out.contains('\u{1b}'), "{out:?}");
+    // A log written by another program, with an escape in a topic's name.
+    let other = dir.join("other.mcap");
+    let mut mcap = mcap::WriteOptions::new()
+        .create(std::io::BufWriter::new(
+            std::fs::File::create(&other).unwrap(),
+        ))
+        .unwrap();
+    let schema = mcap.add_schema("raw", "", &[]).unwrap();
+    let channel = mcap
+        .add_channel(schema, "/x\u{1b}]0;owned\u{7}", "", &Default::default())
+        .unwrap();
+    let header = mcap::records::MessageHeader {
+        channel_id: channel,
+        sequence: 0,
+        log_time: 0,
+        publish_time: 0,
+    };
+    mcap.write_to_known_channel(&header, b"1").unwrap();
+    mcap.finish().unwrap();
+    drop(mcap);
+    let info = vworks(&["log", "info", other.to_str().unwrap()]);
+    let out = text(&info.stdout);
+    assert!(out.contains("/x\\u{1b}]0;owned\\u{7}"), "{out}");
+    assert!(!out.contains('\u{1b}') && !out.contains('\u{7}'), "{out:?}");
+}
+
 #[test]
 fn a_file_that_is_not_a_log_is_an_error() {
     let dir = temp_dir("notlog");

@@ -11,6 +11,7 @@
 //! - [`mesh`]: STL (binary, ASCII) and OBJ vertices.
 //! - [`files`]: where URDFs and meshes are read from (the disk, or memory).
 //! - [`math`]: the small rigid-transform algebra all of it uses.
+//! - [`text`]: names from files as a terminal may print them (control characters escaped).
 //!
 //! Joint values are radians for revolute axes and metres for prismatic ones. A joint
 //! whose URDF gives no acceleration limit accelerates to full speed in
@@ -23,6 +24,7 @@ pub mod ik;
 pub mod math;
 pub mod mesh;
 pub mod model;
+pub mod text;
 pub mod urdf;
 
 pub use error::ModelError;

@@ -16,6 +16,10 @@ use std::path::Path;
 
 use serde_json::{Value as Json, json};
 use vworks_cell::Cell;
+/// Names from a workcell or a log as a terminal may print them (control characters
+/// escaped as in log texts' `{:?}`): the CLI's summary and `log info` use it too.
+pub use vworks_model::text::escape_controls;
+use vworks_model::text::escape_controls_owned;
 use vworks_vm::bytecode::{Module, SrcPos};
 use vworks_vm::machine::EventKind;
 use vworks_vm::types::fmt_quantity;
@@ -470,7 +474,8 @@ impl Event {
     }
 
     /// The trace line `time_ns robot kind details file:line:col`, `-` for an empty field
-    /// and the file's name only: the golden traces' format.
+    /// and the file's name only: the golden traces' format. Control characters (in a name
+    /// from the log) are escaped as in log texts.
     pub fn line(&self) -> String {
         let details = if self.details.is_empty() {
             "-"
@@ -478,12 +483,12 @@ impl Event {
             &self.details
         };
         let pos = self.position().unwrap_or_else(|| "-".into());
-        format!(
+        escape_controls_owned(format!(
             "{} {} {} {details} {pos}",
             self.time_ns,
             self.robot.as_deref().unwrap_or("-"),
             self.kind
-        )
+        ))
     }
 
     /// The event as the JSON object of the log's `/events` topic (schema in
@@ -851,7 +856,8 @@ impl TraceEvent {
         }
     }
 
-    /// The trace line: `time_ns robot kind details file:line:col`, `-` for empty fields.
+    /// The trace line: `time_ns robot kind details file:line:col`, `-` for empty fields;
+    /// control characters (in the workcell's names) escaped as in log texts.
     pub fn line(&self, cell: &Cell) -> String {
         let robot = self
             .robot
@@ -865,7 +871,10 @@ impl TraceEvent {
             (Some(f), Some(p)) => format!("{}:{}:{}", file_name(f), p.line, p.col),
             _ => "-".to_string(),
         };
-        format!("{} {robot} {} {details} {pos}", self.time, self.kind)
+        escape_controls_owned(format!(
+            "{} {robot} {} {details} {pos}",
+            self.time, self.kind
+        ))
     }
 }
 
