@@ -424,6 +424,80 @@ fn names_from_a_log_are_escaped() {
     assert!(!out.contains('\u{1b}') && !out.contains('\u{7}'), "{out:?}");
 }
 
+/// `vworks view` wrote its page to `$TMPDIR/vworks-view/<log>.html`: another local user
+/// who made that folder first (or a link there) could overwrite the user's files or swap
+/// the page. The page goes to a new folder of the user's own (mode 0700), created
+/// exclusively: what is planted at the old path is neither followed nor written.
+#[cfg(unix)]
+#[test]
+fn view_writes_its_page_in_a_private_folder_of_its_own() {
+    use std::os::unix::fs::PermissionsExt as _;
+    let dir = temp_dir("view-private");
+    std::fs::write(
+        dir.join("cell.toml"),
+        "name = \"c\"\n[[robot]]\nname = \"r1\"\nmodel = \"turntable\"\nprogram = \"r1.wsl\"\n",
+    )
+    .unwrap();
+    std::fs::write(dir.join("r1.wsl"), "proc main() { log \"hi\"; }\n").unwrap();
+    let log = dir.join("run.mcap");
+    let cell = dir.join("cell.toml");
+    let run = vworks(&[
+        "run",
+        cell.to_str().unwrap(),
+        "--log",
+        log.to_str().unwrap(),
+    ]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    // The planted folder: the old path links to the victim's folder, which holds a file of
+    // the page's name.
+    let tmp = dir.join("tmp");
+    let victim = dir.join("victim");
+    std::fs::create_dir_all(&tmp).unwrap();
+    std::fs::create_dir_all(&victim).unwrap();
+    std::fs::write(victim.join("run.html"), "precious").unwrap();
+    std::os::unix::fs::symlink(&victim, tmp.join("vworks-view")).unwrap();
+    let view = || {
+        Command::new(env!("CARGO_BIN_EXE_vworks"))
+            .args(["view", log.to_str().unwrap()])
+            .env("TMPDIR", &tmp)
+            .env_remove("BROWSER")
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .output()
+            .unwrap()
+    };
+    let out = view();
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(
+        std::fs::read_to_string(victim.join("run.html")).unwrap() == "precious",
+        "the victim's file was overwritten through the planted link"
+    );
+    assert_eq!(
+        std::fs::read_dir(&victim).unwrap().count(),
+        1,
+        "nothing else written there"
+    );
+    let page = PathBuf::from(text(&out.stdout).trim());
+    assert_eq!(page.file_name().unwrap(), "run.html");
+    let folder = page.parent().unwrap();
+    assert_eq!(
+        folder.parent().unwrap(),
+        tmp.as_path(),
+        "{}",
+        page.display()
+    );
+    assert_ne!(folder, tmp.join("vworks-view"));
+    let meta = std::fs::symlink_metadata(folder).unwrap();
+    assert!(meta.is_dir(), "a folder, not a link");
+    assert_eq!(meta.permissions().mode() & 0o777, 0o700);
+    assert!(std::fs::read_to_string(&page).unwrap().contains("<html"));
+    // A second view makes a folder of its own again.
+    let again = view();
+    assert!(again.status.success(), "{}", text(&again.stderr));
+    let second = PathBuf::from(text(&again.stdout).trim());
+    assert_ne!(second.parent(), page.parent());
+}
+
 #[test]
 fn a_file_that_is_not_a_log_is_an_error() {
     let dir = temp_dir("notlog");
