@@ -82,6 +82,7 @@ pub(crate) fn sweep(a: Args) -> Result<ExitCode, String> {
         jobs: a.jobs,
         until_ns: sweep.until_ns,
         keep_logs: a.keep_logs.clone(),
+        ..RunOptions::default()
     };
     let stop = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&stop);

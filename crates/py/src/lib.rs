@@ -8,13 +8,17 @@
 //! Times are seconds (floats) with `_ns` twins (integers); lengths metres, angles
 //! radians. Errors are `vworks.Error` and its subclasses, never a crash: the library
 //! does not panic on input, and a panic that slipped through would surface as pyo3's
-//! `PanicException`, not an abort. Simulating releases the GIL.
+//! `PanicException`, not an abort. Simulating releases the GIL; Ctrl-C ends a run
+//! (`interrupt`) with `KeyboardInterrupt`.
 
 use std::path::PathBuf;
 use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 
 use pyo3::create_exception;
-use pyo3::exceptions::{PyException, PyIndexError, PyKeyError, PyRuntimeWarning, PyValueError};
+use pyo3::exceptions::{
+    PyException, PyIndexError, PyKeyError, PyRuntimeError, PyRuntimeWarning, PyValueError,
+};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PySlice};
 use vworks_cell::CellError as WorkcellError;
@@ -22,6 +26,7 @@ use vworks_cell::Files as _;
 use vworks_se::engine::{Issue, Outcome, RunResult, TraceEvent, Value};
 use vworks_se::mcaplog::{LoggedEvent, McapLog};
 
+mod interrupt;
 mod program;
 mod sweep;
 
@@ -157,7 +162,8 @@ impl Cell {
     /// (the default) a runtime error raises `SimulationError` (its `.result` is the run)
     /// and a log that could not be written raises `Error`; without, both are in the result
     /// (`outcome == "error"`, `errors`, `log_error`). Collisions and deadlocks are results,
-    /// not exceptions.
+    /// not exceptions. Ctrl-C ends the run (its log finished) and raises
+    /// `KeyboardInterrupt`.
     #[pyo3(signature = (until = None, log = None, log_every = 1, check = true))]
     fn run(
         &self,
@@ -171,13 +177,18 @@ impl Cell {
         if log_every == 0 {
             return Err(PyValueError::new_err("log_every must be 1 or more"));
         }
-        let mut sim = vworks_se::engine::Simulation::new(Arc::clone(&self.cell));
+        let stop = Arc::new(AtomicBool::new(false));
+        let mut sim =
+            vworks_se::engine::Simulation::new(Arc::clone(&self.cell)).with_stop(Arc::clone(&stop));
         if let Some(path) = &log {
             let l = McapLog::create(path, &self.cell, log_every)
                 .map_err(|e| Error::new_err(e.to_string()))?;
             sim = sim.with_log(l);
         }
-        let r = py.detach(|| sim.run(until));
+        let (r, interrupted) = interrupt::interruptible(py, &stop, || sim.run(until));
+        if let Some(e) = interrupted {
+            return Err(e);
+        }
         let log_file = log.as_ref().map(|p| p.display().to_string());
         let report = RunReport::new(&self.cell, r, log_file.as_deref());
         if check && report.outcome == Outcome::Error.name() {
@@ -193,10 +204,15 @@ impl Cell {
     /// A simulation of the cell at time 0, to step (`step_event`, `step_cycle`,
     /// `run_until`) and inspect (`robot(name)`, `globals`, `events_since`).
     fn simulation(&self) -> Simulation {
+        let stop = Arc::new(AtomicBool::new(false));
         Simulation {
             cell: Arc::clone(&self.cell),
-            sim: Some(vworks_se::engine::Simulation::new(Arc::clone(&self.cell))),
+            sim: Some(
+                vworks_se::engine::Simulation::new(Arc::clone(&self.cell))
+                    .with_stop(Arc::clone(&stop)),
+            ),
             result: None,
+            stop,
         }
     }
 
@@ -683,6 +699,10 @@ impl RunReport {
     }
 }
 
+/// The longest simulated span `run_until` runs on the calling thread (100 ms: 25 cycles
+/// of 4 ms); a longer one runs on a thread of its own, so that Ctrl-C can stop it.
+const INLINE_SPAN_NS: i64 = 100_000_000;
+
 /// A running simulation of a cell: step it and look at it.
 #[pyclass(module = "vworks")]
 struct Simulation {
@@ -690,6 +710,8 @@ struct Simulation {
     /// `None` once `result()` ended it.
     sim: Option<vworks_se::engine::Simulation>,
     result: Option<Py<RunReport>>,
+    /// Set by Ctrl-C during `run_until` or `run`: the run ends, outcome `interrupted`.
+    stop: Arc<AtomicBool>,
 }
 
 impl Simulation {
@@ -700,17 +722,28 @@ impl Simulation {
     }
 
     /// Runs `f` on the simulation with the GIL released; raises `SimulationError` if a
-    /// robot's program failed. Returns whether the run goes on.
+    /// robot's program failed. Returns whether the run goes on. With `interruptible` (work
+    /// that may take long), Ctrl-C ends the run (outcome `interrupted`) and raises
+    /// `KeyboardInterrupt`; a single step is short and runs on this thread.
     fn drive(
         &mut self,
         py: Python<'_>,
+        interruptible: bool,
         f: impl FnOnce(&mut vworks_se::engine::Simulation) -> bool + Send,
     ) -> PyResult<bool> {
         let sim = self
             .sim
             .as_mut()
             .ok_or_else(|| Error::new_err("this simulation has ended: result() was called"))?;
-        let going = py.detach(|| f(sim));
+        let going = if interruptible {
+            let (going, interrupted) = interrupt::interruptible(py, &self.stop, || f(sim));
+            if let Some(e) = interrupted {
+                return Err(e);
+            }
+            going
+        } else {
+            py.detach(|| f(sim))
+        };
         if sim.outcome() == Some(Outcome::Error) {
             let first = sim.errors().first().map(issue);
             return Err(simulation_error(py, first.as_ref(), py.None()));
@@ -739,28 +772,33 @@ impl Simulation {
     /// Handles the next event (and the cycle boundaries before it). Returns False once
     /// the run is over. Raises `SimulationError` if a robot's program fails.
     fn step_event(&mut self, py: Python<'_>) -> PyResult<bool> {
-        self.drive(py, |s| s.step(None))
+        self.drive(py, false, |s| s.step(None))
     }
 
     /// Runs to the next cycle boundary and processes it (collision check). Returns False
     /// once the run is over.
     fn step_cycle(&mut self, py: Python<'_>) -> PyResult<bool> {
-        self.drive(py, |s| {
+        self.drive(py, false, |s| {
             let b = s.next_boundary();
             s.advance_to(b)
         })
     }
 
     /// Runs everything due up to `t` seconds and moves the clock there (unless the run
-    /// ends first). Returns False once the run is over.
+    /// ends first). Returns False once the run is over. Ctrl-C ends the run (outcome
+    /// `interrupted`) and raises `KeyboardInterrupt`.
     fn run_until(&mut self, py: Python<'_>, t: f64) -> PyResult<bool> {
         let t = to_ns(t, "t")?;
-        self.drive(py, move |s| s.advance_to(t))
+        // A short span runs on this thread (a thread of its own would cost more than it):
+        // Python sees a Ctrl-C as soon as it returns.
+        let long = t.saturating_sub(self.running()?.time()) > INLINE_SPAN_NS;
+        self.drive(py, long, move |s| s.advance_to(t))
     }
 
     /// Runs to the end and returns the `Result` (as `Cell.run(check=False)` would).
+    /// Ctrl-C ends the run (outcome `interrupted`) and raises `KeyboardInterrupt`.
     fn run(&mut self, py: Python<'_>) -> PyResult<Py<RunReport>> {
-        self.drive(py, |s| {
+        self.drive(py, true, |s| {
             while s.step(None) {}
             false
         })
@@ -821,7 +859,7 @@ impl Simulation {
 
     /// A live view of robot `name`: `.joints` and `.tcp` are read when asked.
     fn robot(slf: Bound<'_, Self>, name: &str) -> PyResult<Robot> {
-        let index = slf.borrow().robot_index(name)?;
+        let index = reading(slf.try_borrow())?.robot_index(name)?;
         Ok(Robot {
             sim: slf.unbind(),
             index,
@@ -867,6 +905,16 @@ impl Simulation {
     }
 }
 
+/// The simulation to read, or the `RuntimeError` pyo3 raises for a method called while
+/// another thread steps it (a `Robot`'s `.joints` would otherwise panic).
+fn reading<T>(borrowed: Result<T, pyo3::pycell::PyBorrowError>) -> PyResult<T> {
+    borrowed.map_err(|e| {
+        PyRuntimeError::new_err(format!(
+            "{e}: another thread is stepping this simulation; read it between steps"
+        ))
+    })
+}
+
 /// A robot of a running `Simulation`.
 #[pyclass(frozen, module = "vworks")]
 struct Robot {
@@ -886,7 +934,7 @@ impl Robot {
     /// Its joints now, one per axis (rad, or m for linear axes), as a numpy array.
     #[getter]
     fn joints<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let sim = self.sim.borrow(py);
+        let sim = reading(self.sim.try_borrow(py))?;
         let q = sim.running()?.joints(self.index);
         py.import("numpy")?.getattr("array")?.call1((q,))
     }
@@ -895,7 +943,7 @@ impl Robot {
     /// metres).
     #[getter]
     fn tcp<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let sim = self.sim.borrow(py);
+        let sim = reading(self.sim.try_borrow(py))?;
         let p = sim.running()?.tcp(self.index);
         let rows: Vec<Vec<f64>> = (0..4)
             .map(|i| {

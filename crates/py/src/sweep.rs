@@ -6,6 +6,8 @@
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -51,6 +53,7 @@ fn py_value<'py>(py: Python<'py>, v: &Value) -> PyResult<Bound<'py, PyAny>> {
 /// `(columns, rows)` of the sweep table; `variables` name the variable columns (the first
 /// path of each), `offset` is added to the variant numbers. With `files` (path → bytes,
 /// as `cell_files` gives them) the workcell and everything it reads come from memory.
+/// Ctrl-C stops the runs under way and raises `KeyboardInterrupt`.
 #[pyfunction]
 #[pyo3(signature = (cell, variants, variables, jobs=None, until=None, files=None, offset=0))]
 #[allow(clippy::too_many_arguments)]
@@ -90,7 +93,8 @@ pub(crate) fn run_variants<'py>(
         Some(m) => m,
         None => &Disk,
     };
-    let outcome = py.detach(|| {
+    let stop = Arc::new(AtomicBool::new(false));
+    let (outcome, interrupted) = crate::interrupt::interruptible(py, &stop, || {
         let loader = Loader::new(&cell, fs).map_err(|e| e.to_string())?;
         for o in parsed.iter().flatten() {
             loader.check(&o.path).map_err(|e| e.to_string())?;
@@ -99,13 +103,17 @@ pub(crate) fn run_variants<'py>(
             jobs: jobs.unwrap_or(0),
             until_ns,
             keep_logs: None,
+            stop: Some(Arc::clone(&stop)),
         };
-        let mut rows = vworks_sweep::run_variants(&loader, &parsed, &options, &|_| {}, None);
+        let mut rows = vworks_sweep::run_variants(&loader, &parsed, &options, &|_| {}, Some(&stop));
         for r in &mut rows {
             r.index += offset;
         }
         Ok::<_, String>(Table::of_cell(&variables, loader.base(), &rows))
     });
+    if let Some(e) = interrupted {
+        return Err(e);
+    }
     let table = outcome.map_err(CellError::new_err)?;
     let rows = PyList::empty(py);
     for r in &table.rows {

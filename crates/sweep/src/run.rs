@@ -20,8 +20,8 @@ pub struct Row {
     pub index: usize,
     /// Its values (path, value as the workcell would write it).
     pub values: Vec<(String, toml::Value)>,
-    /// `completed`, `collision`, `deadlock`, `error`, `until`, or `invalid` (the variant
-    /// did not load: see `error`).
+    /// `completed`, `collision`, `deadlock`, `error`, `until`, `interrupted` (stopped by
+    /// [`RunOptions::stop`]), or `invalid` (the variant did not load: see `error`).
     pub outcome: String,
     /// The run's end (s).
     pub end_time: f64,
@@ -105,6 +105,10 @@ pub struct RunOptions {
     pub until_ns: Option<i64>,
     /// Write each variant's MCAP log into this folder (`variant-00042.mcap`).
     pub keep_logs: Option<std::path::PathBuf>,
+    /// When this becomes true, the runs under way end between two events (outcome
+    /// `interrupted`): with `run_variants`' `stop`, a sweep of endless programs can be
+    /// stopped.
+    pub stop: Option<Arc<AtomicBool>>,
 }
 
 /// Runs `variants` of the loader's workcell; `progress` is called with the number done
@@ -164,6 +168,9 @@ pub fn run_one(loader: &Loader, index: usize, overrides: &[Override], options: &
         Err(e) => return Row::invalid(index, overrides, e.to_string()),
     };
     let mut sim = Simulation::new(Arc::clone(&cell));
+    if let Some(stop) = &options.stop {
+        sim = sim.with_stop(Arc::clone(stop));
+    }
     if let Some(dir) = &options.keep_logs {
         let path = dir.join(format!("variant-{index:05}.mcap"));
         match McapLog::create(Path::new(&path), &cell, 1) {

@@ -61,6 +61,17 @@ def variants_of(
     return names, out
 
 
+def _check_batch(batch: Any) -> Optional[int]:
+    """`batch` as given, if it is None or a whole number of variants from 1 up."""
+    if batch is None:
+        return None
+    if isinstance(batch, bool) or not isinstance(batch, int):
+        raise TypeError(f"batch must be a whole number of variants per task (an int), not {batch!r}")
+    if batch < 1:
+        raise ValueError(f"batch must be 1 or more variants per task, not {batch}")
+    return batch
+
+
 def _batches(variants: List[Variant], size: int) -> List[Tuple[int, List[Variant]]]:
     return [(i, variants[i : i + size]) for i in range(0, len(variants), size)]
 
@@ -108,8 +119,11 @@ def sweep(
     `backend`: ``"local"`` (Rust threads, `jobs` of them, default one per core),
     ``"ray"`` (tasks on the Ray cluster `ray.init()` connected to; started locally if
     none) or ``"dask"`` (tasks on the current `dask.distributed` client). `batch`: variants
-    per task (default: about four tasks per worker). `until` stops each run (s).
+    per task, an int from 1 up (default: about four tasks per worker); a TypeError or
+    ValueError otherwise. `until` stops each run (s). Ctrl-C stops a local sweep's runs
+    and raises KeyboardInterrupt.
     """
+    batch = _check_batch(batch)
     cell = os.fspath(cell)
     names, variants = variants_of(variables)
     if backend == "local":
