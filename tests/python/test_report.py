@@ -13,6 +13,7 @@ here with the `mcap` package and the schemas in the file), not from the page:
 import os
 import re
 import shutil
+import stat
 import subprocess
 import sys
 import time
@@ -470,8 +471,13 @@ def test_vworks_view_opens_the_report_in_a_browser(tmp_path):
     out = subprocess.run([VWORKS, "view", str(log)], capture_output=True, text=True,
                          env={**env, "BROWSER": str(fake), "TMPDIR": str(tmp_path)})
     assert out.returncode == 0, out.stderr
-    written = tmp_path / "vworks-view" / "crash.html"
-    assert f"opened {written}" in out.stderr
+    # A new folder of the user's own in TMPDIR (never a fixed, shared path).
+    match = re.search(r"opened (\S+) \(with ", out.stderr)
+    assert match, out.stderr
+    written = Path(match.group(1))
+    assert written.name == "crash.html" and written.parent.parent == tmp_path
+    assert written.parent.name.startswith("vworks-view-")
+    assert stat.S_IMODE(written.parent.lstat().st_mode) == 0o700
     for _ in range(100):  # the browser runs beside vworks, which does not wait for it
         if opened.exists() and opened.read_text().strip():
             break
@@ -482,7 +488,9 @@ def test_vworks_view_opens_the_report_in_a_browser(tmp_path):
     out = subprocess.run([VWORKS, "view", str(log)], capture_output=True, text=True,
                          env={**env, "TMPDIR": str(tmp_path)})
     assert out.returncode == 0, out.stderr
-    assert out.stdout.strip() == str(written)
+    again = Path(out.stdout.strip())
+    assert again.name == "crash.html" and again.parent.parent == tmp_path
+    assert again.parent != written.parent, "each view makes a folder of its own"
     assert "no display" in out.stderr
 
 
