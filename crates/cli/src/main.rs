@@ -405,10 +405,7 @@ fn write_report(log: &Path, output: Option<PathBuf>) -> Result<ExitCode, String>
 /// Writes the report of `log` to `out` and says so on stderr; the exit code is a failure
 /// if the log is damaged (the report shows what was read).
 fn report_to(log: &Path, out: &Path) -> Result<(vworks_report::Written, ExitCode), String> {
-    let written = vworks_report::write_report(log, out).map_err(|e| match e {
-        vworks_report::ReportError::Write { .. } => format!("{e} with -o"),
-        e => e.to_string(),
-    })?;
+    let written = vworks_report::write_report(log, out).map_err(|e| e.to_string())?;
     eprintln!(
         "wrote {} ({} robots, {} events, {} collisions{})",
         out.display(),
@@ -711,16 +708,34 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
     let flag = std::sync::Arc::clone(&stop);
     let _ = ctrlc::set_handler(move || flag.store(true, std::sync::atomic::Ordering::Relaxed));
     let mut sim = vworks_se::engine::Simulation::new(std::sync::Arc::clone(&cell)).with_stop(stop);
+    // The log goes to a temporary file beside it, renamed at the end (never over an input).
+    let mut log_temp = None;
     if let Some(path) = log {
-        match vworks_se::mcaplog::McapLog::create(path, &cell, log_every) {
-            Ok(l) => sim = sim.with_log(l),
-            Err(e) => {
-                let (m, file) = (e.to_string(), display(path));
+        let created = vworks_model::output::temp_beside(path, &sweep::inputs_of(&cell))
+            .map_err(|e| e.to_string())
+            .and_then(|temp| {
+                let log = vworks_se::mcaplog::McapLog::create(&temp, &cell, log_every);
+                let named = |m: String| m.replace(&temp.display().to_string(), &display(path));
+                log.map_err(|e| named(e.to_string())).map(|l| (temp, l))
+            });
+        match created {
+            Ok((temp, l)) => (sim, log_temp) = (sim.with_log(l), Some(temp)),
+            Err(m) => {
+                let file = display(path);
                 return cannot_start(vec![json_issue("log", &m, None, Some(&file), 0, 0)], m);
             }
         }
     }
-    let r = simulate(sim, until, progress.then_some(started));
+    let mut r = simulate(sim, until, progress.then_some(started));
+    if let (Some(temp), Some(path)) = (&log_temp, log) {
+        let named = |m: &String| m.replace(&temp.display().to_string(), &display(path));
+        r.log_error = r.log_error.as_ref().map(named);
+        let finished = match r.log_error {
+            None => vworks_model::output::finish(temp, path).map_err(|e| e.to_string()),
+            Some(_) => Ok(std::fs::remove_file(temp).unwrap_or(())),
+        };
+        r.log_error = r.log_error.take().or(finished.err());
+    }
     if let Some(e) = &r.log_error {
         eprintln!("error: {e}");
     }
@@ -864,8 +879,7 @@ fn run(cmd: Command, color: bool) -> Result<ExitCode, String> {
             };
             let out = output.unwrap_or_else(|| first.with_extension("wslb"));
             let bytes = module.encode();
-            std::fs::write(&out, &bytes)
-                .map_err(|e| format!("cannot write `{}`: {e}", out.display()))?;
+            vworks_model::output::write_output(&out, &files, &bytes).map_err(|e| e.to_string())?;
             eprintln!(
                 "wrote {} ({} bytes, {} instructions)",
                 out.display(),

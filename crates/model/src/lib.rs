@@ -10,6 +10,8 @@
 //! - [`builtin`]: `irb120`, `kr6r900`, `lrmate200id`, `ur5`, `turntable`, `track`.
 //! - [`mesh`]: STL (binary, ASCII) and OBJ vertices.
 //! - [`files`]: where URDFs and meshes are read from (the disk, or memory).
+//! - [`output`]: where every file vworks writes goes through: never over an input, through
+//!   a temporary file renamed at the end.
 //! - [`math`]: the small rigid-transform algebra all of it uses.
 //! - [`text`]: names from files as a terminal may print them (control characters escaped).
 //!
@@ -24,6 +26,7 @@ pub mod ik;
 pub mod math;
 pub mod mesh;
 pub mod model;
+pub mod output;
 pub mod text;
 pub mod urdf;
 

@@ -221,15 +221,8 @@ pub enum ReportError {
     #[error(transparent)]
     Log(#[from] vworks_se::mcaplog::LogError),
     /// The page cannot be written.
-    #[error(
-        "cannot write `{file}`: {reason}; check that its folder exists and is writable, or choose another file"
-    )]
-    Write {
-        /// The HTML file.
-        file: String,
-        /// What the system said.
-        reason: String,
-    },
+    #[error("{0}")]
+    Write(#[from] vworks_model::output::OutputError),
 }
 
 /// What [`write_report`] wrote.
@@ -252,10 +245,8 @@ pub fn write_report(log: &std::path::Path, out: &std::path::Path) -> Result<Writ
     let options = vworks_se::mcaplog::ReadOptions { poses: true };
     let contents = vworks_se::mcaplog::read_log_with(log, options)?;
     let (report, html) = page(&contents, &log.display().to_string());
-    std::fs::write(out, html).map_err(|e| ReportError::Write {
-        file: out.display().to_string(),
-        reason: e.to_string(),
-    })?;
+    // Never over the log it reads; through a temporary file, so a failure keeps the old page.
+    vworks_model::output::write_output(out, &[log], html.as_bytes())?;
     Ok(Written {
         report,
         events: contents.events.len(),

@@ -33,9 +33,10 @@ use vworks_cell::{CellError, Files};
 
 pub mod html;
 pub mod run;
+pub mod stream;
 pub mod table;
 
-pub use run::{Row, run_variants};
+pub use run::{Row, run_streamed, run_variants};
 pub use table::Table;
 
 /// Why a sweep could not be set up (a run that fails is a row of the table, not this).
@@ -93,7 +94,7 @@ struct VariableFile {
 struct RangeFile {
     from: toml::Value,
     to: toml::Value,
-    steps: usize,
+    steps: u64,
 }
 
 #[derive(Deserialize, Debug)]
@@ -101,7 +102,7 @@ struct RangeFile {
 struct RandomFile {
     from: toml::Value,
     to: toml::Value,
-    count: usize,
+    count: u64,
 }
 
 /// How the variables' values combine into variants.
@@ -122,7 +123,91 @@ pub struct Variable {
     /// program where it is).
     pub paths: Vec<String>,
     /// Its values, as the workcell file would write them.
-    pub values: Vec<toml::Value>,
+    pub values: Values,
+}
+
+/// A variable's values: a list, or made when asked for (a range or random samples of
+/// millions of values take no memory).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Values {
+    /// The values given.
+    List(Vec<toml::Value>),
+    /// `steps` values evenly spaced from `from` to `to`, both included.
+    Range {
+        /// The first value (SI).
+        from: f64,
+        /// The last value (SI).
+        to: f64,
+        /// How many (at least 2).
+        steps: usize,
+        /// Integers (both ends were).
+        integer: bool,
+    },
+    /// `count` uniform samples in [`from`, `to`), each from the variable's own stream.
+    Random {
+        /// The low end (SI).
+        from: f64,
+        /// The high end (SI).
+        to: f64,
+        /// How many (at least 1).
+        count: usize,
+        /// Integers (both ends were).
+        integer: bool,
+        /// The stream's seed: the file's seed and the variable's index.
+        seed: u64,
+    },
+}
+
+impl Values {
+    /// How many values.
+    pub fn len(&self) -> usize {
+        match self {
+            Values::List(v) => v.len(),
+            Values::Range { steps, .. } => *steps,
+            Values::Random { count, .. } => *count,
+        }
+    }
+
+    /// No values (a sweep file never gives a variable none).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The `k`-th value (`k < len()`).
+    pub fn get(&self, k: usize) -> toml::Value {
+        match self {
+            Values::List(v) => v.get(k).cloned().unwrap_or(toml::Value::Integer(0)),
+            Values::Range {
+                from,
+                to,
+                steps,
+                integer,
+            } => value(
+                from + (to - from) * k as f64 / (steps.saturating_sub(1).max(1)) as f64,
+                *integer,
+            ),
+            Values::Random {
+                from,
+                to,
+                integer,
+                seed,
+                ..
+            } => value(from + (to - from) * splitmix64_unit(*seed, k), *integer),
+        }
+    }
+
+    /// Every value, in order.
+    pub fn to_vec(&self) -> Vec<toml::Value> {
+        (0..self.len()).map(|k| self.get(k)).collect()
+    }
+
+    /// Every value is a number (the table shows it as one).
+    pub fn numeric(&self) -> bool {
+        match self {
+            Values::List(v) => v.iter().all(table::is_numeric),
+            Values::Range { .. } | Values::Random { .. } => true,
+        }
+    }
 }
 
 /// A sweep: the workcell, its variables and how they combine.
@@ -204,30 +289,39 @@ impl Sweep {
                 ));
             }
             let values = match (&v.values, &v.range, &v.random) {
-                (Some(values), None, None) if !values.is_empty() => values.clone(),
+                (Some(values), None, None) if !values.is_empty() => Values::List(values.clone()),
                 (None, Some(r), None) => {
-                    let (a, b, unit) = ends(&r.from, &r.to).map_err(|m| bad(&key, m))?;
                     if r.steps < 2 {
                         return Err(bad(
                             &key,
                             "a range needs `steps` of at least 2 (its two ends)".into(),
                         ));
                     }
-                    (0..r.steps)
-                        .map(|k| value(a + (b - a) * k as f64 / (r.steps - 1) as f64, unit))
-                        .collect()
+                    let steps = at_most_max(r.steps)
+                        .ok_or_else(|| bad(&format!("{key}.range.steps"), too_many(r.steps)))?;
+                    let (from, to, integer) = ends(&r.from, &r.to).map_err(|m| bad(&key, m))?;
+                    Values::Range {
+                        from,
+                        to,
+                        steps,
+                        integer,
+                    }
                 }
                 (None, None, Some(r)) => {
-                    let (a, b, unit) = ends(&r.from, &r.to).map_err(|m| bad(&key, m))?;
                     if r.count == 0 {
                         return Err(bad(&key, "`count` must be at least 1".into()));
                     }
-                    // Each variable its own stream: the seed and the variable's index.
-                    let mut rng =
-                        SplitMix64(sf.seed ^ (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
-                    (0..r.count)
-                        .map(|_| value(a + (b - a) * rng.unit(), unit))
-                        .collect()
+                    let count = at_most_max(r.count)
+                        .ok_or_else(|| bad(&format!("{key}.random.count"), too_many(r.count)))?;
+                    let (from, to, integer) = ends(&r.from, &r.to).map_err(|m| bad(&key, m))?;
+                    Values::Random {
+                        from,
+                        to,
+                        count,
+                        integer,
+                        // Each variable its own stream: the seed and the variable's index.
+                        seed: sf.seed ^ (i as u64).wrapping_mul(GOLDEN),
+                    }
                 }
                 _ => {
                     return Err(bad(
@@ -263,9 +357,16 @@ impl Sweep {
             }
         };
         if count.is_none_or(|n| n > MAX_VARIANTS) {
+            let sizes: Vec<String> = variables
+                .iter()
+                .map(|v| v.values.len().to_string())
+                .collect();
             return Err(bad(
                 "variable",
-                format!("more than {MAX_VARIANTS} variants; sweep fewer values, or zip them"),
+                format!(
+                    "{} values make more than {MAX_VARIANTS} variants; sweep fewer values, or zip them",
+                    sizes.join(" × ")
+                ),
             ));
         }
         let until_ns = match &sf.until {
@@ -282,38 +383,74 @@ impl Sweep {
         })
     }
 
-    /// The variants, in order: each one override per variable.
-    pub fn variants(&self) -> Vec<Vec<Override>> {
-        let n = match self.combine {
+    /// How many variants (at most [`MAX_VARIANTS`]: `read` checked it).
+    pub fn count(&self) -> usize {
+        match self.combine {
             Combine::Zip => self.variables.first().map_or(0, |v| v.values.len()),
-            Combine::Product => self.variables.iter().map(|v| v.values.len()).product(),
-        };
-        (0..n)
-            .map(|i| {
-                let mut rest = i;
-                let mut picks = vec![0; self.variables.len()];
-                match self.combine {
-                    Combine::Zip => picks.iter_mut().for_each(|p| *p = i),
-                    Combine::Product => {
-                        // The last variable changes fastest.
-                        for (k, v) in self.variables.iter().enumerate().rev() {
-                            picks[k] = rest % v.values.len();
-                            rest /= v.values.len();
-                        }
-                    }
-                }
-                self.variables
+            Combine::Product => self
+                .variables
+                .iter()
+                .try_fold(1usize, |n, v| n.checked_mul(v.values.len()))
+                .unwrap_or(usize::MAX),
+        }
+    }
+
+    /// The `i`-th variant (`i < count()`): one override per path of each variable, made
+    /// when asked for, so a sweep of millions of variants holds none of them.
+    pub fn variant(&self, i: usize) -> Vec<Override> {
+        let mut picks = vec![i; self.variables.len()];
+        if self.combine == Combine::Product {
+            // The last variable changes fastest.
+            let mut rest = i;
+            for (k, v) in self.variables.iter().enumerate().rev() {
+                let n = v.values.len().max(1);
+                picks[k] = rest % n;
+                rest /= n;
+            }
+        }
+        self.variables
+            .iter()
+            .zip(picks)
+            .flat_map(|(v, k)| {
+                let value = v.values.get(k);
+                v.paths
                     .iter()
-                    .zip(picks)
-                    .flat_map(|(v, k)| {
-                        v.paths
-                            .iter()
-                            .map(move |p| Override::new(p.clone(), v.values[k].clone()))
-                    })
-                    .collect()
+                    .map(move |p| Override::new(p.clone(), value.clone()))
             })
             .collect()
     }
+
+    /// Checks that `objective` is a numeric column of the table this sweep makes of a
+    /// cell with these `robots` (before any variant runs); `Err` names the columns.
+    pub fn check_objective(&self, objective: &str, robots: &[String]) -> Result<(), String> {
+        let variables: Vec<(String, bool)> = self
+            .variables
+            .iter()
+            .map(|v| (v.path.clone(), v.values.numeric()))
+            .collect();
+        let numeric = table::numeric_columns(&variables, robots);
+        if numeric.iter().any(|c| c == objective) {
+            return Ok(());
+        }
+        Err(format!(
+            "`{objective}` is not a numeric column of the table; choose one of {}",
+            numeric.join(", ")
+        ))
+    }
+
+    /// Every variant, in order (for a few; a large sweep asks for [`Sweep::variant`]).
+    pub fn variants(&self) -> Vec<Vec<Override>> {
+        (0..self.count()).map(|i| self.variant(i)).collect()
+    }
+}
+
+/// More than this many values of one variable is more variants than a sweep may have.
+fn at_most_max(n: u64) -> Option<usize> {
+    usize::try_from(n).ok().filter(|n| *n <= MAX_VARIANTS)
+}
+
+fn too_many(n: u64) -> String {
+    format!("{n} values are more than the {MAX_VARIANTS} variants a sweep may have; give fewer")
 }
 
 /// The two ends of a range as SI numbers, and whether both are integers (then the values
@@ -375,21 +512,16 @@ fn time_ns(v: &toml::Value) -> Result<i64, String> {
     Ok((s * 1e9).round() as i64)
 }
 
-/// SplitMix64: a small, well-known generator; the same seed gives the same values on every
+const GOLDEN: u64 = 0x9E37_79B9_7F4A_7C15;
+
+/// The `k`-th (0-based) output of SplitMix64 seeded with `seed`, uniform in [0, 1): a
+/// small, well-known generator whose state after `k + 1` steps is `seed + (k + 1) ·
+/// golden`, so any sample is made directly; the same seed gives the same values on every
 /// machine.
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1).
-    fn unit(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
+fn splitmix64_unit(seed: u64, k: usize) -> f64 {
+    let mut z = seed.wrapping_add((k as u64).wrapping_add(1).wrapping_mul(GOLDEN));
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    (z >> 11) as f64 / (1u64 << 53) as f64
 }

@@ -1,12 +1,19 @@
 //! Running variants: each loaded from the shared [`Loader`] (its overrides applied, its
 //! programs and models from the cache), simulated, and reduced to a [`Row`]. Threads take
-//! the next variant from a shared counter; rows are kept by index, so the table is the
-//! same whatever the number of threads.
+//! the next variant from a shared counter and hand each row over in variant order as soon
+//! as every row before it is done ([`run_streamed`]), so the table is the same whatever
+//! the number of threads, and only the rows that finished early are held: a thread does
+//! not start a variant more than [`WINDOW`] after the first one not yet done.
+//!
+//! A watchdog stops a variant that runs longer than its wall-time limit (its row's
+//! outcome is `timeout`) and, when the sweep is stopped (Ctrl-C), every running variant
+//! at once (their rows are left out).
 
+use std::collections::BTreeMap;
 use std::path::Path;
-use std::sync::Arc;
-use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Arc, Condvar, Mutex, MutexGuard, PoisonError};
+use std::time::{Duration, Instant};
 
 use vworks_cell::{Loader, Override};
 use vworks_se::engine::{RunResult, Simulation};
@@ -20,8 +27,8 @@ pub struct Row {
     pub index: usize,
     /// Its values (path, value as the workcell would write it).
     pub values: Vec<(String, toml::Value)>,
-    /// `completed`, `collision`, `deadlock`, `error`, `until`, `interrupted` (stopped by
-    /// [`RunOptions::stop`]), or `invalid` (the variant did not load: see `error`).
+    /// `completed`, `collision`, `deadlock`, `error`, `until`, or `invalid` (the variant
+    /// did not load: see `error`).
     pub outcome: String,
     /// The run's end (s).
     pub end_time: f64,
@@ -34,6 +41,8 @@ pub struct Row {
     pub min_clearance: Option<f64>,
     /// The deadlock, error or load error, in one line (empty if none).
     pub error: String,
+    /// The variant's log (`keep_logs`) could not be written: `error` says why.
+    pub log_failed: bool,
 }
 
 impl Row {
@@ -67,6 +76,7 @@ impl Row {
                 .first()
                 .map(|e| e.message.lines().next().unwrap_or_default().to_string())
                 .unwrap_or_default(),
+            log_failed: false,
         }
     }
 
@@ -80,7 +90,16 @@ impl Row {
             collisions: 0,
             min_clearance: None,
             error: why.lines().next().unwrap_or_default().to_string(),
+            log_failed: false,
         }
+    }
+
+    /// The variant's log could not be written: the row is an `error` saying why.
+    fn log_failed(mut self, why: &str) -> Row {
+        self.outcome = Outcome::Error.name().to_string();
+        self.error = why.lines().next().unwrap_or_default().to_string();
+        self.log_failed = true;
+        self
     }
 
     /// Completed without a collision: a candidate for the summary's best.
@@ -105,79 +124,348 @@ pub struct RunOptions {
     pub until_ns: Option<i64>,
     /// Write each variant's MCAP log into this folder (`variant-00042.mcap`).
     pub keep_logs: Option<std::path::PathBuf>,
-    /// When this becomes true, the runs under way end between two events (outcome
-    /// `interrupted`): with `run_variants`' `stop`, a sweep of endless programs can be
-    /// stopped.
-    pub stop: Option<Arc<AtomicBool>>,
+    /// Stop a variant that runs longer than this (wall time): its row is a `timeout`.
+    pub variant_timeout: Option<Duration>,
 }
+
+/// Rows started at most this far past the first one not yet done: the rows held
+/// (finished before an earlier one) are fewer.
+pub const WINDOW: usize = 1024;
 
 /// Runs `variants` of the loader's workcell; `progress` is called with the number done
 /// after each one; `stop` ends the sweep early (the rows not run are missing). The rows
-/// are in variant order.
+/// are in variant order. (For many variants, [`run_streamed`] holds none of them.)
 pub fn run_variants(
     loader: &Loader,
     variants: &[Vec<Override>],
     options: &RunOptions,
     progress: &(dyn Fn(usize) + Sync),
-    stop: Option<&AtomicBool>,
+    stop: Option<&Arc<AtomicBool>>,
 ) -> Vec<Row> {
+    let mut rows = Vec::new();
+    run_streamed(
+        loader,
+        variants.len(),
+        &|i| variants.get(i).cloned().unwrap_or_default(),
+        options,
+        progress,
+        stop,
+        &mut |row| rows.push(row),
+    );
+    rows
+}
+
+/// Runs variants `0..count` (`variant(i)` makes the i-th) and hands each row to `sink` in
+/// variant order as soon as it and every row before it are done. `progress` is called
+/// with the number done after each; `stop` stops every running variant at once and starts
+/// no more (their rows are left out; the rows done are all handed over). Returns the
+/// most rows held at once waiting for an earlier one (fewer than [`WINDOW`]).
+pub fn run_streamed(
+    loader: &Loader,
+    count: usize,
+    variant: &(dyn Fn(usize) -> Vec<Override> + Sync),
+    options: &RunOptions,
+    progress: &(dyn Fn(usize) + Sync),
+    stop: Option<&Arc<AtomicBool>>,
+    sink: &mut (dyn FnMut(Row) + Send),
+) -> usize {
     let jobs = match options.jobs {
         0 => std::thread::available_parallelism().map_or(1, usize::from),
         n => n,
-    }
-    .min(variants.len().max(1));
-    let next = AtomicUsize::new(0);
+    };
+    let watch = Watchdog::default();
+    let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
+    let work = |i: usize| {
+        let overrides = variant(i);
+        let running = watch.start(options.variant_timeout);
+        let row = run_watched(loader, i, &overrides, options, &running);
+        watch.end(&running);
+        row
+    };
+    std::thread::scope(|s| {
+        let watching = s.spawn(|| watch.run(stop));
+        let held = schedule(count, jobs, WINDOW, &stopped, &work, progress, sink);
+        watch.finish();
+        let _ = watching.join();
+        held
+    })
+}
+
+/// Runs `work(i)` for `i` in `0..count` on `jobs` threads, each taking the next `i`, but
+/// never one `window` or more past the first not yet done; hands the results to `sink` in
+/// order (`None`: no result, skipped). Stops taking work once `stopped()`. Returns the most
+/// results held at once.
+fn schedule<T: Send>(
+    count: usize,
+    jobs: usize,
+    window: usize,
+    stopped: &(dyn Fn() -> bool + Sync),
+    work: &(dyn Fn(usize) -> Option<T> + Sync),
+    progress: &(dyn Fn(usize) + Sync),
+    sink: &mut (dyn FnMut(T) + Send),
+) -> usize {
+    let state = Mutex::new(Order {
+        taken: 0,
+        next: 0,
+        held: BTreeMap::new(),
+        max_held: 0,
+        sink,
+    });
+    let moved = Condvar::new();
     let done = AtomicUsize::new(0);
-    let rows: Mutex<Vec<Option<Row>>> = Mutex::new(vec![None; variants.len()]);
-    let work = || {
+    let lock = || state.lock().unwrap_or_else(PoisonError::into_inner);
+    let thread = || {
         loop {
-            if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
-                return;
-            }
-            let i = next.fetch_add(1, Ordering::Relaxed);
-            let Some(overrides) = variants.get(i) else {
-                return;
+            let i = {
+                let mut o = lock();
+                while o.taken >= o.next + window && !stopped() {
+                    // Woken when a row is handed over, or to look at `stopped` again.
+                    o = moved
+                        .wait_timeout(o, Duration::from_millis(50))
+                        .unwrap_or_else(PoisonError::into_inner)
+                        .0;
+                }
+                if stopped() || o.taken >= count {
+                    return;
+                }
+                o.taken += 1;
+                o.taken - 1
             };
-            let row = run_one(loader, i, overrides, options);
-            if let Ok(mut r) = rows.lock() {
-                r[i] = Some(row);
-            }
+            let result = work(i);
+            lock().put(i, result);
+            moved.notify_all();
             progress(done.fetch_add(1, Ordering::Relaxed) + 1);
         }
     };
-    if jobs <= 1 {
-        work();
+    let jobs = jobs.clamp(1, count.max(1));
+    if jobs == 1 {
+        thread();
     } else {
         std::thread::scope(|s| {
             for _ in 0..jobs {
-                s.spawn(work);
+                s.spawn(thread);
             }
         });
     }
-    rows.into_inner()
-        .unwrap_or_else(std::sync::PoisonError::into_inner)
-        .into_iter()
-        .flatten()
-        .collect()
+    let mut o = state.into_inner().unwrap_or_else(PoisonError::into_inner);
+    // Stopped: the rows done after one that was not are handed over too, in order.
+    for (_, r) in std::mem::take(&mut o.held) {
+        if let Some(r) = r {
+            (o.sink)(r);
+        }
+    }
+    o.max_held
+}
+
+/// Results in order: those that finished before an earlier one wait in `held`.
+struct Order<'s, T> {
+    /// Indices handed out.
+    taken: usize,
+    /// The first index not yet handed to the sink.
+    next: usize,
+    held: BTreeMap<usize, Option<T>>,
+    max_held: usize,
+    sink: &'s mut (dyn FnMut(T) + Send),
+}
+
+impl<T> Order<'_, T> {
+    fn put(&mut self, i: usize, result: Option<T>) {
+        self.held.insert(i, result);
+        self.max_held = self.max_held.max(self.held.len() - 1);
+        while let Some(r) = self.held.remove(&self.next) {
+            if let Some(r) = r {
+                (self.sink)(r);
+            }
+            self.next += 1;
+        }
+    }
+}
+
+/// A variant being run: its own stop flag, its deadline, and whether it passed it.
+struct Running {
+    stop: Arc<AtomicBool>,
+    deadline: Option<Instant>,
+    timed_out: AtomicBool,
+}
+
+/// Stops variants past their deadline, and every variant when the sweep is stopped.
+#[derive(Default)]
+struct Watchdog {
+    running: Mutex<Vec<Arc<Running>>>,
+    finished: Mutex<bool>,
+    wake: Condvar,
+}
+
+impl Watchdog {
+    fn list(&self) -> MutexGuard<'_, Vec<Arc<Running>>> {
+        self.running.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+
+    fn start(&self, limit: Option<Duration>) -> Arc<Running> {
+        let r = Arc::new(Running {
+            stop: Arc::new(AtomicBool::new(false)),
+            deadline: limit.map(|l| Instant::now() + l),
+            timed_out: AtomicBool::new(false),
+        });
+        self.list().push(Arc::clone(&r));
+        r
+    }
+
+    fn end(&self, r: &Arc<Running>) {
+        self.list().retain(|x| !Arc::ptr_eq(x, r));
+    }
+
+    fn finish(&self) {
+        *self.finished.lock().unwrap_or_else(PoisonError::into_inner) = true;
+        self.wake.notify_all();
+    }
+
+    /// Until `finish`: every 10 ms, stops the variants past their deadline, or all of
+    /// them once `stop` is set.
+    fn run(&self, stop: Option<&Arc<AtomicBool>>) {
+        let mut finished = self.finished.lock().unwrap_or_else(PoisonError::into_inner);
+        while !*finished {
+            let all = stop.is_some_and(|s| s.load(Ordering::Relaxed));
+            let now = Instant::now();
+            for r in self.list().iter() {
+                if r.deadline.is_some_and(|d| now >= d) && !r.stop.load(Ordering::Relaxed) {
+                    r.timed_out.store(true, Ordering::Relaxed);
+                    r.stop.store(true, Ordering::Relaxed);
+                } else if all {
+                    r.stop.store(true, Ordering::Relaxed);
+                }
+            }
+            finished = self
+                .wake
+                .wait_timeout(finished, Duration::from_millis(10))
+                .unwrap_or_else(PoisonError::into_inner)
+                .0;
+        }
+    }
+}
+
+/// One variant under the watchdog: `None` if the sweep was stopped while it ran.
+fn run_watched(
+    loader: &Loader,
+    index: usize,
+    overrides: &[Override],
+    options: &RunOptions,
+    running: &Running,
+) -> Option<Row> {
+    let row = run_with(loader, index, overrides, options, Some(&running.stop));
+    if row.outcome != Outcome::Interrupted.name() {
+        return Some(row);
+    }
+    if !running.timed_out.load(Ordering::Relaxed) {
+        return None;
+    }
+    let limit = options.variant_timeout.unwrap_or_default().as_secs_f64();
+    Some(Row {
+        outcome: "timeout".into(),
+        error: format!(
+            "ran longer than the variant timeout of {limit} s (wall time), stopped at {} s of simulated time",
+            row.end_time
+        ),
+        ..row
+    })
 }
 
 /// One variant: load, simulate (with its log if asked), reduce.
 pub fn run_one(loader: &Loader, index: usize, overrides: &[Override], options: &RunOptions) -> Row {
+    run_with(loader, index, overrides, options, None)
+}
+
+fn run_with(
+    loader: &Loader,
+    index: usize,
+    overrides: &[Override],
+    options: &RunOptions,
+    stop: Option<&Arc<AtomicBool>>,
+) -> Row {
     let cell = match loader.load(overrides) {
         Ok(c) => Arc::new(c),
         Err(e) => return Row::invalid(index, overrides, e.to_string()),
     };
     let mut sim = Simulation::new(Arc::clone(&cell));
-    if let Some(stop) = &options.stop {
+    if let Some(stop) = stop {
         sim = sim.with_stop(Arc::clone(stop));
     }
     if let Some(dir) = &options.keep_logs {
         let path = dir.join(format!("variant-{index:05}.mcap"));
         match McapLog::create(Path::new(&path), &cell, 1) {
             Ok(log) => sim = sim.with_log(log),
-            Err(e) => return Row::invalid(index, overrides, e.to_string()),
+            Err(e) => {
+                let row = Row::invalid(index, overrides, String::new());
+                return row.log_failed(&e.to_string());
+            }
         }
     }
     let r = sim.run(options.until_ns);
-    Row::of(index, overrides, &r)
+    let row = Row::of(index, overrides, &r);
+    match &r.log_error {
+        Some(e) => row.log_failed(e),
+        None => row,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+
+    use super::*;
+
+    /// Rows come out in order whatever the threads, and the rows held while an early
+    /// variant is slow stay within the window, however many variants there are.
+    #[test]
+    fn rows_are_handed_over_in_order_holding_at_most_the_window() {
+        let (count, window) = (5_000, 16);
+        let others = AtomicUsize::new(0);
+        let work = |i: usize| {
+            if i == 0 {
+                // Slow: the other thread finishes the window behind it, then would go on
+                // (without the window) while this one is still running.
+                while others.load(Ordering::Relaxed) < window - 1 {
+                    std::thread::yield_now();
+                }
+                for _ in 0..100_000 {
+                    std::thread::yield_now();
+                    if others.load(Ordering::Relaxed) >= 2 * window {
+                        break;
+                    }
+                }
+            } else {
+                others.fetch_add(1, Ordering::Relaxed);
+            }
+            (i % 7 != 3).then_some(i)
+        };
+        let mut got = Vec::new();
+        let held = schedule(count, 2, window, &|| false, &work, &|_| {}, &mut |i| {
+            got.push(i)
+        });
+        let want: Vec<usize> = (0..count).filter(|i| i % 7 != 3).collect();
+        assert_eq!(got, want);
+        assert!(held < window, "{held} rows held, the window is {window}");
+    }
+
+    #[test]
+    fn a_stopped_schedule_hands_over_what_was_done() {
+        let stop = AtomicBool::new(false);
+        let work = |i: usize| {
+            if i == 9 {
+                stop.store(true, Ordering::Relaxed);
+            }
+            Some(i)
+        };
+        let mut got = Vec::new();
+        schedule(
+            100,
+            1,
+            4,
+            &|| stop.load(Ordering::Relaxed),
+            &work,
+            &|_| {},
+            &mut |i| got.push(i),
+        );
+        assert_eq!(got, (0..10).collect::<Vec<_>>());
+    }
 }

@@ -78,50 +78,188 @@ fn shown(v: &toml::Value) -> Value {
     }
 }
 
+/// Rows of a table, visited in order: a [`Table`] in memory, or a table file read back
+/// (`stream::TableFile`) so the page never holds every row.
+pub trait Rows {
+    /// The column names.
+    fn columns(&self) -> &[String];
+    /// Calls `f` with each row in order.
+    fn for_each_row(&self, f: &mut dyn FnMut(&[Value])) -> std::io::Result<()>;
+}
+
+impl Rows for Table {
+    fn columns(&self) -> &[String] {
+        &self.columns
+    }
+
+    fn for_each_row(&self, f: &mut dyn FnMut(&[Value])) -> std::io::Result<()> {
+        self.rows.iter().for_each(|r| f(r));
+        Ok(())
+    }
+}
+
+/// Completed without a collision (a candidate for the best), read from the row's
+/// `outcome` and `collisions`: the same as [`Row::feasible`].
+pub fn feasible(columns: &[String], row: &[Value]) -> bool {
+    let at = |name: &str| {
+        columns
+            .iter()
+            .position(|c| c == name)
+            .and_then(|k| row.get(k))
+    };
+    matches!(at("outcome"), Some(Value::Text(o)) if o == "completed")
+        && at("collisions").and_then(Value::number) == Some(0.0)
+}
+
+/// The columns of a sweep's table: `variant`, each variable, `outcome`, `end_time`, each
+/// robot's `cycle_time.ROBOT`, `collisions`, `min_clearance`, `error`.
+pub fn columns(variables: &[String], robots: &[String]) -> Vec<String> {
+    let mut columns = vec!["variant".to_string()];
+    columns.extend(variables.iter().cloned());
+    columns.extend(["outcome".to_string(), "end_time".to_string()]);
+    columns.extend(robots.iter().map(|r| format!("cycle_time.{r}")));
+    columns.extend(["collisions", "min_clearance", "error"].map(String::from));
+    columns
+}
+
+/// The numeric columns of such a table, known before any variant runs: `variant`, the
+/// variables whose every value is a number, `end_time`, `cycle_time.ROBOT`,
+/// `collisions`, `min_clearance` — what an objective may be.
+pub fn numeric_columns(variables: &[(String, bool)], robots: &[String]) -> Vec<String> {
+    let mut out = vec!["variant".to_string()];
+    out.extend(variables.iter().filter(|(_, n)| *n).map(|(v, _)| v.clone()));
+    out.push("end_time".into());
+    out.extend(robots.iter().map(|r| format!("cycle_time.{r}")));
+    out.extend(["collisions", "min_clearance"].map(String::from));
+    out
+}
+
+/// Whether a variable's value shows as a number in the table.
+pub fn is_numeric(v: &toml::Value) -> bool {
+    shown(v).number().is_some()
+}
+
+/// One row of the table with these `variables` and `robots`.
+pub fn row_values(variables: &[String], robots: &[String], r: &Row) -> Vec<Value> {
+    let mut out = vec![Value::Int(r.index as i64)];
+    for v in variables {
+        out.push(
+            r.values
+                .iter()
+                .rev()
+                .find(|(p, _)| p == v)
+                .map_or(Value::Empty, |(_, x)| shown(x)),
+        );
+    }
+    out.push(Value::Text(r.outcome.clone()));
+    out.push(if r.outcome == "invalid" {
+        Value::Empty
+    } else {
+        Value::Num(r.end_time)
+    });
+    for robot in robots {
+        out.push(
+            r.cycle_times
+                .iter()
+                .find(|(n, _)| n == robot)
+                .and_then(|(_, t)| *t)
+                .map_or(Value::Empty, Value::Num),
+        );
+    }
+    out.push(Value::Int(r.collisions as i64));
+    out.push(r.min_clearance.map_or(Value::Empty, Value::Num));
+    out.push(Value::Text(r.error.clone()));
+    out
+}
+
+/// A CSV line (RFC 4180) of `values`, with its newline.
+pub fn csv_line(values: &[Value]) -> String {
+    let cells: Vec<String> = values.iter().map(Value::csv).collect();
+    format!("{}\n", cells.join(","))
+}
+
+/// The CSV header line of `columns`.
+pub fn csv_header(columns: &[String]) -> String {
+    let names: Vec<Value> = columns.iter().map(|c| Value::Text(c.clone())).collect();
+    csv_line(&names)
+}
+
+/// A JSON line: one object, keys in column order, with its newline.
+pub fn json_line(columns: &[String], values: &[Value]) -> String {
+    let mut s = String::from("{");
+    for (k, (c, v)) in columns.iter().zip(values).enumerate() {
+        if k > 0 {
+            s.push(',');
+        }
+        let _ = write!(s, "{}:{}", serde_json::json!(c), v.json());
+    }
+    s.push_str("}\n");
+    s
+}
+
+/// The best rows by an objective, kept as rows pass (at most `n` held): the smallest
+/// objective first among feasible rows, ties in the order they came.
+#[derive(Clone, Debug)]
+pub struct Best {
+    column: Option<usize>,
+    n: usize,
+    seen: usize,
+    /// (objective, order seen, row).
+    kept: Vec<(f64, usize, Vec<Value>)>,
+}
+
+impl Best {
+    /// Keeps the `n` best by the column `objective` of `columns`.
+    pub fn new(columns: &[String], objective: &str, n: usize) -> Best {
+        Best {
+            column: columns.iter().position(|c| c == objective),
+            n,
+            seen: 0,
+            kept: Vec::new(),
+        }
+    }
+
+    /// Offers a row (with the table's `columns`); kept if feasible and among the best.
+    pub fn offer(&mut self, columns: &[String], row: &[Value]) {
+        let order = self.seen;
+        self.seen += 1;
+        let Some(x) = self.column.and_then(|k| row.get(k)).and_then(Value::number) else {
+            return;
+        };
+        if self.n == 0 || !feasible(columns, row) {
+            return;
+        }
+        let at = self
+            .kept
+            .partition_point(|(v, o, _)| v.total_cmp(&x).then(o.cmp(&order)).is_lt());
+        if at < self.n {
+            self.kept.insert(at, (x, order, row.to_vec()));
+            self.kept.truncate(self.n);
+        }
+    }
+
+    /// The best rows, best first.
+    pub fn rows(&self) -> Vec<&[Value]> {
+        self.kept.iter().map(|(_, _, r)| r.as_slice()).collect()
+    }
+
+    /// The order (0-based, as offered) of each best row, best first.
+    pub fn order(&self) -> Vec<usize> {
+        self.kept.iter().map(|(_, o, _)| *o).collect()
+    }
+}
+
 impl Table {
     /// The table of `rows`, with a column per variable in `variables` and per robot in
     /// `robots`.
     pub fn new(variables: &[String], robots: &[String], rows: &[Row]) -> Table {
-        let mut columns = vec!["variant".to_string()];
-        columns.extend(variables.iter().cloned());
-        columns.extend(["outcome".to_string(), "end_time".to_string()]);
-        columns.extend(robots.iter().map(|r| format!("cycle_time.{r}")));
-        columns.extend(["collisions", "min_clearance", "error"].map(String::from));
-        let rows = rows
-            .iter()
-            .map(|r| {
-                let mut out = vec![Value::Int(r.index as i64)];
-                for v in variables {
-                    out.push(
-                        r.values
-                            .iter()
-                            .rev()
-                            .find(|(p, _)| p == v)
-                            .map_or(Value::Empty, |(_, x)| shown(x)),
-                    );
-                }
-                out.push(Value::Text(r.outcome.clone()));
-                out.push(if r.outcome == "invalid" {
-                    Value::Empty
-                } else {
-                    Value::Num(r.end_time)
-                });
-                for robot in robots {
-                    out.push(
-                        r.cycle_times
-                            .iter()
-                            .find(|(n, _)| n == robot)
-                            .and_then(|(_, t)| *t)
-                            .map_or(Value::Empty, Value::Num),
-                    );
-                }
-                out.push(Value::Int(r.collisions as i64));
-                out.push(r.min_clearance.map_or(Value::Empty, Value::Num));
-                out.push(Value::Text(r.error.clone()));
-                out
-            })
-            .collect();
-        Table { columns, rows }
+        Table {
+            columns: columns(variables, robots),
+            rows: rows
+                .iter()
+                .map(|r| row_values(variables, robots, r))
+                .collect(),
+        }
     }
 
     /// The table of `rows` of a sweep of `cell`: a column per variable and per robot.
@@ -137,40 +275,23 @@ impl Table {
 
     /// CSV (RFC 4180), header first.
     pub fn csv(&self) -> String {
-        let mut s = String::new();
-        let header: Vec<String> = self
-            .columns
-            .iter()
-            .map(|c| Value::Text(c.clone()).csv())
-            .collect();
-        let _ = writeln!(s, "{}", header.join(","));
-        for row in &self.rows {
-            let cells: Vec<String> = row.iter().map(Value::csv).collect();
-            let _ = writeln!(s, "{}", cells.join(","));
-        }
+        let mut s = csv_header(&self.columns);
+        self.rows.iter().for_each(|r| s.push_str(&csv_line(r)));
         s
     }
 
     /// JSON lines: one object per row, keys in column order.
     pub fn json_lines(&self) -> String {
-        let mut s = String::new();
-        for row in &self.rows {
-            s.push('{');
-            for (k, (c, v)) in self.columns.iter().zip(row).enumerate() {
-                if k > 0 {
-                    s.push(',');
-                }
-                let _ = write!(s, "{}:{}", serde_json::json!(c), v.json());
-            }
-            s.push_str("}\n");
-        }
-        s
+        self.rows
+            .iter()
+            .map(|r| json_line(&self.columns, r))
+            .collect()
     }
 
-    /// The `n` best rows by `objective` (smallest first) among those where `feasible`
-    /// (completed, no collision) holds: their indices into `rows`. `Err` names the numeric
+    /// The `n` best rows by `objective` (smallest first) among the feasible ones
+    /// (completed, no collision): their indices into `rows`. `Err` names the numeric
     /// columns if `objective` is not one.
-    pub fn best(&self, objective: &str, n: usize, feasible: &[bool]) -> Result<Vec<usize>, String> {
+    pub fn best(&self, objective: &str, n: usize) -> Result<Vec<usize>, String> {
         let numeric: Vec<&str> = self
             .columns
             .iter()
@@ -178,23 +299,14 @@ impl Table {
             .filter(|(k, _)| self.rows.iter().any(|r| r[*k].number().is_some()))
             .map(|(_, c)| c.as_str())
             .collect();
-        let Some(k) = self
-            .column(objective)
-            .filter(|k| numeric.contains(&self.columns[*k].as_str()))
-        else {
+        if !numeric.contains(&objective) {
             return Err(format!(
                 "`{objective}` is not a numeric column of the table; choose one of {}",
                 numeric.join(", ")
             ));
-        };
-        let mut candidates: Vec<(f64, usize)> = self
-            .rows
-            .iter()
-            .enumerate()
-            .filter(|(i, _)| feasible.get(*i).copied().unwrap_or(false))
-            .filter_map(|(i, r)| Some((r[k].number()?, i)))
-            .collect();
-        candidates.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        Ok(candidates.into_iter().take(n).map(|(_, i)| i).collect())
+        }
+        let mut best = Best::new(&self.columns, objective, n);
+        self.rows.iter().for_each(|r| best.offer(&self.columns, r));
+        Ok(best.order())
     }
 }

@@ -181,8 +181,7 @@ fn the_best_are_completed_without_collision_smallest_first() {
     let rows = run_variants(&loader, &variants, &RunOptions::default(), &|_| {}, None);
     let names = vec!["robot.r2.base.xyz.0".to_string()];
     let table = Table::new(&names, &["r1".into(), "r2".into()], &rows);
-    let feasible: Vec<bool> = rows.iter().map(vworks_sweep::Row::feasible).collect();
-    let best = table.best("end_time", 3, &feasible).unwrap();
+    let best = table.best("end_time", 3).unwrap();
     assert_eq!(best.len(), 3);
     let k = table.column("end_time").unwrap();
     let t = |i: usize| table.rows[i][k].number().unwrap();
@@ -196,9 +195,157 @@ fn the_best_are_completed_without_collision_smallest_first() {
         best.iter()
             .all(|i| rows[*i].outcome == "completed" && rows[*i].collisions == 0)
     );
-    let e = table.best("speed", 3, &feasible).unwrap_err();
+    let e = table.best("speed", 3).unwrap_err();
     assert!(e.contains("end_time") && e.contains("cycle_time.r1"), "{e}");
     // The page charts the objective over the one variable named (a scatter).
-    let page = vworks_sweep::html::page("t", &table, &names, "end_time", &feasible, &best);
+    let page = vworks_sweep::html::page("t", &table, &names, "end_time", &best);
     assert!(page.contains("<svg id=\"chart\"") && page.contains("class=\"feasible\""));
+}
+
+/// `steps = 4294967296` aborted allocating 137 GB and `count = 2^64-1` panicked: the
+/// counts are checked before anything is made, and the error names the key.
+#[test]
+fn absurd_sizes_are_errors_naming_the_key() {
+    for (line, key) in [
+        (
+            "range = { from = \"1ms\", to = \"8ms\", steps = 4294967296 }",
+            "variable[0] `cycle`.range.steps",
+        ),
+        (
+            "random = { from = \"1ms\", to = \"8ms\", count = 18446744073709551615 }",
+            "variable[0] `cycle`.random.count",
+        ),
+    ] {
+        let text = format!("cell = \"c.toml\"\n[[variable]]\npath = \"cycle\"\n{line}\n");
+        let e = sweep_of(&text).unwrap_err();
+        assert!(
+            e.starts_with(&format!("s/sweep.toml: {key}: ")) && e.contains("give fewer"),
+            "{e}"
+        );
+    }
+    // Each variable within the limit, their product over it: every size named.
+    let text = "cell = \"c.toml\"\n[[variable]]\npath = \"cycle\"\nrange = { from = 1, to = 9, steps = 5000000 }\n[[variable]]\npath = \"clearance\"\nrange = { from = 1, to = 9, steps = 3 }\n";
+    let e = sweep_of(text).unwrap_err();
+    assert!(
+        e.contains("5000000 × 3 values make more than 10000000 variants"),
+        "{e}"
+    );
+    // Within it, a range of millions of values is made when asked for, not before.
+    let text = "cell = \"c.toml\"\n[[variable]]\npath = \"cycle\"\nrange = { from = 0, to = 9999999, steps = 10000000 }\n";
+    let s = sweep_of(text).unwrap();
+    assert_eq!(s.count(), 10_000_000);
+    assert_eq!(s.variant(1234567)[0].value, toml::Value::Integer(1234567));
+}
+
+/// The k-th random sample is made directly; it is the k-th of the generator run in turn.
+#[test]
+fn random_samples_are_splitmix64_in_turn() {
+    let text = "cell = \"c.toml\"\nseed = 7\n[[variable]]\npath = \"cycle\"\nvalues = [1]\n[[variable]]\npath = \"clearance\"\nrandom = { from = 0.0, to = 1.0, count = 50 }\n";
+    let s = sweep_of(text).unwrap();
+    let mut state: u64 = 7 ^ 0x9E37_79B9_7F4A_7C15; // the seed ^ the variable's index × golden
+    for k in 0..50 {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        let want = (z >> 11) as f64 / (1u64 << 53) as f64;
+        assert_eq!(
+            s.variant(k)[1].value,
+            toml::Value::Float(want),
+            "sample {k}"
+        );
+    }
+}
+
+/// `minimize = "cycle_time.r3"` was found wrong after every variant ran: now before.
+#[test]
+fn the_objective_is_checked_before_running() {
+    let sweep = Sweep::read(&root().join("workcells/handoff/sweep.toml"), &Disk).unwrap();
+    let robots = vec!["r1".to_string(), "r2".to_string()];
+    for ok in [
+        "end_time",
+        "cycle_time.r2",
+        "robot.r2.base.xyz.0",
+        "collisions",
+    ] {
+        assert_eq!(sweep.check_objective(ok, &robots), Ok(()), "{ok}");
+    }
+    let e = sweep.check_objective("cycle_time.r3", &robots).unwrap_err();
+    assert!(
+        e.starts_with("`cycle_time.r3` is not a numeric column of the table; choose one of variant, robot.r2.base.xyz.0, robot.r2.base.xyz.1, end_time, cycle_time.r1, cycle_time.r2, collisions, min_clearance"),
+        "{e}"
+    );
+}
+
+/// A cell in a fresh folder whose r1 runs `body` (its `main`).
+fn cell_running(name: &str, body: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("vworks-sweep-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("cell.toml"),
+        "[[robot]]\nname = \"r1\"\nmodel = \"irb120\"\nprogram = \"r1.wsl\"\n",
+    )
+    .unwrap();
+    std::fs::write(dir.join("r1.wsl"), format!("proc main() {{\n{body}\n}}\n")).unwrap();
+    dir
+}
+
+/// A variant that never ends blocked the sweep: the wall-time limit makes it a
+/// `timeout` row, and the variants after it run.
+#[test]
+fn an_endless_variant_is_stopped_at_its_timeout() {
+    let dir = cell_running("endless", "    while true {\n        delay 1s;\n    }");
+    let loader = Loader::new(&dir.join("cell.toml"), &Disk).unwrap();
+    let variants = vec![
+        vec![Override::new("cycle", "8ms")],
+        vec![Override::new("cycle", "not a time")],
+    ];
+    let options = RunOptions {
+        jobs: 1,
+        variant_timeout: Some(std::time::Duration::from_millis(300)),
+        ..RunOptions::default()
+    };
+    let rows = run_variants(&loader, &variants, &options, &|_| {}, None);
+    let _ = std::fs::remove_dir_all(&dir);
+    let outcomes: Vec<&str> = rows.iter().map(|r| r.outcome.as_str()).collect();
+    assert_eq!(outcomes, ["timeout", "invalid"]);
+    assert!(
+        rows[0].error.contains("variant timeout of 0.3 s"),
+        "{}",
+        rows[0].error
+    );
+    assert!(rows[0].end_time > 0.0);
+}
+
+/// A log that cannot be written (a full disk: /dev/full) made a `completed` row with an
+/// empty log: now the row is an error saying why.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_log_that_cannot_be_written_is_the_variants_error() {
+    let dir = cell_running("full", "    delay 1s;");
+    let logs = dir.join("logs");
+    std::fs::create_dir_all(&logs).unwrap();
+    std::os::unix::fs::symlink("/dev/full", logs.join("variant-00000.mcap")).unwrap();
+    let loader = Loader::new(&dir.join("cell.toml"), &Disk).unwrap();
+    let variants = vec![
+        vec![Override::new("cycle", "8ms")],
+        vec![Override::new("cycle", "4ms")],
+    ];
+    let options = RunOptions {
+        keep_logs: Some(logs.clone()),
+        ..RunOptions::default()
+    };
+    let rows = run_variants(&loader, &variants, &options, &|_| {}, None);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(rows[0].outcome, "error");
+    assert!(rows[0].log_failed);
+    assert!(
+        rows[0].error.contains("No space left on device"),
+        "{}",
+        rows[0].error
+    );
+    assert_eq!(rows[1].outcome, "completed");
+    assert!(!rows[1].log_failed);
 }

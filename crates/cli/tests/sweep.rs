@@ -1,0 +1,300 @@
+//! `vworks sweep` as a user runs it — the table streamed as rows finish, Ctrl-C and a
+//! kill, the per-variant wall-time limit, checks before running, full disks — and every
+//! output of the CLI refusing to overwrite an input.
+
+#![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)] // tests fail by panicking
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+
+fn vworks_in(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_vworks"))
+        .args(args)
+        .current_dir(dir)
+        .env("NO_COLOR", "1")
+        .output()
+        .unwrap()
+}
+
+fn spawn_in(dir: &Path, args: &[&str]) -> Child {
+    Command::new(env!("CARGO_BIN_EXE_vworks"))
+        .args(args)
+        .current_dir(dir)
+        .env("NO_COLOR", "1")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+/// A fresh folder with a one-robot cell whose program never ends when its param
+/// `endless` is 1, and a sweep file over `endless` with `values`.
+fn sweep_dir(name: &str, values: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("vworks-sweep-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    std::fs::write(
+        d.join("cell.toml"),
+        "[[robot]]\nname = \"r1\"\nmodel = \"irb120\"\nprogram = \"r1.wsl\"\n",
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("r1.wsl"),
+        "param endless = 0;\nproc main() {\n    delay 1s;\n    while endless == 1 {\n        delay 1s;\n    }\n}\n",
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("s.toml"),
+        format!(
+            "cell = \"cell.toml\"\n[[variable]]\npath = \"params.endless\"\nvalues = {values}\n"
+        ),
+    )
+    .unwrap();
+    d
+}
+
+/// The rows of a CSV table (header left out).
+fn rows(csv: &str) -> Vec<String> {
+    csv.lines().skip(1).map(str::to_string).collect()
+}
+
+fn signal(child: &Child, sig: &str) {
+    let status = Command::new("kill")
+        .args([sig, &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+}
+
+/// Variant 2 never ends. The rows before it are in the table while it runs (a kill
+/// leaves them); Ctrl-C stops it at once, keeps them and exits 130.
+#[cfg(unix)]
+#[test]
+fn rows_are_written_as_they_finish_and_ctrl_c_keeps_them() {
+    let d = sweep_dir("sigint", "[0, 0, 1, 0]");
+    let child = spawn_in(&d, &["sweep", "s.toml", "--jobs", "1", "-q"]);
+    let seen = partial_rows_named(&d, "s.csv", 2);
+    assert!(rows(&seen)[0].starts_with("0,0,completed,1,"), "{seen}");
+    signal(&child, "-INT");
+    let out = child.wait_with_output().unwrap();
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    assert!(
+        err.contains("2 variants in") && err.contains("(interrupted)"),
+        "{err}"
+    );
+    let table = std::fs::read_to_string(d.join("s.csv")).unwrap();
+    let got: Vec<String> = rows(&table);
+    assert_eq!(got.len(), 2, "{table}");
+    assert!(got[1].starts_with("1,0,completed,1,"), "{table}");
+    assert!(
+        std::fs::read_to_string(d.join("s.html"))
+            .unwrap()
+            .contains("<table id=\"all\">")
+    );
+    assert!(text(&out.stdout).contains("variant 0: end_time 1"));
+    // A kill leaves the rows done in the table being written.
+    let child = spawn_in(&d, &["sweep", "s.toml", "--jobs", "1", "-q", "-o", "k.csv"]);
+    let seen = partial_rows_named(&d, "k.csv", 2);
+    signal(&child, "-KILL");
+    let _ = child.wait_with_output();
+    assert_eq!(rows(&seen).len(), 2, "{seen}");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// Waits (up to a generous minute) until the table `name` being written in `dir` holds
+/// `n` rows; returns its text.
+fn partial_rows_named(dir: &Path, name: &str, n: usize) -> String {
+    for _ in 0..1200 {
+        let partial = std::fs::read_dir(dir)
+            .unwrap()
+            .filter_map(|e| Some(e.ok()?.path()))
+            .find(|p| {
+                let f = p.file_name().unwrap_or_default().to_string_lossy();
+                f.starts_with(&format!("{name}.")) && f.ends_with(".partial")
+            });
+        if let Some(text) = partial.and_then(|p| std::fs::read_to_string(p).ok())
+            && rows(&text).len() >= n
+        {
+            return text;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    panic!("the table {name} never held {n} rows while the sweep ran");
+}
+
+/// With `--variant-timeout`, the endless variant is a `timeout` row and the sweep goes on.
+#[test]
+fn an_endless_variant_is_a_timeout_row() {
+    let d = sweep_dir("timeout", "[0, 1, 0]");
+    let out = vworks_in(&d, &["sweep", "s.toml", "--variant-timeout", "500ms", "-q"]);
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(err.contains("1 timed out"), "{err}");
+    let table = std::fs::read_to_string(d.join("s.csv")).unwrap();
+    let got = rows(&table);
+    assert_eq!(got.len(), 3, "{table}");
+    assert!(got[1].starts_with("1,1,timeout,"), "{table}");
+    assert!(got[1].contains("variant timeout of 0.5 s"), "{table}");
+    assert!(got[2].starts_with("2,0,completed,1,"), "{table}");
+    let bad = vworks_in(&d, &["sweep", "s.toml", "--variant-timeout", "0s"]);
+    assert_eq!(bad.status.code(), Some(1));
+    assert!(text(&bad.stderr).contains("--variant-timeout `0s` is not a time above 0"));
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// A wrong objective was found after every variant ran, and nothing was written: now it
+/// is an error before the first variant. A sweep where no variant loads still writes its
+/// table, with the reasons.
+#[test]
+fn the_objective_is_checked_first_and_the_table_always_written() {
+    let d = sweep_dir("minimize", "[0, 0]");
+    let out = vworks_in(&d, &["sweep", "s.toml", "--minimize", "cycle_time.r3"]);
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("--minimize: `cycle_time.r3` is not a numeric column of the table; choose one of variant, params.endless, end_time, cycle_time.r1, collisions, min_clearance"),
+        "{err}"
+    );
+    assert!(!err.contains("variants in"), "nothing ran: {err}");
+    let left: Vec<_> = std::fs::read_dir(&d).unwrap().collect();
+    assert_eq!(left.len(), 3, "nothing written: {left:?}");
+    // Every variant invalid: the table says why, the exit is 0.
+    std::fs::write(
+        d.join("s.toml"),
+        "cell = \"cell.toml\"\n[[variable]]\npath = \"cycle\"\nvalues = [\"1 furlong\", \"-4ms\"]\n",
+    )
+    .unwrap();
+    let out = vworks_in(&d, &["sweep", "s.toml"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert!(text(&out.stdout).contains("no variant completed without a collision"));
+    let table = std::fs::read_to_string(d.join("s.csv")).unwrap();
+    let got = rows(&table);
+    assert_eq!(got.len(), 2, "{table}");
+    assert!(
+        got.iter()
+            .all(|r| r.contains(",invalid,") && r.contains("cycle")),
+        "{table}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// A table on a full disk left a truncated file and said "check that its folder exists":
+/// now it says so, keeps no partial file, and still prints the best variants; a log that
+/// cannot be written fails the sweep.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_full_disk_is_said_and_fails_the_sweep() {
+    let d = sweep_dir("full", "[0, 0]");
+    let out = vworks_in(&d, &["sweep", "s.toml", "-o", "/dev/full"]);
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("cannot write `/dev/full`: no space left on device"),
+        "{err}"
+    );
+    assert!(!err.contains("check that its folder exists"), "{err}");
+    assert!(
+        text(&out.stdout).contains("variant 0: end_time 1"),
+        "{}",
+        text(&out.stdout)
+    );
+    // The logs: variant 1's is /dev/full.
+    let logs = d.join("logs");
+    std::fs::create_dir_all(&logs).unwrap();
+    std::os::unix::fs::symlink("/dev/full", logs.join("variant-00001.mcap")).unwrap();
+    let out = vworks_in(&d, &["sweep", "s.toml", "--keep-logs", "logs"]);
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("the logs of 1 variants could not be written"),
+        "{err}"
+    );
+    let table = std::fs::read_to_string(d.join("s.csv")).unwrap();
+    let got = rows(&table);
+    assert!(got[0].contains(",completed,"), "{table}");
+    assert!(
+        got[1].contains(",error,") && got[1].contains("No space left on device"),
+        "{table}"
+    );
+    assert!(
+        std::fs::metadata(logs.join("variant-00000.mcap"))
+            .unwrap()
+            .len()
+            > 0
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// `report run.mcap -o run.mcap`, `sweep -o cell.toml`, `build x.wsl -o x.wsl` destroyed
+/// their input: each is refused, by path, through `./` or a symlink, and the input stays.
+#[test]
+fn an_output_that_is_an_input_is_refused() {
+    let d = sweep_dir("inputs", "[0]");
+    let ok = vworks_in(&d, &["run", "cell.toml", "--log", "run.mcap"]);
+    assert_eq!(ok.status.code(), Some(0), "{}", text(&ok.stderr));
+    let log = std::fs::read(d.join("run.mcap")).unwrap();
+    #[cfg(unix)]
+    std::os::unix::fs::symlink("r1.wsl", d.join("link.wsl")).unwrap();
+    let cases: &[&[&str]] = &[
+        &["build", "r1.wsl", "-o", "r1.wsl"],
+        &["build", "r1.wsl", "-o", "./r1.wsl"],
+        #[cfg(unix)]
+        &["build", "r1.wsl", "-o", "link.wsl"],
+        &["report", "run.mcap", "-o", "run.mcap"],
+        &["report", "run.mcap", "-o", "./run.mcap"],
+        &["sweep", "s.toml", "-o", "cell.toml"],
+        &["sweep", "s.toml", "-o", "s.toml"],
+        &["sweep", "s.toml", "--html", "./r1.wsl"],
+        &["sweep", "s.toml", "-o", "t.csv", "--html", "t.csv"],
+        &["run", "cell.toml", "--log", "r1.wsl"],
+        &["run", "cell.toml", "--log", "./cell.toml"],
+    ];
+    let before: Vec<(String, Vec<u8>)> = ["r1.wsl", "cell.toml", "s.toml"]
+        .iter()
+        .map(|f| (f.to_string(), std::fs::read(d.join(f)).unwrap()))
+        .collect();
+    for args in cases {
+        let out = vworks_in(&d, args);
+        let err = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(
+            err.contains("writing it would destroy it"),
+            "{args:?}: {err}"
+        );
+        for (f, bytes) in &before {
+            assert_eq!(
+                &std::fs::read(d.join(f)).unwrap(),
+                bytes,
+                "{args:?} changed {f}"
+            );
+        }
+        assert_eq!(std::fs::read(d.join("run.mcap")).unwrap(), log, "{args:?}");
+    }
+    // Outputs elsewhere are written, with no temporary file left beside them.
+    for args in [
+        &["build", "r1.wsl", "-o", "r1.wslb"][..],
+        &["report", "run.mcap", "-o", "run.html"],
+        &["run", "cell.toml", "--log", "run.mcap"],
+        &["sweep", "s.toml"],
+    ] {
+        let out = vworks_in(&d, args);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{args:?}: {}",
+            text(&out.stderr)
+        );
+    }
+    let partial: Vec<_> = std::fs::read_dir(&d)
+        .unwrap()
+        .filter_map(|e| Some(e.ok()?.file_name().to_string_lossy().into_owned()))
+        .filter(|n| n.ends_with(".partial"))
+        .collect();
+    assert!(partial.is_empty(), "{partial:?}");
+    let _ = std::fs::remove_dir_all(&d);
+}
