@@ -732,7 +732,7 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
         r.log_error = r.log_error.as_ref().map(named);
         let finished = match r.log_error {
             None => vworks_model::output::finish(temp, path).map_err(|e| e.to_string()),
-            Some(_) => Ok(std::fs::remove_file(temp).unwrap_or(())),
+            Some(_) => Ok(vworks_model::output::discard(temp, path)),
         };
         r.log_error = r.log_error.take().or(finished.err());
     }

@@ -298,3 +298,33 @@ fn an_output_that_is_an_input_is_refused() {
     assert!(partial.is_empty(), "{partial:?}");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// `run --log /dev/full` removed the device (the failed log's "temporary file" was the
+/// device itself, written in place): a device output is never replaced or removed.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_device_output_is_neither_replaced_nor_removed() {
+    use std::os::unix::fs::FileTypeExt;
+    let d = sweep_dir("device", "[0]");
+    let is_device =
+        || std::fs::symlink_metadata("/dev/full").is_ok_and(|m| m.file_type().is_char_device());
+    assert!(is_device(), "/dev/full is not the device before the test");
+    let ok = vworks_in(&d, &["run", "cell.toml", "--log", "run.mcap"]);
+    assert_eq!(ok.status.code(), Some(0), "{}", text(&ok.stderr));
+    for args in [
+        &["run", "cell.toml", "--log", "/dev/full"][..],
+        &["build", "r1.wsl", "-o", "/dev/full"],
+        &["report", "run.mcap", "-o", "/dev/full"],
+        &["sweep", "s.toml", "-o", "/dev/full"],
+    ] {
+        let out = vworks_in(&d, args);
+        let err = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(
+            err.to_lowercase().contains("no space left on device"),
+            "{args:?}: {err}"
+        );
+        assert!(is_device(), "{args:?} replaced or removed /dev/full");
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}

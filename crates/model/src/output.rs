@@ -244,6 +244,14 @@ pub fn finish(temp: &Path, path: &Path) -> Result<(), OutputError> {
     })
 }
 
+/// Gives up a `temp` (from [`temp_beside`]) that will not be finished: removes it, unless
+/// it is `path` itself (a device, written in place: never removed).
+pub fn discard(temp: &Path, path: &Path) {
+    if temp != path {
+        let _ = std::fs::remove_file(temp);
+    }
+}
+
 /// Writes `bytes` to `path` through a temporary file, refusing it if it is one of
 /// `inputs`.
 pub fn write_output<P: AsRef<Path>>(
@@ -336,5 +344,10 @@ mod tests {
             .to_string();
         assert!(e.contains("no space left on device"), "{e}");
         write_output(Path::new("/dev/null"), &[] as &[&Path], b"x").unwrap();
+        // A writer of its own writes the device itself, and giving it up keeps it.
+        let temp = temp_beside(Path::new("/dev/null"), &[] as &[&Path]).unwrap();
+        assert_eq!(temp, Path::new("/dev/null"));
+        discard(&temp, Path::new("/dev/null"));
+        assert!(Path::new("/dev/null").exists());
     }
 }
