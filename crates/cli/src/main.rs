@@ -730,11 +730,11 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
     if let (Some(temp), Some(path)) = (&log_temp, log) {
         let named = |m: &String| m.replace(&temp.display().to_string(), &display(path));
         r.log_error = r.log_error.as_ref().map(named);
-        let finished = match r.log_error {
-            None => vworks_model::output::finish(temp, path).map_err(|e| e.to_string()),
-            Some(_) => Ok(vworks_model::output::discard(temp, path)),
-        };
-        r.log_error = r.log_error.take().or(finished.err());
+        if r.log_error.is_some() {
+            vworks_model::output::discard(temp, path);
+        } else if let Err(e) = vworks_model::output::finish(temp, path) {
+            r.log_error = Some(e.to_string());
+        }
     }
     if let Some(e) = &r.log_error {
         eprintln!("error: {e}");

@@ -209,6 +209,7 @@ fn schedule<T: Send>(
         next: 0,
         held: BTreeMap::new(),
         max_held: 0,
+        waiting: 0,
         sink,
     });
     let moved = Condvar::new();
@@ -220,10 +221,12 @@ fn schedule<T: Send>(
                 let mut o = lock();
                 while o.taken >= o.next + window && !stopped() {
                     // Woken when a row is handed over, or to look at `stopped` again.
+                    o.waiting += 1;
                     o = moved
                         .wait_timeout(o, Duration::from_millis(50))
                         .unwrap_or_else(PoisonError::into_inner)
                         .0;
+                    o.waiting -= 1;
                 }
                 if stopped() || o.taken >= count {
                     return;
@@ -232,8 +235,12 @@ fn schedule<T: Send>(
                 o.taken - 1
             };
             let result = work(i);
-            lock().put(i, result);
-            moved.notify_all();
+            let mut o = lock();
+            o.put(i, result);
+            if o.waiting > 0 {
+                moved.notify_all();
+            }
+            drop(o);
             progress(done.fetch_add(1, Ordering::Relaxed) + 1);
         }
     };
@@ -265,6 +272,8 @@ struct Order<'s, T> {
     next: usize,
     held: BTreeMap<usize, Option<T>>,
     max_held: usize,
+    /// Threads waiting for the window to move (woken only if there are some).
+    waiting: usize,
     sink: &'s mut (dyn FnMut(T) + Send),
 }
 
