@@ -22,8 +22,11 @@
 //! values = ["200mm/s", "250mm/s"]     # or random = { from = …, to = …, count = 10 }
 //! ```
 //!
-//! A variant is a list of [`Override`]s; the same sweep file gives the same variants, the
-//! same runs and the same table, whatever the number of threads.
+//! A variant is a list of [`Override`]s, made when it runs ([`Sweep::variant`]); the same
+//! sweep file gives the same variants, the same runs and the same table, whatever the
+//! number of threads. Sizes are checked before anything is made ([`MAX_VARIANTS`]), rows
+//! are streamed to the table in variant order ([`run_streamed`], [`stream`]), so a sweep's
+//! memory does not grow with its number of variants.
 
 use std::path::{Path, PathBuf};
 

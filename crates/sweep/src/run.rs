@@ -27,8 +27,9 @@ pub struct Row {
     pub index: usize,
     /// Its values (path, value as the workcell would write it).
     pub values: Vec<(String, toml::Value)>,
-    /// `completed`, `collision`, `deadlock`, `error`, `until`, or `invalid` (the variant
-    /// did not load: see `error`).
+    /// `completed`, `collision`, `deadlock`, `error` (also: its log could not be
+    /// written), `until`, `timeout` (stopped at its wall-time limit), or `invalid` (the
+    /// variant did not load: see `error`).
     pub outcome: String,
     /// The run's end (s).
     pub end_time: f64,
