@@ -75,6 +75,8 @@ pub fn load_str_with(
         message,
         help: help.to_string(),
     };
+    // urdf-rs walks the element tree recursively: nesting is bounded before it sees it.
+    check_nesting(text, file)?;
     // Joint elements read from the text itself (comments and references left out).
     let stripped = strip_blocks(text);
     let elements = joint_elements(&stripped);
@@ -410,6 +412,76 @@ pub fn load_str_with(
     model.chain_cache = model.chain();
     model.wrist = crate::ik::SphericalWrist::detect(&model);
     Ok(model)
+}
+
+/// How deep elements may nest in a URDF (`<robot>` is at depth 1). URDFs nest 5 deep
+/// (robot, link, collision, geometry, mesh), a few more with `<gazebo>` plugin blocks;
+/// urdf-rs reads the tree recursively (its version conversion, the XML printer and the
+/// deserializer), and 20,000 levels overflowed the stack.
+pub const MAX_NESTING: usize = 64;
+
+/// Rejects elements nested deeper than [`MAX_NESTING`], by one streaming pass over the
+/// text (comments, CDATA, processing instructions, declarations and quoted attribute
+/// values skipped; self-closing elements count at their depth, and do not nest).
+fn check_nesting(text: &str, file: &str) -> Result<(), ModelError> {
+    let b = text.as_bytes();
+    let skip_to = |from: usize, end: &str| {
+        text[from..]
+            .find(end)
+            .map_or(b.len(), |k| from + k + end.len())
+    };
+    let (mut depth, mut at) = (0usize, 0usize);
+    while let Some(k) = text[at..].find('<') {
+        let start = at + k;
+        let rest = &text[start..];
+        if rest.starts_with("<!--") {
+            at = skip_to(start, "-->");
+        } else if rest.starts_with("<![CDATA[") {
+            at = skip_to(start, "]]>");
+        } else if rest.starts_with("<?") {
+            at = skip_to(start, "?>");
+        } else if rest.starts_with("<!") || rest.starts_with("</") {
+            depth = depth.saturating_sub(usize::from(rest.starts_with("</")));
+            at = skip_to(start, ">");
+        } else {
+            // A start tag: up to its `>` outside quotes.
+            let mut quote = None;
+            let mut end = b.len();
+            for (i, &c) in b.iter().enumerate().skip(start + 1) {
+                match (quote, c) {
+                    (None, b'"' | b'\'') => quote = Some(c),
+                    (Some(q), _) if c == q => quote = None,
+                    (None, b'>') => {
+                        end = i;
+                        break;
+                    }
+                    _ => {}
+                }
+            }
+            if depth + 1 > MAX_NESTING {
+                let name: String = rest[1..]
+                    .chars()
+                    .take_while(|c| !c.is_whitespace() && !matches!(c, '>' | '/'))
+                    .take(40)
+                    .collect();
+                let line = 1 + text[..start].bytes().filter(|&c| c == b'\n').count();
+                return Err(ModelError::Invalid {
+                    file: file.to_string(),
+                    element: format!("element `<{name}>` at line {line}"),
+                    message: format!(
+                        "is nested {} deep, deeper than the {MAX_NESTING} levels vworks reads",
+                        depth + 1
+                    ),
+                    help: "a URDF's elements nest about 5 deep (robot, link, collision, geometry, mesh); look for elements that are never closed".into(),
+                });
+            }
+            if end < b.len() && b[end - 1] != b'/' {
+                depth += 1;
+            }
+            at = (end + 1).min(b.len());
+        }
+    }
+    Ok(())
 }
 
 /// A `<joint …>` element of the text: its start tag's attributes, and its body up to its

@@ -438,3 +438,36 @@ fn a_mimic_joint_on_the_tool_chain_is_an_error() {
     );
     load("finger.urdf", &robot(&arm_with_finger(mimic))).unwrap_or_else(|e| panic!("{e}"));
 }
+
+#[test]
+fn deeply_nested_elements_are_an_error_not_a_stack_overflow() {
+    // 20,000 elements one inside the next: urdf-rs walks the tree recursively (its
+    // `convert_versioned`, the XML printer, the deserializer), which overflowed the stack.
+    let n = 20_000;
+    let t = robot(&(link("a") + &"<x>".repeat(n) + &"</x>".repeat(n)));
+    expect_error(
+        "nesting",
+        load("deep.urdf", &t),
+        "deep.urdf",
+        &["element `<x>` at line 1", "64"],
+    );
+    // At the limit (an element inside 63 others, <robot> the outermost) the file is read;
+    // comments, quoted `>` and `/>`, and self-closing elements do not count.
+    let inner = 63;
+    let t = robot(
+        &(link("a")
+            + "<!-- <y><y><y> -->"
+            + &r#"<x note="a > b" other='c/>'>"#.repeat(inner - 1)
+            + "<y/>"
+            + &"</x>".repeat(inner - 1)),
+    );
+    let m = load("at_limit.urdf", &t).unwrap();
+    assert_eq!(m.links.len(), 1);
+    let t = robot(&(link("a") + &"<x>".repeat(inner + 1) + &"</x>".repeat(inner + 1)));
+    expect_error(
+        "one too deep",
+        load("too_deep.urdf", &t),
+        "too_deep.urdf",
+        &["65 deep", "64"],
+    );
+}
