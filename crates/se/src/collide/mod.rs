@@ -33,10 +33,12 @@ use crate::world::World;
 
 mod broadphase;
 mod narrow;
+mod pairs;
 mod sweep;
 
 use broadphase::SweepAndPrune;
 use narrow::*;
+use pairs::{PairFilter, Promises};
 use sweep::SweepScratch;
 
 /// A collision that started.
@@ -141,22 +143,16 @@ fn reach_of(
     extent: f64,
 ) -> Vec<(usize, f64)> {
     use vworks_model::model::JointKind;
-    // The joints from the link up to the root, and their offsets.
-    let mut path = Vec::new();
-    let mut at = link;
-    while let Some((j, joint)) = model.joints.iter().enumerate().find(|(_, j)| j.child == at) {
-        path.push(j);
-        at = joint.parent;
-        if path.len() > model.joints.len() {
-            break; // a cycle: the loader rejects those; never loop
-        }
-    }
     let mut out = Vec::new();
-    // Walking from the link towards the root, the distance from a joint to the body grows
-    // by each joint origin's offset below it.
+    // Walking from the link towards the root (each link's parent joint), the distance from
+    // a joint to the body grows by each joint origin's offset below it.
     let mut below = extent;
-    for &j in &path {
-        let joint = &model.joints[j];
+    let mut at = link;
+    let mut steps = 0;
+    while let Some((j, joint)) = model.links.get(at).and_then(|l| {
+        let j = l.parent_joint?;
+        Some((j, model.joints.get(j)?))
+    }) {
         match joint.kind {
             JointKind::Revolute | JointKind::Continuous => out.push((j, below)),
             JointKind::Prismatic => out.push((j, 1.0)),
@@ -167,6 +163,11 @@ fn reach_of(
         if joint.kind == JointKind::Prismatic {
             // The joint's own travel adds to the lever arm of the joints above it.
             below += (joint.upper - joint.lower).abs().min(1e3);
+        }
+        at = joint.parent;
+        steps += 1;
+        if steps > model.joints.len() {
+            break; // a cycle: the loader rejects those; never loop
         }
     }
     out
@@ -185,12 +186,8 @@ pub struct Collider {
     /// The boundary check's broadphase and the pairs it keeps (reused).
     broadphase: SweepAndPrune,
     pairs: Vec<(usize, usize)>,
-    /// Pairs never checked, as a dense matrix (`i * n + j`, both orders).
-    skip_dense: Vec<bool>,
-    /// For two link bodies of one robot (`i * n + j`): how many leading entries of each
-    /// one's `reach` are joints the other does not have (the shared joints, above their
-    /// common ancestor, come last and move both alike).
-    unshared: Vec<(u8, u8)>,
+    /// Pairs never checked.
+    filter: PairFilter,
     touching: BTreeSet<(usize, usize)>,
     near: BTreeSet<(usize, usize)>,
     /// Pairs touching when a part was gripped or released (a part resting on a table, a
@@ -205,10 +202,10 @@ pub struct Collider {
     sweep_scratch: SweepScratch,
     /// The time `frames` and `poses` are for (the last check's), once there was one.
     checked_at: Option<i64>,
-    /// Adaptive checking: per pair (`i * n + j`), the time before which the current
-    /// motions cannot bring it within the clearance, so its query can be skipped.
-    /// Cleared whenever a motion starts or a part is gripped or released.
-    safe_until: Vec<i64>,
+    /// Adaptive checking: per pair, the time before which the current motions cannot
+    /// bring it within the clearance, so its query can be skipped. Withdrawn whenever a
+    /// motion starts (its robot's pairs) or a part is gripped or released (all).
+    promises: Promises,
     /// No two bodies can come within the clearance before this time under the current
     /// motions (`i64::MIN`: no such promise): the engine skips the sweeps and boundary
     /// checks before it. See [`Collider::horizon`].
@@ -221,6 +218,10 @@ pub struct Collider {
     ahead_pairs: Vec<(usize, usize)>,
     /// Whether to skip queries by `safe_until` (see [`Collider::set_adaptive`]).
     adaptive: bool,
+    /// Each robot's link bodies (the links of every robot come first, robot by robot),
+    /// and where they end.
+    robot_bodies: Vec<std::ops::Range<usize>>,
+    links_end: usize,
 }
 
 impl std::fmt::Debug for Collider {
@@ -254,7 +255,9 @@ impl Collider {
     /// The bodies of `cell`, with the pairs never to check.
     pub fn new(cell: &Cell) -> Collider {
         let mut bodies = Vec::new();
+        let mut robot_bodies = Vec::with_capacity(cell.robots.len());
         for (r, robot) in cell.robots.iter().enumerate() {
+            let first = bodies.len();
             for (l, link) in robot.model.links.iter().enumerate() {
                 for s in &link.shapes {
                     let radius = bounding_radius(&s.shape);
@@ -270,7 +273,9 @@ impl Collider {
                     });
                 }
             }
+            robot_bodies.push(first..bodies.len());
         }
+        let links_end = bodies.len();
         for d in &cell.devices {
             bodies.push(BodyRef {
                 owner: Owner::Device,
@@ -293,82 +298,10 @@ impl Collider {
                 reach: Vec::new(),
             });
         }
-        // Links of one robot that touch at its zero configuration touch by design (the
-        // enveloping shapes overlap around the joints): like MoveIt's "default" pairs.
-        let zero_frames: Vec<Vec<Iso>> = cell
-            .robots
-            .iter()
-            .map(|r| r.model.fk(&vec![0.0; r.model.dof()]))
-            .collect();
-        let pose_at_zero = |b: &BodyRef| match b.owner {
-            Owner::Link { robot, link } => zero_frames[robot][link].to_pose() * b.local,
-            _ => Pose::IDENTITY,
-        };
-        let mut skip = BTreeSet::new();
-        for i in 0..bodies.len() {
-            for j in i + 1..bodies.len() {
-                let (a, b) = (&bodies[i], &bodies[j]);
-                let same_robot = match (a.owner, b.owner) {
-                    (
-                        Owner::Link {
-                            robot: ra,
-                            link: la,
-                        },
-                        Owner::Link {
-                            robot: rb,
-                            link: lb,
-                        },
-                    ) if ra == rb => {
-                        la == lb
-                            || cell.robots[ra]
-                                .model
-                                .adjacent_pairs()
-                                .contains(&(la.min(lb), la.max(lb)))
-                            || parry3d::query::intersection_test(
-                                &pose_at_zero(a),
-                                a.shape.as_ref(),
-                                &pose_at_zero(b),
-                                b.shape.as_ref(),
-                            )
-                            .is_ok_and(|x| x.intersecting)
-                    }
-                    _ => false,
-                };
-                let allowed = cell.allowed.iter().any(|(x, y)| {
-                    (matches(&a.name, a.owner, cell, x) && matches(&b.name, b.owner, cell, y))
-                        || (matches(&a.name, a.owner, cell, y)
-                            && matches(&b.name, b.owner, cell, x))
-                });
-                let static_pair =
-                    matches!(a.owner, Owner::Device) && matches!(b.owner, Owner::Device);
-                if same_robot || allowed || static_pair {
-                    skip.insert((i, j));
-                }
-            }
-        }
         let n = bodies.len();
-        let mut unshared = vec![(0u8, 0u8); n * n];
-        for i in 0..n {
-            for j in 0..n {
-                let (a, b) = (&bodies[i], &bodies[j]);
-                let only = |x: &BodyRef, y: &BodyRef| {
-                    x.reach
-                        .iter()
-                        .take_while(|(jt, _)| !y.reach.iter().any(|(k, _)| k == jt))
-                        .count()
-                        .min(u8::MAX as usize) as u8
-                };
-                unshared[i * n + j] = (only(a, b), only(b, a));
-            }
-        }
-        let mut skip_dense = vec![false; n * n];
-        for &(i, j) in &skip {
-            skip_dense[i * n + j] = true;
-            skip_dense[j * n + i] = true;
-        }
+        let filter = PairFilter::new(cell, &bodies);
         Collider {
-            skip_dense,
-            unshared,
+            filter,
             poses: vec![Pose::IDENTITY; n],
             aabbs: vec![Aabb::new_invalid(); n],
             broadphase: SweepAndPrune::default(),
@@ -381,13 +314,15 @@ impl Collider {
             queries: 0,
             sweep_scratch: SweepScratch::default(),
             checked_at: None,
-            safe_until: vec![i64::MIN; n * n],
+            promises: Promises::new(n),
             horizon: i64::MIN,
             body_speed: Vec::new(),
             ahead_boxes: Vec::new(),
             ahead: SweepAndPrune::default(),
             ahead_pairs: Vec::new(),
             adaptive: true,
+            robot_bodies,
+            links_end,
             bodies,
         }
     }
@@ -401,7 +336,7 @@ impl Collider {
     /// A motion started, or a part was gripped or released: the speed bounds behind the
     /// skipped queries no longer hold.
     pub fn motions_changed(&mut self) {
-        self.safe_until.fill(i64::MIN);
+        self.promises.withdraw_all();
         self.horizon = i64::MIN;
     }
 
@@ -423,26 +358,32 @@ impl Collider {
     }
 
     /// Robot `r` starts a motion: the promises of the pairs with one of its bodies (its
-    /// links, a part it holds) no longer hold; the others' still do. (Clearing all of them
-    /// cost a memset of n² entries per motion start: 1.6 MB with 64 robots.)
+    /// links, a part it holds) no longer hold; the others' still do (see [`Promises`]).
     pub fn motion_started(&mut self, r: usize) {
         self.horizon = i64::MIN;
-        let n = self.bodies.len();
-        for i in 0..n {
-            let mine = match self.bodies[i].owner {
-                Owner::Link { robot, .. } => robot == r,
-                Owner::Part(p) => self.world.held[p].is_some_and(|(h, _)| h == r),
-                Owner::Device => false,
-            };
-            if mine {
-                for j in 0..i {
-                    self.safe_until[j * n + i] = i64::MIN;
-                }
-                for j in i + 1..n {
-                    self.safe_until[i * n + j] = i64::MIN;
-                }
+        self.promises.begin_withdrawal();
+        if let Some(links) = self.robot_bodies.get(r) {
+            for i in links.clone() {
+                self.promises.withdraw(i);
             }
         }
+        for (i, b) in self.bodies.iter().enumerate().skip(self.links_end) {
+            if matches!(b.owner, Owner::Part(p) if self.world.held[p].is_some_and(|(h, _)| h == r))
+            {
+                self.promises.withdraw(i);
+            }
+        }
+    }
+
+    /// How many pair entries the collider holds: the pairs its filter lists, its
+    /// promises, and the pairs touching, near or exempt. Linear in the bodies (the
+    /// broadphase's neighbours of each), not quadratic (tested).
+    pub fn pair_entries(&self) -> usize {
+        self.filter.entries()
+            + self.promises.entries()
+            + self.touching.len()
+            + self.near.len()
+            + self.exempt.len()
     }
 
     /// Robot `r`'s tool link in the cell at time `t` (the frames of the last check stay).
@@ -524,7 +465,7 @@ impl Collider {
                 let pair = (i.min(j), i.max(j));
                 if j == i
                     || self.static_pair(pair)
-                    || self.skip_dense[pair.0 * n + pair.1]
+                    || self.filter.never(pair.0, pair.1)
                     || self.held_by(pair, cell)
                 {
                     continue;
@@ -641,7 +582,6 @@ impl Collider {
                 js[j] = SPEED_MARGIN * rates[i];
             }
         }
-        let n = self.bodies.len();
         // Sort and sweep along x.
         let aabbs = &self.aabbs;
         let mut pairs = std::mem::take(&mut self.pairs);
@@ -651,15 +591,14 @@ impl Collider {
         let mut starts = Vec::new();
         for &pair in &pairs {
             {
-                if self.skip_dense[pair.0 * n + pair.1] || self.held_by(pair, cell) {
+                if self.filter.never(pair.0, pair.1) || self.held_by(pair, cell) {
                     continue;
                 }
                 if self.static_pair(pair) {
                     continue;
                 }
                 let (a, b) = (&self.bodies[pair.0], &self.bodies[pair.1]);
-                let idx = pair.0 * n + pair.1;
-                if self.adaptive && t < self.safe_until[idx] {
+                if self.adaptive && t < self.promises.get(pair.0, pair.1) {
                     continue; // provably farther than the clearance until then
                 }
                 // Held parts' speeds are not bounded here: always queried.
@@ -684,13 +623,14 @@ impl Collider {
                 if self.adaptive && v.is_finite() {
                     let d = wide.map_or(within, |(d, _, _)| d);
                     let gap = d.max(0.0) * trust(a.shape.as_ref(), b.shape.as_ref());
-                    self.safe_until[idx] = if v <= 0.0 {
+                    let until = if v <= 0.0 {
                         i64::MAX
                     } else if gap > cell.clearance {
                         t.saturating_add(((gap - cell.clearance) / v * 1e9) as i64)
                     } else {
                         i64::MIN
                     };
+                    self.promises.set(pair.0, pair.1, until);
                 }
                 if self.exempt.contains(&pair) {
                     // Touching since a grip or release: exempt until they separate.
@@ -765,7 +705,6 @@ impl Collider {
         {
             return i64::MIN;
         }
-        let n = self.bodies.len();
         self.body_speed.clear();
         let mut fastest = 0.0f64;
         for b in &self.bodies {
@@ -786,10 +725,10 @@ impl Collider {
         let mut h = t.saturating_add(HORIZON_NS);
         // The pairs the check's broadphase kept: their promises.
         for &(i, j) in &self.pairs {
-            if self.skip_dense[i * n + j] || self.static_pair((i, j)) {
+            if self.filter.never(i, j) || self.static_pair((i, j)) {
                 continue;
             }
-            h = h.min(self.safe_until[i * n + j]);
+            h = h.min(self.promises.get(i, j));
         }
         if h <= t {
             return i64::MIN;
@@ -807,7 +746,7 @@ impl Collider {
         self.ahead.overlapping(&self.ahead_boxes, &mut pairs);
         for &(i, j) in &pairs {
             let (a, b) = (&self.aabbs[i], &self.aabbs[j]);
-            if self.skip_dense[i * n + j] || self.static_pair((i, j)) || a.intersects(b) {
+            if self.filter.never(i, j) || self.static_pair((i, j)) || a.intersects(b) {
                 continue; // (boxes within the clearance: a pair the check kept, above)
             }
             let v = self.body_speed[i] + self.body_speed[j];

@@ -149,7 +149,6 @@ impl Collider {
             }
         }
         let mut found = Vec::new();
-        let nb = self.bodies.len();
         // Broadphase: each body's bounding box grown by how far it can move, swept along
         // x; only overlapping pairs go further.
         sw.reach_box.clear();
@@ -163,8 +162,8 @@ impl Collider {
         for &(i, j) in &pairs {
             {
                 if sw.bound[i] + sw.bound[j] <= 0.0
-                    || self.skip_dense[i * nb + j]
-                    || (self.adaptive && to <= self.safe_until[i * nb + j])
+                    || self.filter.never(i, j)
+                    || (self.adaptive && to <= self.promises.get(i, j))
                 {
                     continue;
                 }
@@ -237,9 +236,9 @@ impl Collider {
         ) {
             (Some((ra, reach_a)), Some((rb, reach_b))) if ra == rb => {
                 if matches!((a.owner, b.owner), (Owner::Link { .. }, Owner::Link { .. })) {
-                    // The unshared joints are a precomputed prefix of each reach.
-                    let (na, nb) = self.unshared[i * self.bodies.len() + j];
-                    sum(ra, reach_a, usize::from(na), &[]) + sum(ra, reach_b, usize::from(nb), &[])
+                    // The unshared joints are a prefix of each reach.
+                    let (na, nb) = pairs::unshared(reach_a, reach_b);
+                    sum(ra, reach_a, na, &[]) + sum(ra, reach_b, nb, &[])
                 } else {
                     // A held part and a link of the robot holding it.
                     sum(ra, reach_a, usize::MAX, reach_b) + sum(ra, reach_b, usize::MAX, reach_a)
