@@ -34,9 +34,12 @@ use crate::trace::format_value;
 pub use crate::trace::{Detail, Issue, Kind, TraceEvent, Value};
 use vworks_cell::Cell;
 
+mod limit;
 mod queue;
 mod races;
 mod route;
+
+pub use limit::EVENT_LIMIT;
 
 use queue::{Entry, Queued, SortedSet};
 use races::Seen;
@@ -113,6 +116,8 @@ pub struct Simulation {
     instant: i64,
     instant_entries: u64,
     instant_limit: u64,
+    /// How many events the trace may hold ([`Simulation::with_event_limit`]).
+    event_limit: u64,
     /// Reads of globals a robot's segment made (reused; see [`Vm::take_reads`]).
     reads: Vec<(u32, SrcPos)>,
     /// Per robot: the last remote request made to it (time, caller, position, stamp).
@@ -243,6 +248,7 @@ impl Simulation {
             instant: -1,
             instant_entries: 0,
             instant_limit: INSTANT_LIMIT,
+            event_limit: EVENT_LIMIT,
             reads: Vec::new(),
             last_request: vec![None; n],
             last_signal: vec![None; n],
@@ -304,6 +310,14 @@ impl Simulation {
         for vm in &mut self.vms {
             vm.set_instant_events(limit.max(1));
         }
+        self
+    }
+
+    /// How many events the run may record (default [`EVENT_LIMIT`]): the trace is kept in
+    /// memory, so a run that would record more stops with an error naming what records
+    /// them (a handler firing every nanosecond, a loop of short delays).
+    pub fn with_event_limit(mut self, limit: u64) -> Simulation {
+        self.event_limit = limit.max(1);
         self
     }
 
@@ -570,6 +584,10 @@ impl Simulation {
         self.instant_entries += 1;
         if self.instant_entries > self.instant_limit {
             self.livelock(t);
+            return false;
+        }
+        if self.trace.len() as u64 >= self.event_limit {
+            self.too_many_events(t);
             return false;
         }
         let entry = Entry::unpack(entry);

@@ -17,6 +17,19 @@ impl Vm {
             .copied()
     }
 
+    /// The period of handler `handler` (its index in the module's table) as it is enabled
+    /// now, if it fires by time or by cycles (ns; `None` for a condition handler, an
+    /// `after` handler, or one not enabled).
+    pub fn handler_period_ns(&self, handler: u32) -> Option<i64> {
+        self.enabled
+            .iter()
+            .filter(|e| e.handler == handler)
+            .find_map(|e| match e.firing {
+                Firing::Timer { period, .. } => period,
+                Firing::Edge { .. } => None,
+            })
+    }
+
     pub(super) fn fire_event(&mut self, t: i64, i: usize) -> Next {
         self.source = Source::Fire(i);
         let h = &self.m.handlers[self.enabled[i].handler as usize];

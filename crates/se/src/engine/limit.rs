@@ -1,0 +1,127 @@
+//! The run's event limit: the trace is kept in memory (`RunResult::trace`, Python's
+//! events, the golden traces), so a run records at most [`EVENT_LIMIT`] events. One that
+//! would record more — a handler firing every nanosecond, a loop of 1 ns delays — stops
+//! with an error naming what records them and what to do, instead of growing until the
+//! process aborts.
+
+use vworks_vm::machine::EventKind;
+
+use super::{Detail, Kind, Simulation};
+
+/// How many events a run records at most by default (see
+/// [`Simulation::with_event_limit`]): far more than real cells record (the handoff
+/// example, 3 a second: 38 days; 64 robots with an event every 100 ms each: 4 hours),
+/// few enough to bound the trace's memory (an event is 104 bytes: about 1 GB).
+pub const EVENT_LIMIT: u64 = 10_000_000;
+
+/// A time in the largest of s, ms and ns that gives it exactly (`1 ns`, `4 ms`, `2 s`).
+fn exact_time(ns: i64) -> String {
+    match ns {
+        _ if ns % 1_000_000_000 == 0 => format!("{} s", ns / 1_000_000_000),
+        _ if ns % 1_000_000 == 0 => format!("{} ms", ns / 1_000_000),
+        _ => format!("{ns} ns"),
+    }
+}
+
+/// How many of the last events are looked at to find what records them.
+const TAIL: usize = 10_000;
+
+impl Simulation {
+    /// The trace holds `event_limit` events at `t`: stops the run with an error naming the
+    /// robot that recorded most of the last ones and, when a handler's firings are most of
+    /// those, the handler and its period.
+    pub(super) fn too_many_events(&mut self, t: i64) {
+        let tail = &self.trace[self.trace.len().saturating_sub(TAIL)..];
+        let mut per_robot = vec![0usize; self.vms.len()];
+        for e in tail {
+            if let Some(r) = e.robot.filter(|r| *r < per_robot.len()) {
+                per_robot[r] += 1;
+            }
+        }
+        // The busiest robot (the first of equals).
+        let Some((r, _)) =
+            per_robot
+                .iter()
+                .enumerate()
+                .fold(None, |best: Option<(usize, usize)>, (r, &k)| match best {
+                    Some((_, b)) if b >= k => best,
+                    _ if k > 0 => Some((r, k)),
+                    _ => best,
+                })
+        else {
+            let m = format!(
+                "the run has recorded {} events, the most a run keeps; simulate less time (`--until`)",
+                self.event_limit
+            );
+            self.error(t, None, None, "runtime", m);
+            self.outcome = Some(super::Outcome::Error);
+            return;
+        };
+        // Its handler that fired most among the last events, if firings are most of them.
+        let fired = |h: u32, events: &[super::TraceEvent]| {
+            events
+                .iter()
+                .filter(|e| {
+                    e.robot == Some(r)
+                        && e.kind == Kind::WhenFire
+                        && matches!(e.detail, Detail::Vm(EventKind::WhenFire { handler }) if handler == h)
+                })
+                .count()
+        };
+        let handlers = self.cell.robots[r].module.handlers.len() as u32;
+        let busiest = (0..handlers)
+            .map(|h| (fired(h, tail), h))
+            .filter(|(k, _)| *k > 0)
+            .max_by(|a, b| a.0.cmp(&b.0).then(b.1.cmp(&a.1)));
+        let robot = self.cell.robots[r].name.clone();
+        let (message, pos) = match busiest {
+            // A firing records two events (`when_fire`, `when_end`).
+            Some((k, h)) if 4 * k >= per_robot[r] => {
+                let m = &self.cell.robots[r].module;
+                let info = &m.handlers[h as usize];
+                let name = m.str(m.procs[info.target as usize].name).to_string();
+                let every = self.vms[r]
+                    .handler_period_ns(h)
+                    .map(|p| format!(" every {}", exact_time(p)))
+                    .unwrap_or_default();
+                let total = fired(h, &self.trace);
+                (
+                    format!(
+                        "the run has recorded {} events, the most a run keeps: the handler `{name}` of {robot}, firing{every}, fired {total} times; give it a longer period, disable it when it is not needed, or simulate less time (`--until`)",
+                        self.event_limit
+                    ),
+                    info.pos,
+                )
+            }
+            _ => {
+                let pos = tail
+                    .iter()
+                    .rev()
+                    .find(|e| e.robot == Some(r))
+                    .and_then(|e| e.pos)
+                    .unwrap_or_default();
+                (
+                    format!(
+                        "the run has recorded {} events, the most a run keeps: {robot} recorded {} of the last {}, the last at {}:{pos}; let more time pass between its events, or simulate less time (`--until`)",
+                        self.event_limit,
+                        per_robot[r],
+                        tail.len(),
+                        self.short(r, pos),
+                    ),
+                    pos,
+                )
+            }
+        };
+        self.error(t, Some(r), Some(pos), "runtime", message);
+        self.outcome = Some(super::Outcome::Error);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// The memory bound [`super::EVENT_LIMIT`] documents: events of fixed size.
+    #[test]
+    fn a_trace_event_takes_at_most_104_bytes() {
+        assert!(std::mem::size_of::<crate::trace::TraceEvent>() <= 104);
+    }
+}
