@@ -122,6 +122,6 @@ mod tests {
     /// The memory bound [`super::EVENT_LIMIT`] documents: events of fixed size.
     #[test]
     fn a_trace_event_takes_at_most_104_bytes() {
-        assert!(std::mem::size_of::<crate::trace::TraceEvent>() <= 104);
+        assert!(size_of::<crate::trace::TraceEvent>() <= 104);
     }
 }
