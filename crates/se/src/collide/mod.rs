@@ -38,7 +38,7 @@ mod sweep;
 
 use broadphase::SweepAndPrune;
 use narrow::*;
-use pairs::{PairFilter, Promises};
+use pairs::{BodyKeys, PairFilter, Promises};
 use sweep::SweepScratch;
 
 /// A collision that started.
@@ -85,6 +85,8 @@ struct BodyRef {
     radius: f64,
     /// A device's pose in the cell (devices never move).
     fixed: Pose,
+    /// Its link and parent link, for the pair filter ([`PairFilter::never`]).
+    keys: BodyKeys,
     /// For a link's body: per moving joint upstream (robot joint index), how far any point
     /// of the body can be from that joint's axis (m; 1 for a prismatic joint, whose
     /// displacement moves every point by as much). Speed bound = Σ joint speed × reach.
@@ -216,7 +218,7 @@ pub struct Collider {
     ahead_boxes: Vec<Aabb>,
     ahead: SweepAndPrune,
     ahead_pairs: Vec<(usize, usize)>,
-    /// Whether to skip queries by `safe_until` (see [`Collider::set_adaptive`]).
+    /// Whether to skip queries by their promises (see [`Collider::set_adaptive`]).
     adaptive: bool,
     /// Each robot's link bodies (the links of every robot come first, robot by robot),
     /// and where they end.
@@ -270,6 +272,7 @@ impl Collider {
                         radius,
                         fixed: Pose::IDENTITY,
                         reach: reach_of(&robot.model, l, extent),
+                        keys: BodyKeys::default(),
                     });
                 }
             }
@@ -285,6 +288,7 @@ impl Collider {
                 radius: bounding_radius(&d.shape),
                 fixed: d.pose.to_pose() * d.local.to_pose(),
                 reach: Vec::new(),
+                keys: BodyKeys::default(),
             });
         }
         for (i, p) in cell.parts.iter().enumerate() {
@@ -296,10 +300,14 @@ impl Collider {
                 radius: bounding_radius(&p.shape),
                 fixed: Pose::IDENTITY,
                 reach: Vec::new(),
+                keys: BodyKeys::default(),
             });
         }
         let n = bodies.len();
         let filter = PairFilter::new(cell, &bodies);
+        for (b, k) in bodies.iter_mut().zip(filter.keys()) {
+            b.keys = *k;
+        }
         Collider {
             filter,
             poses: vec![Pose::IDENTITY; n],
@@ -463,10 +471,7 @@ impl Collider {
             let pi = self.body_pose(cell, i, &frames);
             for j in 0..n {
                 let pair = (i.min(j), i.max(j));
-                if j == i
-                    || self.static_pair(pair)
-                    || self.filter.never(pair.0, pair.1)
-                    || self.held_by(pair, cell)
+                if j == i || self.static_pair(pair) || self.never(pair) || self.held_by(pair, cell)
                 {
                     continue;
                 }
@@ -591,7 +596,7 @@ impl Collider {
         let mut starts = Vec::new();
         for &pair in &pairs {
             {
-                if self.filter.never(pair.0, pair.1) || self.held_by(pair, cell) {
+                if self.never(pair) || self.held_by(pair, cell) {
                     continue;
                 }
                 if self.static_pair(pair) {
@@ -725,7 +730,7 @@ impl Collider {
         let mut h = t.saturating_add(HORIZON_NS);
         // The pairs the check's broadphase kept: their promises.
         for &(i, j) in &self.pairs {
-            if self.filter.never(i, j) || self.static_pair((i, j)) {
+            if self.never((i, j)) || self.static_pair((i, j)) {
                 continue;
             }
             h = h.min(self.promises.get(i, j));
@@ -746,7 +751,7 @@ impl Collider {
         self.ahead.overlapping(&self.ahead_boxes, &mut pairs);
         for &(i, j) in &pairs {
             let (a, b) = (&self.aabbs[i], &self.aabbs[j]);
-            if self.filter.never(i, j) || self.static_pair((i, j)) || a.intersects(b) {
+            if self.never((i, j)) || self.static_pair((i, j)) || a.intersects(b) {
                 continue; // (boxes within the clearance: a pair the check kept, above)
             }
             let v = self.body_speed[i] + self.body_speed[j];
@@ -793,6 +798,13 @@ impl Collider {
             },
         };
         owner.to_pose() * b.local
+    }
+
+    /// The pair `i < j` is never checked (see [`PairFilter`]).
+    #[inline(always)]
+    fn never(&self, (i, j): (usize, usize)) -> bool {
+        self.filter
+            .never((i, j), &self.bodies[i].keys, &self.bodies[j].keys)
     }
 
     /// Two bodies neither of which can move (devices and parts nobody holds): never
@@ -978,6 +990,7 @@ mod tests {
                 local: Pose::IDENTITY,
                 fixed: Pose::IDENTITY,
                 reach: Vec::new(),
+                keys: BodyKeys::default(),
             };
             let pose = g.pose();
             let (ours, parry) = (body.bounding_box(&pose), shape.compute_aabb(&pose));

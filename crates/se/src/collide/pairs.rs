@@ -17,9 +17,9 @@ use super::{BodyRef, Owner, matches};
 /// like MoveIt's "default" pairs), and the pairs the workcell allows. (Two devices are
 /// never checked either: see `Collider::static_pair`.)
 pub(super) struct PairFilter {
-    /// Per body: its link as `robot << 32 | link` and its parent link's likewise
-    /// (`u64::MAX`: none; bodies that are not links get keys no link has).
-    link: Vec<(u64, u64)>,
+    /// Per body: its link and its parent link, and which of its lists are not empty (the
+    /// one place the hot loop reads for most pairs).
+    keys: Vec<BodyKeys>,
     /// Per body `i`: the bodies `j > i` of its robot that touch it at the zero
     /// configuration (besides its own link and the links joined to it), sorted.
     touching_at_zero: Vec<Vec<usize>>,
@@ -27,6 +27,21 @@ pub(super) struct PairFilter {
     /// matches the entry's first name, bit 2 its second).
     allowed: Vec<Vec<(usize, u8)>>,
 }
+
+/// A body's link as `robot << 32 | link` and its parent link's likewise (`u64::MAX`:
+/// none; bodies that are not links get keys no link has), and flags: [`TOUCHES_AT_ZERO`],
+/// [`ALLOWED`].
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct BodyKeys {
+    link: u64,
+    parent: u64,
+    flags: u8,
+}
+
+/// The body touches others of its robot at the zero configuration.
+const TOUCHES_AT_ZERO: u8 = 1;
+/// The body matches an entry of the workcell's allowed pairs.
+const ALLOWED: u8 = 2;
 
 /// Bodies' boxes at the zero configuration are grown by this before they are compared,
 /// so that two shapes touching exactly are still a candidate pair (m).
@@ -37,24 +52,31 @@ impl PairFilter {
     pub(super) fn new(cell: &Cell, bodies: &[BodyRef]) -> PairFilter {
         let n = bodies.len();
         let key = |robot: usize, link: usize| ((robot as u64) << 32) | link as u64;
-        let link = bodies
+        let keys = bodies
             .iter()
             .enumerate()
-            .map(|(i, b)| match b.owner {
-                Owner::Link { robot, link } => {
-                    let model = &cell.robots[robot].model;
-                    let parent = model.links[link]
-                        .parent_joint
-                        .and_then(|j| model.joints.get(j))
-                        .map_or(u64::MAX, |j| key(robot, j.parent));
-                    (key(robot, link), parent)
+            .map(|(i, b)| {
+                let (link, parent) = match b.owner {
+                    Owner::Link { robot, link } => {
+                        let model = &cell.robots[robot].model;
+                        let parent = model.links[link]
+                            .parent_joint
+                            .and_then(|j| model.joints.get(j))
+                            .map_or(u64::MAX, |j| key(robot, j.parent));
+                        (key(robot, link), parent)
+                    }
+                    // Above every link's key (robots and links are far fewer than 2^31).
+                    _ => ((1 << 63) | i as u64, u64::MAX),
+                };
+                BodyKeys {
+                    link,
+                    parent,
+                    flags: 0,
                 }
-                // Above every link's key (robots and links are far fewer than 2^31).
-                _ => ((1 << 63) | i as u64, u64::MAX),
             })
             .collect();
         let mut filter = PairFilter {
-            link,
+            keys,
             touching_at_zero: vec![Vec::new(); n],
             allowed: vec![Vec::new(); n],
         };
@@ -66,6 +88,14 @@ impl PairFilter {
                 if sides != 0 {
                     filter.allowed[i].push((k, sides));
                 }
+            }
+        }
+        for (i, k) in filter.keys.iter_mut().enumerate() {
+            if !filter.touching_at_zero[i].is_empty() {
+                k.flags |= TOUCHES_AT_ZERO;
+            }
+            if !filter.allowed[i].is_empty() {
+                k.flags |= ALLOWED;
             }
         }
         filter
@@ -98,7 +128,7 @@ impl PairFilter {
             broadphase.overlapping(&boxes, &mut pairs);
             for &(a, b) in &pairs {
                 let (i, j) = (start + a, start + b);
-                if self.same_or_joined(i, j) {
+                if same_or_joined(&self.keys[i], &self.keys[j]) {
                     continue;
                 }
                 let touching = parry3d::query::intersection_test(
@@ -119,26 +149,25 @@ impl PairFilter {
         }
     }
 
-    /// Bodies `i` and `j` are shapes of one link, or of two links joined by a joint.
-    fn same_or_joined(&self, i: usize, j: usize) -> bool {
-        let ((a, pa), (b, pb)) = (self.link[i], self.link[j]);
-        a == b || pa == b || pb == a
+    /// Each body's keys (the collider keeps a copy in each body, beside what the hot loop
+    /// reads of it anyway).
+    pub(super) fn keys(&self) -> &[BodyKeys] {
+        &self.keys
     }
 
-    /// Whether the pair `i < j` is never checked.
-    #[inline]
-    pub(super) fn never(&self, i: usize, j: usize) -> bool {
-        self.same_or_joined(i, j)
-            || self.touching_at_zero[i].binary_search(&j).is_ok()
-            || self.allowed(i, j)
+    /// Whether the pair `i < j`, of keys `a` and `b`, is never checked (inlined: the
+    /// boundary check asks it of every pair its broadphase keeps).
+    #[inline(always)]
+    pub(super) fn never(&self, (i, j): (usize, usize), a: &BodyKeys, b: &BodyKeys) -> bool {
+        same_or_joined(a, b)
+            || (a.flags & TOUCHES_AT_ZERO != 0
+                && self.touching_at_zero[i].binary_search(&j).is_ok())
+            || (a.flags & b.flags & ALLOWED != 0 && self.allowed(i, j))
     }
 
     /// The workcell allows the pair: one entry names one body first and the other second.
     fn allowed(&self, i: usize, j: usize) -> bool {
         let (a, b) = (&self.allowed[i], &self.allowed[j]);
-        if a.is_empty() || b.is_empty() {
-            return false;
-        }
         a.iter().any(|&(k, sa)| {
             b.binary_search_by_key(&k, |e| e.0).is_ok_and(|at| {
                 (sa & 1 != 0 && b[at].1 & 2 != 0) || (sa & 2 != 0 && b[at].1 & 1 != 0)
@@ -152,6 +181,13 @@ impl PairFilter {
         self.touching_at_zero.iter().map(Vec::len).sum::<usize>()
             + self.allowed.iter().map(Vec::len).sum::<usize>()
     }
+}
+
+/// Two bodies are shapes of one link, or of two links joined by a joint.
+#[inline(always)]
+fn same_or_joined(a: &BodyKeys, b: &BodyKeys) -> bool {
+    // (Parents come before children: of two joined links, the second is the child.)
+    b.parent == a.link || a.link == b.link || a.parent == b.link
 }
 
 /// One pair's promise: no query needed before `until` (see `Collider::check`).

@@ -162,7 +162,7 @@ impl Collider {
         for &(i, j) in &pairs {
             {
                 if sw.bound[i] + sw.bound[j] <= 0.0
-                    || self.filter.never(i, j)
+                    || self.never((i, j))
                     || (self.adaptive && to <= self.promises.get(i, j))
                 {
                     continue;
