@@ -474,3 +474,41 @@ fn the_language_references_motion_example_runs_with_its_zones() {
         "{lines:#?}"
     );
 }
+
+#[test]
+fn a_sync_timeout_tied_with_the_last_arrival_warns_in_either_order() {
+    // r1's wait at `meet` times out at 1 s, the instant r2 arrives. Queued first, the
+    // timeout wins (r1 gives up, r2 waits alone: deadlock); with the tie reversed, r2's
+    // arrival completes the meeting before the deadline (both go on). Either way the
+    // outcome is the tie order's: a race warning names both statements.
+    let files = [
+        ("cell.toml", TWO_ROBOTS),
+        (
+            "a.wsl",
+            "proc main() {\n    sync meet with a, b timeout 1s;\n}\n",
+        ),
+        (
+            "b.wsl",
+            "proc main() {\n    delay 1s;\n    sync meet with a, b;\n}\n",
+        ),
+    ];
+    let path = write_cell("sync-tie", &files);
+    let cell = Arc::new(load(&path).unwrap_or_else(|e| panic!("{e}")));
+    for (ranks, outcome) in [
+        (vec![0, 1], Outcome::Deadlock),
+        (vec![1, 0], Outcome::Completed),
+    ] {
+        let mut sim = Simulation::new(Arc::clone(&cell));
+        sim.set_tie_ranks(ranks.clone());
+        while sim.step(None) {}
+        assert_eq!(sim.outcome(), Some(outcome), "ranks {ranks:?}");
+        let races: Vec<&str> = sim
+            .warnings()
+            .iter()
+            .filter(|w| w.kind == "race")
+            .map(|w| w.message.as_str())
+            .collect();
+        assert_eq!(races.len(), 1, "ranks {ranks:?}: {races:?}");
+        assert!(races[0].contains("at sync point `meet`"), "{}", races[0]);
+    }
+}

@@ -453,7 +453,14 @@ fn link_syncs(
             }
             members.sort_unstable();
             members.dedup();
-            let all_known = members.len() == site.tasks.len();
+            let mut distinct: Vec<String> = site
+                .tasks
+                .iter()
+                .map(|t| m.str(*t).to_lowercase())
+                .collect();
+            distinct.sort_unstable();
+            distinct.dedup();
+            let all_known = members.len() == distinct.len();
             if all_known && !members.contains(&(ri as u32)) {
                 diags.push(
                     at(m, Code::E0107, format!("sync point `{name}`: the task list does not hold this robot's own task `{}`", r.task), site.pos)
@@ -474,6 +481,8 @@ fn link_syncs(
                         .with_help("every task that meets at one sync point must list the same tasks"),
                 ),
                 Some(_) => {}
+                // (A list with an unknown task is reported as such, not compared.)
+                None if !all_known => {}
                 None => {
                     points.insert(key.clone(), (name.to_string(), members));
                 }

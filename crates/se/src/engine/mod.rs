@@ -132,6 +132,8 @@ pub struct Simulation {
     /// at the meeting under way; per robot, the sync point it waits at.
     sync_arrived: Vec<Vec<bool>>,
     at_sync: Vec<Option<usize>>,
+    /// Per sync point: the last wait there that timed out (time, robot, position).
+    sync_timeout: Vec<Option<(i64, usize, SrcPos)>>,
 }
 
 /// How many queue entries the cell may handle at one simulated instant by default: far
@@ -261,6 +263,7 @@ impl Simulation {
                 .map(|s| vec![false; s.members.len()])
                 .collect(),
             at_sync: vec![None; n],
+            sync_timeout: vec![None; cell.linked.syncs.len()],
             cell,
         }
     }

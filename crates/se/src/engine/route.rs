@@ -66,14 +66,12 @@ impl Simulation {
                 }
                 self.clear_waits(r);
                 // A wait at a sync point that timed out: the task leaves the meeting.
-                if let Some(cs) = self.at_sync[r].take() {
-                    let members = &self.cell.linked.syncs[cs].members;
-                    if let Some(k) = members.iter().position(|q| *q as usize == r) {
-                        self.sync_arrived[cs][k] = false;
-                    }
+                if *timed_out && let Some(cs) = self.at_sync[r] {
+                    self.sync_timeout[cs] = Some((t, r, e.pos));
                 }
+                self.leave_sync(r);
             }
-            EventKind::WaitSync { site, .. } => self.arrive(r, *site as usize, t),
+            EventKind::WaitSync { site, .. } => self.arrive(r, *site as usize, t, e.pos),
             EventKind::EnableWhen { handler } => {
                 let m = self.vms[r].module();
                 let h = &m.handlers[*handler as usize];
@@ -95,8 +93,9 @@ impl Simulation {
                 for w in &mut self.when_list {
                     w.retain(|(q, _)| *q != r);
                 }
-                // (`stop` in a handler may end a wait.)
+                // (`stop` in a handler may end a wait, a wait at a sync point too.)
                 self.clear_waits(r);
+                self.leave_sync(r);
             }
             EventKind::Signal { site } => {
                 let (target, idx) = self.signal_to[r][*site as usize];
@@ -148,6 +147,7 @@ impl Simulation {
                 // The handlers the remote work enabled ended with it.
                 self.sync_when_list(r);
                 self.clear_waits(r);
+                self.leave_sync(r);
                 if let Some((caller, req)) = self.serving[r].pop_front() {
                     self.tick(r);
                     self.merge_clock(caller, Seen::Robot(r));
@@ -255,10 +255,21 @@ impl Simulation {
         }
     }
 
+    /// Robot `r` leaves the meeting it waits at, if any (its wait timed out, or its
+    /// program or remote work ended while it waited): its arrival no longer counts.
+    fn leave_sync(&mut self, r: usize) {
+        if let Some(cs) = self.at_sync[r].take() {
+            let members = &self.cell.linked.syncs[cs].members;
+            if let Some(k) = members.iter().position(|q| *q as usize == r) {
+                self.sync_arrived[cs][k] = false;
+            }
+        }
+    }
+
     /// Robot `r` arrives at the sync point of its sync site `site`: when every task of the
     /// list has arrived, the meeting is complete and all of them go on at `t` (each has
     /// seen every other's arrival).
-    fn arrive(&mut self, r: usize, site: usize, t: i64) {
+    fn arrive(&mut self, r: usize, site: usize, t: i64, pos: SrcPos) {
         let cs = self.cell.linked.robots[r].syncs[site] as usize;
         let cell = Arc::clone(&self.cell);
         let members = &cell.linked.syncs[cs].members;
@@ -267,8 +278,27 @@ impl Simulation {
         }
         self.at_sync[r] = Some(cs);
         self.tick(r);
+        let name = format!("at sync point `{}`", cell.linked.syncs[cs].name);
+        const TIED: &str = "time out there and arrive at the same instant; whether they meet depends on their order";
+        if let Some((ot, q, qpos)) = self.sync_timeout[cs]
+            && ot == t
+            && q != r
+        {
+            self.race(t, (q, qpos), (r, pos), &name, TIED);
+        }
         if !self.sync_arrived[cs].iter().all(|a| *a) {
             return;
+        }
+        // A task whose wait would time out at this very instant meets the others only
+        // because this arrival came first.
+        for q in members {
+            let q = *q as usize;
+            if q != r
+                && self.vms[q].wait_deadline() == Some(t)
+                && let Some((_, qpos)) = self.vms[q].waiting_for()
+            {
+                self.race(t, (q, qpos), (r, pos), &name, TIED);
+            }
         }
         self.sync_arrived[cs].iter_mut().for_each(|a| *a = false);
         for q in members {
