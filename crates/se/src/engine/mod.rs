@@ -132,6 +132,10 @@ pub struct Simulation {
     /// at the meeting under way; per robot, the sync point it waits at.
     sync_arrived: Vec<Vec<bool>>,
     at_sync: Vec<Option<usize>>,
+    /// Per robot: the instant of its `check_wait` and of its `check_when` still queued, if
+    /// any (a set at that instant needs no second one: the queued check comes after it and
+    /// tests the values it leaves).
+    check_pending: Vec<(Option<i64>, Option<i64>)>,
     /// Per sync point: the last wait there that timed out (time, robot, position).
     sync_timeout: Vec<Option<(i64, usize, SrcPos)>>,
 }
@@ -263,6 +267,7 @@ impl Simulation {
                 .map(|s| vec![false; s.members.len()])
                 .collect(),
             at_sync: vec![None; n],
+            check_pending: vec![(None, None); n],
             sync_timeout: vec![None; cell.linked.syncs.len()],
             cell,
         }
@@ -611,6 +616,7 @@ impl Simulation {
                 self.perform(r);
             }
             Entry::CheckWait(r, cg) => {
+                self.check_pending[r].0 = None;
                 self.record(t, Some(r), Kind::CheckWait, Detail::Global(cg), None);
                 if self.vms[r].check_wait(t) {
                     // What r does next follows the sets whose values released it: the
@@ -628,6 +634,7 @@ impl Simulation {
                 }
             }
             Entry::CheckWhen(r, cg) => {
+                self.check_pending[r].1 = None;
                 self.record(t, Some(r), Kind::CheckWhen, Detail::Global(cg), None);
                 if self.vms[r].check_when(t) > 0 {
                     // The handlers it fires follow the sets of every global their

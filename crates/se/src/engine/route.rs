@@ -241,16 +241,25 @@ impl Simulation {
         }
         // check_wait / check_when for exactly the robots on this global's wait and when
         // lists, queued behind what is already due (in robot order, for determinism).
+        // A robot whose check of this instant is still queued gets no second one: that
+        // check comes after this set and tests the values it leaves (without this, checks
+        // of robots taking turns piled up: 1,000 queued in a ring of 32).
         for i in 0..self.wait_list[cg].len() {
             let q = self.wait_list[cg].0[i];
-            self.push(t, Entry::CheckWait(q, cg as u32));
+            if self.check_pending[q].0 != Some(t) {
+                self.check_pending[q].0 = Some(t);
+                self.push(t, Entry::CheckWait(q, cg as u32));
+            }
         }
         let mut last = None;
         for i in 0..self.when_list[cg].len() {
             let q = self.when_list[cg].0[i].0;
             if last != Some(q) {
                 last = Some(q);
-                self.push(t, Entry::CheckWhen(q, cg as u32));
+                if self.check_pending[q].1 != Some(t) {
+                    self.check_pending[q].1 = Some(t);
+                    self.push(t, Entry::CheckWhen(q, cg as u32));
+                }
             }
         }
     }
