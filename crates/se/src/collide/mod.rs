@@ -366,7 +366,7 @@ impl Collider {
     }
 
     /// Robot `r` starts a motion: the promises of the pairs with one of its bodies (its
-    /// links, a part it holds) no longer hold; the others' still do (see [`Promises`]).
+    /// links, a part it holds) no longer hold; the others' still do (see `Promises`).
     pub fn motion_started(&mut self, r: usize) {
         self.horizon = i64::MIN;
         self.promises.begin_withdrawal();
