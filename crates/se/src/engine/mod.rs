@@ -618,13 +618,12 @@ impl Simulation {
             Entry::CheckWait(r, cg) => {
                 self.check_pending[r].0 = None;
                 self.record(t, Some(r), Kind::CheckWait, Detail::Global(cg), None);
+                let cond = self.vms[r].waiting_cond();
                 if self.vms[r].check_wait(t) {
                     // What r does next follows the sets whose values released it: the
-                    // condition read every global on its wait list.
-                    for g in 0..self.wait_list.len() {
-                        if self.wait_list[g].contains(&r) {
-                            self.merge_clock(r, Seen::Set(g));
-                        }
+                    // condition read every one of its globals.
+                    if let Some(c) = cond {
+                        self.seen_condition(r, c);
                     }
                     self.requeue(r);
                 } else if let Some(poll) = self.vms[r].take_poll_check() {
@@ -879,7 +878,8 @@ impl Simulation {
             let (mut what, pos) = self.vms[*r]
                 .waiting_for()
                 .unwrap_or_else(|| ("something".into(), SrcPos::default()));
-            if let Some(globals) = self.vms[*r].waiting_condition_globals() {
+            if let Some(c) = self.vms[*r].waiting_cond() {
+                let globals = &self.cell.robots[*r].module.conds[c as usize].globals;
                 what = format!("a condition on {}", self.names_in_program(*r, globals));
             }
             if let Some(cs) = self.at_sync[*r] {
@@ -930,18 +930,12 @@ impl Simulation {
             .map(|g| {
                 let global = m.str(m.globals[*g as usize].name);
                 // Several of the robot's signals on one wire: the first, by name.
-                match robot
+                let first = robot
                     .signal_names
-                    .binary_search_by(|(w, _)| w.as_str().cmp(global))
-                {
-                    Ok(i) => {
-                        let first = robot.signal_names[..=i]
-                            .iter()
-                            .rposition(|(w, _)| w != global)
-                            .map_or(0, |k| k + 1);
-                        robot.signal_names[first].1.as_str()
-                    }
-                    Err(_) => global,
+                    .partition_point(|(w, _)| w.as_str() < global);
+                match robot.signal_names.get(first) {
+                    Some((w, name)) if w == global => name.as_str(),
+                    _ => global,
                 }
             })
             .collect();

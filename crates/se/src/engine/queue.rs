@@ -90,10 +90,6 @@ impl<T: Ord + Copy> SortedSet<T> {
         }
     }
 
-    pub(super) fn contains(&self, x: &T) -> bool {
-        self.0.binary_search(x).is_ok()
-    }
-
     pub(super) fn remove(&mut self, x: &T) {
         if let Ok(i) = self.0.binary_search(x) {
             self.0.remove(i);

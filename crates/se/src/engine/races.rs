@@ -3,6 +3,8 @@
 //! it); two same-instant actions on one global, signal or remote robot that neither has
 //! seen are a race — their order is only the queue's tie order.
 
+use std::sync::Arc;
+
 use vworks_vm::bytecode::SrcPos;
 use vworks_vm::types::fmt_quantity;
 
@@ -69,6 +71,16 @@ impl Simulation {
             };
             let mine = &mut self.clock[r * n + k];
             *mine = (*mine).max(seen);
+        }
+    }
+
+    /// Robot `r` tested condition `c` of its module: it has seen the last set of every
+    /// global the condition reads.
+    pub(super) fn seen_condition(&mut self, r: usize, c: u32) {
+        let cell = Arc::clone(&self.cell);
+        for g in &cell.robots[r].module.conds[c as usize].globals {
+            let cg = cell.linked.robots[r].globals[*g as usize] as usize;
+            self.merge_clock(r, Seen::Set(cg));
         }
     }
 

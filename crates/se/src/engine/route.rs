@@ -45,14 +45,14 @@ impl Simulation {
                 // same instant, so either order releases it at the same time.
                 let passed = !self.vms[r].waits();
                 let stamp = self.tick(r);
+                if passed {
+                    // A wait that passes on a value set earlier at this instant would, in
+                    // the other order, have blocked and been released by that set's
+                    // check_wait at the same instant: it follows the set either way.
+                    self.seen_condition(r, *cond);
+                }
                 for g in &cell.robots[r].module.conds[*cond as usize].globals {
                     let cg = cell.linked.robots[r].globals[*g as usize] as usize;
-                    if passed {
-                        // A wait that passes on a value set earlier at this instant would,
-                        // in the other order, have blocked and been released by that set's
-                        // check_wait at the same instant: it follows the set either way.
-                        self.merge_clock(r, Seen::Set(cg));
-                    }
                     self.check_race(cg, r, t, e.pos, false);
                     if passed {
                         self.last_read[cg] = Some((t, r, e.pos, stamp));
@@ -268,10 +268,15 @@ impl Simulation {
     /// program or remote work ended while it waited): its arrival no longer counts.
     fn leave_sync(&mut self, r: usize) {
         if let Some(cs) = self.at_sync[r].take() {
-            let members = &self.cell.linked.syncs[cs].members;
-            if let Some(k) = members.iter().position(|q| *q as usize == r) {
-                self.sync_arrived[cs][k] = false;
-            }
+            self.mark_arrived(cs, r, false);
+        }
+    }
+
+    /// Whether member `r` of sync point `cs` has arrived at the meeting under way.
+    fn mark_arrived(&mut self, cs: usize, r: usize, arrived: bool) {
+        let members = &self.cell.linked.syncs[cs].members;
+        if let Ok(k) = members.binary_search(&(r as u32)) {
+            self.sync_arrived[cs][k] = arrived;
         }
     }
 
@@ -282,18 +287,16 @@ impl Simulation {
         let cs = self.cell.linked.robots[r].syncs[site] as usize;
         let cell = Arc::clone(&self.cell);
         let members = &cell.linked.syncs[cs].members;
-        if let Some(k) = members.iter().position(|q| *q as usize == r) {
-            self.sync_arrived[cs][k] = true;
-        }
+        self.mark_arrived(cs, r, true);
         self.at_sync[r] = Some(cs);
         self.tick(r);
-        let name = format!("at sync point `{}`", cell.linked.syncs[cs].name);
+        let name = || format!("at sync point `{}`", cell.linked.syncs[cs].name);
         const TIED: &str = "time out there and arrive at the same instant; whether they meet depends on their order";
         if let Some((ot, q, qpos)) = self.sync_timeout[cs]
             && ot == t
             && q != r
         {
-            self.race(t, (q, qpos), (r, pos), &name, TIED);
+            self.race(t, (q, qpos), (r, pos), &name(), TIED);
         }
         if !self.sync_arrived[cs].iter().all(|a| *a) {
             return;
@@ -306,14 +309,20 @@ impl Simulation {
                 && self.vms[q].wait_deadline() == Some(t)
                 && let Some((_, qpos)) = self.vms[q].waiting_for()
             {
-                self.race(t, (q, qpos), (r, pos), &name, TIED);
+                self.race(t, (q, qpos), (r, pos), &name(), TIED);
             }
         }
         self.sync_arrived[cs].iter_mut().for_each(|a| *a = false);
-        for q in members {
-            for p in members {
-                self.merge_clock(*q as usize, Seen::Robot(*p as usize));
-            }
+        // Every member has seen every arrival: the first gathers them all, the others
+        // take its clock.
+        let (first, rest) = members
+            .split_first()
+            .map_or((0, &[][..]), |(f, rest)| (*f as usize, rest));
+        for p in rest {
+            self.merge_clock(first, Seen::Robot(*p as usize));
+        }
+        for q in rest {
+            self.merge_clock(*q as usize, Seen::Robot(first));
         }
         for q in members {
             let q = *q as usize;

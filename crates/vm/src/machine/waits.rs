@@ -143,11 +143,11 @@ impl Vm {
         false
     }
 
-    /// The module globals the condition this VM waits on reads (`None` unless it waits
-    /// for a condition).
-    pub fn waiting_condition_globals(&self) -> Option<&[u32]> {
-        match &self.state {
-            State::Waiting { cond: Some(c), .. } => Some(&self.m.conds[*c as usize].globals),
+    /// The condition (index in the module's conditions) this VM waits on, if it waits
+    /// for one.
+    pub fn waiting_cond(&self) -> Option<u32> {
+        match self.state {
+            State::Waiting { cond, .. } => cond,
             _ => None,
         }
     }
