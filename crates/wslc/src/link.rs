@@ -439,28 +439,28 @@ fn link_syncs(
         for site in &m.syncs {
             let name = m.str(site.name);
             let mut members = Vec::new();
+            let mut all_known = true;
             for t in &site.tasks {
                 let t = m.str(*t);
-                match cell.robots.iter().position(|q| q.task.eq_ignore_ascii_case(t)) {
+                match cell
+                    .robots
+                    .iter()
+                    .position(|q| q.task.eq_ignore_ascii_case(t))
+                {
                     Some(q) => members.push(q as u32),
                     // (Robots that run one program report its unknown tasks once.)
-                    None if shared => {}
-                    None => diags.push(
+                    None if shared => all_known = false,
+                    None => {
+                        all_known = false;
+                        diags.push(
                         at(m, Code::E0107, format!("sync point `{name}`: no robot of the cell runs the task `{t}`"), site.pos)
                             .with_help(format!("the tasks are: {}; a RAPID task's name goes in its robot's `task` key of the workcell (`task = \"T_ROB1\"`)", tasks())),
-                    ),
+                    );
+                    }
                 }
             }
             members.sort_unstable();
             members.dedup();
-            let mut distinct: Vec<String> = site
-                .tasks
-                .iter()
-                .map(|t| m.str(*t).to_lowercase())
-                .collect();
-            distinct.sort_unstable();
-            distinct.dedup();
-            let all_known = members.len() == distinct.len();
             if all_known && !members.contains(&(ri as u32)) {
                 diags.push(
                     at(m, Code::E0107, format!("sync point `{name}`: the task list does not hold this robot's own task `{}`", r.task), site.pos)
@@ -476,13 +476,13 @@ fn link_syncs(
                     .join(", ")
             };
             match points.get(&key) {
+                // (A list with an unknown task is reported as such, not compared.)
+                _ if !all_known => {}
                 Some((_, have)) if *have != members => diags.push(
                     at(m, Code::E0107, format!("sync point `{name}` lists the tasks {} here, but {} where another task meets there", listed(&members), listed(have)), site.pos)
                         .with_help("every task that meets at one sync point must list the same tasks"),
                 ),
                 Some(_) => {}
-                // (A list with an unknown task is reported as such, not compared.)
-                None if !all_known => {}
                 None => {
                     points.insert(key.clone(), (name.to_string(), members));
                 }
