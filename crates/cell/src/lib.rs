@@ -786,6 +786,8 @@ fn load_parsed(
     let mut sources = vec![(file.clone(), text.to_string())];
     let mut files: Vec<(String, Vec<u8>)> = Vec::new();
     let mut robots = Vec::new();
+    // Each task name (lower case) and the robot that runs it.
+    let mut tasks: BTreeMap<String, usize> = BTreeMap::new();
     let mut modules: Vec<(String, Arc<Module>)> = Vec::new();
     let mut diagnostics = Vec::new();
     let mut warnings = Vec::new();
@@ -857,18 +859,17 @@ fn load_parsed(
                 t.clone()
             }
         };
-        if let Some((other, _, _)) = robots
-            .iter()
-            .find(|(o, _, _): &&(Robot, String, bool)| o.task.eq_ignore_ascii_case(&task))
-        {
+        if let Some(&other) = tasks.get(&task.to_ascii_lowercase()) {
+            let other: &(Robot, String, bool) = &robots[other];
             return Err(cx.bad(
                 &format!("{key}.task"),
                 format!(
                     "robot `{}` already runs the task `{}`: give each robot a task name of its own",
-                    other.name, other.task
+                    other.0.name, other.0.task
                 ),
             ));
         }
+        tasks.insert(task.to_ascii_lowercase(), i);
         let Some(program) = &r.program else {
             return Err(cx.bad(
                 &format!("{key}.program"),
