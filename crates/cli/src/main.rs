@@ -74,16 +74,22 @@ enum Command {
         /// Print the result as one JSON object.
         #[arg(long)]
         json: bool,
-        /// Print the event trace, one line per event.
+        /// Print the event trace, one line per event, times in seconds
+        /// (`7.220474304 s r1 set gopartsready=1 r1.mod:37:7`).
         #[arg(long)]
         trace: bool,
+        /// Print the event trace with times in integer nanoseconds (`7220474304 r1 set …`):
+        /// the format of `vworks log events` and the golden files.
+        #[arg(long, conflicts_with = "trace")]
+        trace_ns: bool,
         /// Write the run to this MCAP file (events, cycle states, geometry; opens in Foxglove).
         #[arg(long)]
         log: Option<PathBuf>,
         /// Log the state of every N-th cycle only (events are never thinned).
         #[arg(long, default_value_t = 1, value_parser = every_nth)]
         log_every: u64,
-        /// No progress bar (it shows on a terminal for runs longer than a second).
+        /// No progress bar (it shows on a terminal for runs longer than a second) and no
+        /// `log` lines of the programs (they print as they happen, before the summary).
         #[arg(short, long)]
         quiet: bool,
         /// Change a value of the workcell for this run, by its dotted path as a sweep names
@@ -146,6 +152,10 @@ enum LogCommand {
         /// Only events of this robot.
         #[arg(long)]
         robot: Option<String>,
+        /// Times in seconds (`7.220474304 s`, `duration=1.3 s`) instead of nanoseconds,
+        /// as `run --trace` prints them.
+        #[arg(long)]
+        seconds: bool,
     },
 }
 
@@ -279,7 +289,17 @@ fn read_log(what: LogCommand) -> Result<ExitCode, String> {
     // kill: what was read is printed, and the damage is a warning and exit code 1.
     let log = vworks_se::mcaplog::read_log(&file).map_err(|e| e.to_string())?;
     match &what {
-        LogCommand::Events { kind, robot, .. } => {
+        LogCommand::Events {
+            kind,
+            robot,
+            seconds,
+            ..
+        } => {
+            let times = if *seconds {
+                vworks_se::trace::Times::Seconds
+            } else {
+                vworks_se::trace::Times::Nanoseconds
+            };
             for e in &log.events {
                 if kind.as_deref().is_some_and(|want| want != e.kind.name())
                     || robot
@@ -288,7 +308,7 @@ fn read_log(what: LogCommand) -> Result<ExitCode, String> {
                 {
                     continue;
                 }
-                out!("{}", e.line());
+                out!("{}", e.line_as(times));
             }
         }
         LogCommand::Info { .. } => {
@@ -552,20 +572,53 @@ fn open_in_browser(page: &Path) -> Result<String, String> {
         })
 }
 
+/// A program's `log` line as a plain run prints it: `[11.156 s] r1: done`.
+fn log_line(l: &vworks_se::trace::LogLine) -> String {
+    use vworks_se::trace::escape_controls as esc;
+    format!(
+        "[{:.3} s] {}: {}",
+        l.time_ns as f64 / 1e9,
+        esc(&l.robot),
+        esc(&l.text)
+    )
+}
+
 /// Runs the simulation to its end (or `until`). With `progress` (the run's start), a bar on
 /// stderr shows the simulated time done and the speed, once the run has taken a second:
 /// against `until` when there is one, else as a spinner (the end is not known ahead).
+/// With `print_logs`, the programs' `log` lines print on stdout as they happen (above the
+/// bar).
 fn simulate(
     mut sim: vworks_se::engine::Simulation,
     until: Option<i64>,
     progress: Option<std::time::Instant>,
+    print_logs: bool,
 ) -> vworks_se::engine::RunResult {
-    let Some(started) = progress else {
+    if progress.is_none() && !print_logs {
         return sim.run(until);
-    };
+    }
     let mut bar: Option<indicatif::ProgressBar> = None;
     let mut steps = 0u32;
-    while sim.step(until) {
+    let mut seen = 0;
+    loop {
+        let more = sim.step(until);
+        if print_logs && sim.trace().len() > seen {
+            for e in &sim.trace()[seen..] {
+                if let Some(l) = e.log_line(sim.cell()) {
+                    match &bar {
+                        Some(bar) => bar.suspend(|| out!("{}", log_line(&l))),
+                        None => out!("{}", log_line(&l)),
+                    }
+                }
+            }
+            seen = sim.trace().len();
+        }
+        if !more {
+            break;
+        }
+        let Some(started) = progress else {
+            continue;
+        };
         steps = steps.wrapping_add(1);
         // The clock is read every few thousand steps: the bar costs nothing measurable.
         if !steps.is_multiple_of(4096) {
@@ -607,11 +660,14 @@ struct RunOptions<'a> {
     set: &'a [String],
     until: Option<&'a str>,
     json: bool,
-    trace: bool,
+    /// `--trace` (seconds) or `--trace-ns`: print the event trace in this style.
+    trace: Option<vworks_se::trace::Times>,
     log: Option<&'a Path>,
     log_every: u64,
     /// Show a progress bar (stderr is a terminal and not `--quiet`).
     progress: bool,
+    /// `--quiet`: no progress bar, no `log` lines.
+    quiet: bool,
     color: bool,
 }
 
@@ -641,6 +697,7 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
         log,
         log_every,
         progress,
+        quiet,
         color,
     } = opts;
     // With --json, a run that cannot start is still one JSON object on stdout; the
@@ -726,7 +783,8 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
             }
         }
     }
-    let mut r = simulate(sim, until, progress.then_some(started));
+    let print_logs = !json && trace.is_none() && !quiet;
+    let mut r = simulate(sim, until, progress.then_some(started), print_logs);
     if let (Some(temp), Some(path)) = (&log_temp, log) {
         let named = |m: &String| m.replace(&temp.display().to_string(), &display(path));
         r.log_error = r.log_error.as_ref().map(named);
@@ -740,9 +798,9 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
         eprintln!("error: {e}");
     }
     let wall = started.elapsed().as_secs_f64();
-    if trace {
+    if let Some(times) = trace {
         for e in &r.trace {
-            out!("{}", e.line(&cell));
+            out!("{}", e.line_as(&cell, times));
         }
     }
     if json {
@@ -752,7 +810,7 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
             "{}",
             serde_json::to_string_pretty(&v).map_err(|e| e.to_string())?
         );
-    } else if !trace {
+    } else if trace.is_none() {
         // Names and messages from the workcell, escaped as log texts are.
         use vworks_se::trace::escape_controls as esc;
         out!(
@@ -789,11 +847,17 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
                 esc(&c.b),
                 c.depth * 1e3
             );
+            for m in &c.motions {
+                out!("  {}", esc(&m.describe()));
+            }
         }
         // (The compile and link warnings, which open the list, were printed with their
         // source lines.)
         for w in r.warnings.iter().skip(cell.warnings.len()) {
             out!("warning[{}]: {}", w.kind, esc(&w.message));
+            for m in &w.motions {
+                out!("  {}", esc(&m.describe()));
+            }
         }
         for e in &r.errors {
             let at = e.file.as_ref().map_or(String::new(), |f| {
@@ -893,6 +957,7 @@ fn run(cmd: Command, color: bool) -> Result<ExitCode, String> {
             until,
             json,
             trace,
+            trace_ns,
             log,
             log_every,
             quiet,
@@ -903,10 +968,15 @@ fn run(cmd: Command, color: bool) -> Result<ExitCode, String> {
                 set: &set,
                 until: until.as_deref(),
                 json,
-                trace,
+                trace: match (trace, trace_ns) {
+                    (true, _) => Some(vworks_se::trace::Times::Seconds),
+                    (_, true) => Some(vworks_se::trace::Times::Nanoseconds),
+                    _ => None,
+                },
                 log: log.as_deref(),
                 log_every,
                 progress: !quiet && std::io::stderr().is_terminal(),
+                quiet,
                 color,
             },
         ),

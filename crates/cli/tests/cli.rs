@@ -189,7 +189,12 @@ fn run_prints_a_summary_and_exits_by_outcome() {
     let out = vworks(&["run", &workcell("handoff")]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     let s = text(&out.stdout);
-    assert!(s.starts_with("cell handoff: completed at 63.418 s"), "{s}");
+    // The programs' two `log` lines as they happened (r2's at 48.3 s, r1's last, at its
+    // end), then the summary.
+    let lines: Vec<&str> = s.lines().collect();
+    assert!(lines[0].starts_with("[48.336 s] r2: "), "{s}");
+    assert!(lines[1].starts_with("[63.418 s] r1: r1 done"), "{s}");
+    assert_eq!(lines[2], "cell handoff: completed at 63.418 s", "{s}");
     assert!(
         s.contains("r1") && s.contains("ended at") && s.contains("globals: handed=3"),
         "{s}"
@@ -247,7 +252,7 @@ fn run_json_has_the_contracts_fields() {
 
 #[test]
 fn run_until_and_trace() {
-    let out = vworks(&["run", &workcell("handoff"), "--until", "2s", "--trace"]);
+    let out = vworks(&["run", &workcell("handoff"), "--until", "2s", "--trace-ns"]);
     assert_eq!(out.status.code(), Some(0));
     let s = text(&out.stdout);
     assert!(
@@ -262,6 +267,34 @@ fn run_until_and_trace() {
             .and_then(|t| t.parse::<i64>().ok())
             .is_some_and(|t| t <= 2_000_000_000)
     }));
+    // --trace: the same events, times and durations in seconds (`1.3 s` for 1300000000).
+    let out = vworks(&["run", &workcell("handoff"), "--until", "2s", "--trace"]);
+    assert_eq!(out.status.code(), Some(0));
+    let people = text(&out.stdout);
+    assert_eq!(people.lines().count(), s.lines().count());
+    for (ns, sec) in s.lines().zip(people.lines()) {
+        let (t_ns, rest_ns) = ns.split_once(' ').unwrap();
+        let (t_s, rest_s) = sec.split_once(" s ").unwrap();
+        let t_ns: i64 = t_ns.parse().unwrap();
+        let t_s: f64 = t_s.parse().unwrap();
+        assert!((t_s * 1e9 - t_ns as f64).abs() < 0.5, "{ns} / {sec}");
+        // Everything else the same, but for durations and deadlines.
+        if let Some((before, after)) = rest_ns.split_once("duration=") {
+            let (d_ns, tail) = after.split_once(' ').unwrap();
+            let d: i64 = d_ns.parse().unwrap();
+            let expected = if d % 1_000_000_000 == 0 {
+                format!("{}duration={} s {tail}", before, d / 1_000_000_000)
+            } else {
+                let frac = format!("{:09}", d % 1_000_000_000);
+                let frac = frac.trim_end_matches('0');
+                format!("{before}duration={}.{frac} s {tail}", d / 1_000_000_000)
+            };
+            assert_eq!(rest_s, expected);
+        } else {
+            assert_eq!(rest_s, rest_ns);
+        }
+    }
+    assert!(people.contains(" duration=1.3 s "), "{people}");
     let out = vworks(&["run", &workcell("handoff"), "--until", "2 parsecs"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(
@@ -602,4 +635,22 @@ fn package_meshes_are_found_through_ros_package_path() {
     assert!(text(&without.stderr).contains("ROS_PACKAGE_PATH"));
     let with = run(Some(&share));
     assert_eq!(with.status.code(), Some(0), "{}", text(&with.stderr));
+}
+
+/// `log events` prints the contract's trace lines (integer ns), byte-identical to `run
+/// --trace-ns`; with `--seconds`, byte-identical to `run --trace`.
+#[test]
+fn log_events_match_the_run_trace_in_both_styles() {
+    let d = temp_dir("log-seconds");
+    let log = d.join("crash.mcap");
+    let log = log.to_str().unwrap();
+    let run_ns = vworks(&["run", &workcell("crash"), "--trace-ns", "--log", log]);
+    let events = vworks(&["log", "events", log]);
+    assert_eq!(text(&events.stdout), text(&run_ns.stdout));
+    assert!(text(&events.stdout).starts_with("0 left motion_start move_j duration="));
+    let run_s = vworks(&["run", &workcell("crash"), "--trace"]);
+    let seconds = vworks(&["log", "events", "--seconds", log]);
+    assert_eq!(text(&seconds.stdout), text(&run_s.stdout));
+    assert!(text(&seconds.stdout).starts_with("0 s left motion_start move_j duration="));
+    let _ = std::fs::remove_dir_all(&d);
 }

@@ -1,5 +1,5 @@
 //! Whole runs of small cells, and what vworks answers: data-driven, like `errors.rs`.
-//! Each `tests/runs/NAME.case` holds a command (usually `vworks run cell.toml --trace`)
+//! Each `tests/runs/NAME.case` holds a command (usually `vworks run cell.toml --trace-ns`, the trace in integer nanoseconds)
 //! and the files it works on; the expected exit code and output are in `NAME.out` beside
 //! it (`UPDATE_EXPECT=1 cargo test -p vworks-cli --test runs` rewrites them; review them in
 //! the diff).

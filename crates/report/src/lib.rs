@@ -24,7 +24,7 @@ use std::fmt::Write as _;
 
 use vworks_se::mcaplog::{LogContents, LoggedEvent};
 use vworks_se::stats::{Ending, Fold, RobotStats};
-use vworks_se::trace::{Data, Kind};
+use vworks_se::trace::{Data, Kind, RobotMotion, Times};
 
 pub use vworks_se::stats::Activity;
 
@@ -83,8 +83,27 @@ pub struct Collision {
     pub a: String,
     /// The second body.
     pub b: String,
-    /// The start event's details text (depth and point).
+    /// How deep and where (`depth=0.4mm point=(0.5200, 0.1000, 0.4000)`).
     pub details: String,
+    /// Each robot whose body is in the pair and the motion it was making.
+    pub motions: Vec<RobotMotion>,
+}
+
+/// A warning or an error in the report.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Issue {
+    /// When (ns).
+    pub time_ns: i64,
+    /// [`Kind::Warning`] or [`Kind::Error`].
+    pub kind: Kind,
+    /// Its robot, if one.
+    pub robot: Option<String>,
+    /// The message.
+    pub message: String,
+    /// Where in the robot's program (`r1.wsl:7:9`), if known.
+    pub position: Option<String>,
+    /// For a near miss: each robot in the pair and the motion it was making.
+    pub motions: Vec<RobotMotion>,
 }
 
 /// Everything the report shows, derived from a log.
@@ -100,8 +119,8 @@ pub struct Report {
     pub timelines: Vec<Timeline>,
     /// Collisions, in order of start.
     pub collisions: Vec<Collision>,
-    /// Warnings and errors: (time ns, `warning`/`error`, robot, message).
-    pub issues: Vec<(i64, Kind, Option<String>, String)>,
+    /// Warnings and errors, in order.
+    pub issues: Vec<Issue>,
 }
 
 impl Report {
@@ -160,14 +179,33 @@ impl Report {
             }
             match (e.kind, r, &e.data) {
                 (Kind::Signal, Some(r), _) => signals[r].push((e.time_ns, e.details.clone())),
-                (Kind::CollisionStart, _, Data::Collision { a, b, .. }) => {
+                (
+                    Kind::CollisionStart,
+                    _,
+                    Data::Collision {
+                        a,
+                        b,
+                        contact,
+                        motions,
+                    },
+                ) => {
                     open_collisions.insert((a.clone(), b.clone()), collisions.len());
+                    // Depth and point, as the details text shows them (without the motions,
+                    // which have a column).
+                    let details = Data::Collision {
+                        a: String::new(),
+                        b: String::new(),
+                        contact: *contact,
+                        motions: Vec::new(),
+                    }
+                    .text();
                     collisions.push(Collision {
                         start_ns: e.time_ns,
                         end_ns: None,
                         a: a.clone(),
                         b: b.clone(),
-                        details: e.details.clone(),
+                        details: details.trim().to_string(),
+                        motions: motions.clone(),
                     });
                 }
                 (Kind::CollisionEnd, _, Data::Collision { a, b, .. }) => {
@@ -176,11 +214,20 @@ impl Report {
                     }
                 }
                 (Kind::Warning | Kind::Error, _, data) => {
-                    let message = match data {
-                        Data::Issue { message, .. } => message.clone(),
-                        _ => e.details.clone(),
+                    let (message, motions) = match data {
+                        Data::Issue {
+                            message, motions, ..
+                        } => (message.clone(), motions.clone()),
+                        _ => (e.details.clone(), Vec::new()),
                     };
-                    issues.push((e.time_ns, e.kind, e.robot.clone(), message));
+                    issues.push(Issue {
+                        time_ns: e.time_ns,
+                        kind: e.kind,
+                        robot: e.robot.clone(),
+                        message,
+                        position: e.position(),
+                        motions,
+                    });
                 }
                 _ => {}
             }
@@ -409,6 +456,19 @@ fn format_tick(t: f64, step: f64) -> String {
 /// A titled table (`id`) of `rows` (each its time in ns, which a click shows, and its
 /// cells, already escaped) under `columns` (name, whether numeric), or the `none` line
 /// when there are no rows.
+/// The motions of a collision or near miss as one table cell: one line per robot, `r1
+/// moving: r1.wsl:7:9 move_l above speed 250mm/s;` (escaped).
+fn motions_cell(motions: &[RobotMotion]) -> String {
+    if motions.is_empty() {
+        return "–".into();
+    }
+    motions
+        .iter()
+        .map(|m| esc(&m.describe()))
+        .collect::<Vec<_>>()
+        .join("<br>")
+}
+
 fn list(
     s: &mut String,
     (title, id, none): (&str, &str, &str),
@@ -538,6 +598,7 @@ th {{ background: #f6f6f6; position: sticky; top: 0; }} td.num, th.num {{ text-a
                 secs(c.start_ns),
                 c.end_ns.map_or("–".into(), secs),
                 esc(&format!("{} {}", c.a, c.b)),
+                motions_cell(&c.motions),
                 esc(&c.details),
             ],
         )
@@ -549,18 +610,26 @@ th {{ background: #f6f6f6; position: sticky; top: 0; }} td.num, th.num {{ text-a
             ("start", true),
             ("end", true),
             ("bodies", false),
+            ("motions", false),
             ("details", false),
         ],
         collisions,
     );
-    let issues = report.issues.iter().map(|(t, kind, robot, message)| {
+    let issues = report.issues.iter().map(|i| {
+        let mut message = esc(&i.message);
+        if !i.motions.is_empty() {
+            message.push_str("<br>");
+            message.push_str(&motions_cell(&i.motions));
+        } else if let Some(p) = &i.position {
+            let _ = write!(message, " <span class=\"src\">({})</span>", esc(p));
+        }
         (
-            *t,
+            i.time_ns,
             vec![
-                secs(*t),
-                esc(kind.name()),
-                esc(robot.as_deref().unwrap_or("–")),
-                esc(message),
+                secs(i.time_ns),
+                esc(i.kind.name()),
+                esc(i.robot.as_deref().unwrap_or("–")),
+                message,
             ],
         )
     });
@@ -606,7 +675,8 @@ th {{ background: #f6f6f6; position: sticky; top: 0; }} td.num, th.num {{ text-a
             k = e.kind.name(),
             ns = e.time_ns,
             t = e.time_ns as f64 / 1e9,
-            d = esc(&e.details),
+            // Durations and deadlines in seconds, as the time column (not nanoseconds).
+            d = esc(&e.details_as(Times::Seconds)),
             p = esc(&pos)
         );
     }
@@ -664,6 +734,77 @@ mod tests {
         }
     }
 
+    /// A collision row names each robot's motion (statement and place), a near miss's row
+    /// too, and the event table writes durations in seconds like its time column.
+    #[test]
+    fn collision_rows_name_the_motions_and_events_show_seconds() {
+        let motion = |robot: &str, moving: bool| RobotMotion {
+            robot: robot.into(),
+            moving,
+            file: Some(format!("/cell/{robot}.wsl")),
+            line: 3,
+            col: 5,
+            statement: "move_l p1 speed 1m/s;".into(),
+        };
+        let motions = vec![motion("r1", true), motion("r2", false)];
+        let mut start = ev(
+            1_500_000_000,
+            None,
+            Kind::CollisionStart,
+            Data::Collision {
+                a: "r1.link_6".into(),
+                b: "r2.link_6".into(),
+                contact: Some((0.0004, [0.5, 0.0, 0.25])),
+                motions: motions.clone(),
+            },
+        );
+        start.details = start.data.text();
+        let mut near = ev(
+            1_400_000_000,
+            None,
+            Kind::Warning,
+            Data::Issue {
+                kind: "near_miss".into(),
+                message: "near miss: r1.link_6 and r2.link_6 come within 2.00 mm".into(),
+                distance_m: Some(0.002),
+                motions: motions.clone(),
+            },
+        );
+        near.details = near.data.text();
+        let mut moving = ev(
+            0,
+            Some("r1"),
+            Kind::MotionStart,
+            Data::Motion {
+                command: "move_l".into(),
+                duration_ns: 1_300_000_000,
+                zone_m: None,
+                blend_m: None,
+            },
+        );
+        moving.details = moving.data.text();
+        let log = LogContents {
+            events: vec![moving, near, start],
+            ..LogContents::default()
+        };
+        let r = Report::from_log(&log);
+        assert_eq!(r.collisions[0].motions, motions);
+        assert_eq!(
+            r.collisions[0].details,
+            "depth=0.4mm point=(0.5000, 0.0000, 0.2500)"
+        );
+        assert_eq!(r.issues[0].motions, motions);
+        let page = html(&r, &log.events, "t.mcap");
+        let moving_row = "r1 moving: r1.wsl:3:5 move_l p1 speed 1m/s;";
+        let standing_row = "r2 standing after: r2.wsl:3:5 move_l p1 speed 1m/s;";
+        let collisions = &page[page.find("id=\"collisions\"").unwrap()..];
+        assert!(collisions.contains(&format!("{moving_row}<br>{standing_row}")));
+        let issues = &page[page.find("id=\"issues\"").unwrap()..];
+        assert!(issues.contains(&format!("2.00 mm<br>{moving_row}")));
+        assert!(page.contains("<td>move_l duration=1.3 s</td>"), "{page}");
+        assert!(!page.contains("1300000000"));
+    }
+
     /// Times by hand from docs/engine.md: a moves 0–5, waits 5–8, fires a handler at 9
     /// (no time) and ends at 10; b sends a signal at 7 and waits from 7 to the end at 12;
     /// idle is the rest of the 12 ns run.
@@ -673,6 +814,7 @@ mod tests {
             a: "a.link_1".into(),
             b: "b.link_2".into(),
             contact,
+            motions: Vec::new(),
         };
         let mut signal = ev(7, Some("b"), Kind::Signal, Data::None);
         signal.details = "a.go".into();
@@ -697,6 +839,7 @@ mod tests {
                         kind: "near_miss".into(),
                         message: "near miss: x and y come within 1mm".into(),
                         distance_m: Some(1e-3),
+                        motions: Vec::new(),
                     },
                 ),
             ],
@@ -722,7 +865,7 @@ mod tests {
             r.collisions[0].start_ns..r.collisions[0].end_ns.unwrap(),
             8..9
         );
-        assert_eq!(r.issues[0].3, "near miss: x and y come within 1mm");
+        assert_eq!(r.issues[0].message, "near miss: x and y come within 1mm");
         let page = html(&r, &log.events, "x.mcap");
         assert!(page.contains("<svg id=\"gantt\""));
         assert!(page.contains("class=\"collision\""));

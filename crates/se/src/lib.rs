@@ -7,7 +7,8 @@
 //!   [`engine::Simulation`].
 //! - [`world`]: the robots' joints and link frames and the parts' poses at a boundary.
 //! - [`collide`]: collision checks at cycle boundaries and the sweep between them (parry3d).
-//! - [`trace`]: the typed event vocabulary every consumer of a run shares.
+//! - [`trace`]: the typed event vocabulary every consumer of a run shares; [`place`]: where
+//!   in the programs something happened (the motions in a collision, the lines logged).
 //! - [`stats`]: time per robot, one fold over those events; [`result`]: what a run
 //!   produced, and its JSON form.
 //! - [`sink`]: consumers attached to a run; [`mcaplog`], the MCAP log, is one.
@@ -21,6 +22,7 @@
 pub mod collide;
 pub mod engine;
 pub mod mcaplog;
+pub mod place;
 pub mod result;
 pub mod sink;
 pub mod stats;

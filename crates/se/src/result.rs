@@ -7,6 +7,7 @@ use std::collections::BTreeMap;
 use serde_json::{Value as Json, json};
 
 use crate::collide::Contact;
+use crate::place::{LogLine, RobotMotion};
 use crate::stats::RobotStats;
 use crate::trace::{Issue, TraceEvent, Value};
 
@@ -62,6 +63,8 @@ pub struct RunResult {
     pub global_values: Vec<(String, Value)>,
     /// The event trace.
     pub trace: Vec<TraceEvent>,
+    /// The lines the programs logged, in order (also in the trace, as `log` events).
+    pub logs: Vec<LogLine>,
     /// Cycle boundaries passed and collision queries made.
     pub cycles: u64,
     /// Narrow-phase queries made.
@@ -73,8 +76,8 @@ pub struct RunResult {
 }
 
 impl Issue {
-    /// As JSON: `kind`, `message`, `robot`, `file`, `line`, `col`, and `distance_m` for a
-    /// near miss.
+    /// As JSON: `kind`, `message`, `robot`, `file`, `line`, `col`, and for a near miss
+    /// `distance_m` and `motions` (each robot in the pair and its motion).
     pub fn to_json(&self) -> Json {
         let mut v = issue_json(
             &self.kind,
@@ -86,6 +89,9 @@ impl Issue {
         );
         if let Some(d) = self.distance_m {
             v["distance_m"] = d.into();
+        }
+        if !self.motions.is_empty() {
+            v["motions"] = self.motions.iter().map(RobotMotion::to_json).collect();
         }
         v
     }
@@ -118,9 +124,13 @@ impl RunResult {
                 // simulated time, so it is 0 by definition (docs/engine.md).
                 "handler_ns": 0, "motions": s.motions, "end_time_ns": s.end_time_ns, "ended": s.ended.name(),
             })).collect::<Vec<_>>(),
-            "collisions": self.collisions.iter().map(|c| json!({"time_ns": c.time_ns, "a": c.a, "b": c.b, "depth_m": c.depth, "point_m": c.point})).collect::<Vec<_>>(),
+            "collisions": self.collisions.iter().map(|c| json!({
+                "time_ns": c.time_ns, "a": c.a, "b": c.b, "depth_m": c.depth, "point_m": c.point,
+                "motions": c.motions.iter().map(RobotMotion::to_json).collect::<Vec<_>>(),
+            })).collect::<Vec<_>>(),
             "warnings": self.warnings.iter().map(Issue::to_json).collect::<Vec<_>>(),
             "errors": self.errors.iter().map(Issue::to_json).collect::<Vec<_>>(),
+            "logs": self.logs.iter().map(LogLine::to_json).collect::<Vec<_>>(),
             "globals": self.global_values.iter().map(|(k, v)| (k.clone(), v.to_json())).collect::<serde_json::Map<_, _>>(),
             "cycles": self.cycles,
             "collision_queries": self.queries,

@@ -12,8 +12,6 @@
 //! log events`) is rendered from these types ([`TraceEvent::line`], [`Event::line`]); no
 //! consumer parses it back.
 
-use std::path::Path;
-
 use serde_json::{Value as Json, json};
 use vworks_cell::Cell;
 /// Names from a workcell or a log as a terminal may print them (control characters
@@ -26,6 +24,42 @@ use vworks_vm::types::fmt_quantity;
 use vworks_vm::{Dim, Type};
 
 use crate::collide::Contact;
+use crate::place::file_name;
+pub use crate::place::{LogLine, RobotMotion, statement_at};
+
+/// How a trace line writes times: integer nanoseconds (the contract's format: golden files,
+/// `vworks log events`, `run --trace-ns`) or seconds for people (`run --trace`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum Times {
+    /// `7220474304 r1 set …`, `duration=1300000000`.
+    #[default]
+    Nanoseconds,
+    /// `7.220474304 s r1 set …`, `duration=1.3 s`: exact, trailing zeros dropped.
+    Seconds,
+}
+
+impl Times {
+    /// A time (or duration) in ns written in this style.
+    pub fn write(self, ns: i64) -> String {
+        match self {
+            Times::Nanoseconds => ns.to_string(),
+            Times::Seconds => seconds(ns),
+        }
+    }
+}
+
+/// `ns` as exact seconds for people: `7.220474304 s`, `1.3 s`, `0 s`, `-0.5 s`.
+pub fn seconds(ns: i64) -> String {
+    let sign = if ns < 0 { "-" } else { "" };
+    let a = ns.unsigned_abs();
+    let (whole, frac) = (a / 1_000_000_000, a % 1_000_000_000);
+    if frac == 0 {
+        return format!("{sign}{whole} s");
+    }
+    let digits = format!("{frac:09}");
+    format!("{sign}{whole}.{} s", digits.trim_end_matches('0'))
+}
 
 /// What an event is: its kind, as trace lines and the log name it ([`Kind::name`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -261,6 +295,10 @@ pub struct Issue {
     pub col: u32,
     /// For a near miss, how close the bodies came (m), exactly; the message rounds it.
     pub distance_m: Option<f64>,
+    /// For a near miss, each robot whose body is in the pair and the motion it was
+    /// making (the first moving one's, else the first one's, is also `robot`, `file`,
+    /// `line`, `col`).
+    pub motions: Vec<RobotMotion>,
 }
 
 /// One event as the engine records it. Recording one allocates nothing for a VM event:
@@ -425,6 +463,8 @@ pub enum Data {
         b: String,
         /// For a start: penetration depth (m) and a contact point in the cell (m).
         contact: Option<(f64, [f64; 3])>,
+        /// For a start: each robot whose body is in the pair, and the motion it was making.
+        motions: Vec<RobotMotion>,
     },
     /// `warning` / `error`: its kind (`race`, `near_miss`, `runtime`, `deadlock`, a
     /// compiler code), message, and for a near miss the distance (m).
@@ -435,6 +475,8 @@ pub enum Data {
         message: String,
         /// For a near miss, how close the bodies came (m).
         distance_m: Option<f64>,
+        /// For a near miss, each robot whose body is in the pair, and its motion.
+        motions: Vec<RobotMotion>,
     },
 }
 
@@ -459,13 +501,6 @@ pub struct Event {
     pub col: u32,
 }
 
-/// `path`'s file name (the whole text if it has none).
-fn file_name(path: &str) -> String {
-    Path::new(path)
-        .file_name()
-        .map_or(path.to_string(), |n| n.to_string_lossy().into_owned())
-}
-
 impl Event {
     /// `file:line:col` with the file's name only, if the event has a source position.
     pub fn position(&self) -> Option<String> {
@@ -477,18 +512,44 @@ impl Event {
     /// and the file's name only: the golden traces' format. Control characters (in a name
     /// from the log) are escaped as in log texts.
     pub fn line(&self) -> String {
-        let details = if self.details.is_empty() {
-            "-"
-        } else {
-            &self.details
-        };
+        self.line_as(Times::Nanoseconds)
+    }
+
+    /// The trace line with times written as `times` says.
+    pub fn line_as(&self, times: Times) -> String {
+        let details = self.details_as(times);
+        let details = if details.is_empty() { "-" } else { &details };
         let pos = self.position().unwrap_or_else(|| "-".into());
         escape_controls_owned(format!(
             "{} {} {} {details} {pos}",
-            self.time_ns,
+            times.write(self.time_ns),
             self.robot.as_deref().unwrap_or("-"),
             self.kind
         ))
+    }
+
+    /// The details text with durations and deadlines written as `times` says (a set's
+    /// value stays in display units, as recorded).
+    pub fn details_as(&self, times: Times) -> String {
+        match (&self.data, times) {
+            (_, Times::Nanoseconds)
+            | (
+                Data::None
+                | Data::Set { .. }
+                | Data::MotionEnd { .. }
+                | Data::WaitEnd { .. }
+                | Data::Signal { .. }
+                | Data::Part { .. }
+                | Data::Text { .. }
+                | Data::Procedure { .. }
+                | Data::Remote { .. }
+                | Data::Global { .. }
+                | Data::Collision { .. }
+                | Data::Issue { .. },
+                _,
+            ) => self.details.clone(),
+            (data, times) => data.text_as(times),
+        }
     }
 
     /// The event as the JSON object of the log's `/events` topic (schema in
@@ -536,7 +597,13 @@ impl Data {
     /// The details as a trace line shows them (empty for [`Data::None`]). A set's value is
     /// written in SI units here; [`TraceEvent::details`] writes it in display units.
     pub fn text(&self) -> String {
-        let deadline = |d: &Option<i64>| d.map_or(String::new(), |d| format!(" deadline={d}"));
+        self.text_as(Times::Nanoseconds)
+    }
+
+    /// [`Data::text`] with durations and deadlines written as `times` says.
+    pub fn text_as(&self, times: Times) -> String {
+        let deadline =
+            |d: &Option<i64>| d.map_or(String::new(), |d| format!(" deadline={}", times.write(d)));
         match self {
             Data::None => String::new(),
             Data::Motion {
@@ -545,7 +612,7 @@ impl Data {
                 zone_m,
                 blend_m,
             } => {
-                let mut s = format!("{command} duration={duration_ns}");
+                let mut s = format!("{command} duration={}", times.write(*duration_ns));
                 if let Some(z) = zone_m {
                     s += &format!(" zone={}", fmt_quantity(*z, Dim::LENGTH));
                 }
@@ -568,7 +635,7 @@ impl Data {
                     format!("zone={}", fmt_quantity(*zone_m, Dim::LENGTH))
                 }
             }
-            Data::Delay { duration_ns } => format!("duration={duration_ns}"),
+            Data::Delay { duration_ns } => format!("duration={}", times.write(*duration_ns)),
             Data::Set { global, new, .. } => match new {
                 Value::Bool(b) => format!("{global}={b}"),
                 Value::Int(i) => format!("{global}={i}"),
@@ -594,14 +661,22 @@ impl Data {
             Data::Procedure { procedure } => procedure.clone(),
             Data::Global { global } => global.clone(),
             Data::Text { text } => format!("{text:?}"),
-            Data::Issue { message, .. } => format!("{message:?}"),
-            Data::Collision { a, b, contact } => match contact {
+            Data::Issue {
+                message, motions, ..
+            } => format!("{message:?}{}", RobotMotion::trace_suffix(motions)),
+            Data::Collision {
+                a,
+                b,
+                contact,
+                motions,
+            } => match contact {
                 Some((depth, p)) => format!(
-                    "{a} {b} depth={} point=({:.4}, {:.4}, {:.4})",
+                    "{a} {b} depth={} point=({:.4}, {:.4}, {:.4}){}",
                     fmt_quantity(*depth, Dim::LENGTH),
                     p[0],
                     p[1],
-                    p[2]
+                    p[2],
+                    RobotMotion::trace_suffix(motions)
                 ),
                 None => format!("{a} {b}"),
             },
@@ -655,15 +730,35 @@ impl Data {
             Data::Procedure { procedure } => json!({"procedure": procedure}),
             Data::Remote { robot, procedure } => json!({"robot": robot, "procedure": procedure}),
             Data::Global { global } => json!({"global": global}),
-            Data::Collision { a, b, contact } => match contact {
-                Some((depth, point)) => json!({"a": a, "b": b, "depth_m": depth, "point_m": point}),
-                None => json!({"a": a, "b": b}),
-            },
+            Data::Collision {
+                a,
+                b,
+                contact,
+                motions,
+            } => {
+                let mut o = match contact {
+                    Some((depth, point)) => {
+                        json!({"a": a, "b": b, "depth_m": depth, "point_m": point})
+                    }
+                    None => json!({"a": a, "b": b}),
+                };
+                if !motions.is_empty() {
+                    o["motions"] = motions.iter().map(RobotMotion::to_json).collect();
+                }
+                o
+            }
             Data::Issue {
                 kind,
                 message,
                 distance_m,
-            } => json!({"kind": kind, "message": message, "distance_m": distance_m}),
+                motions,
+            } => {
+                let mut o = json!({"kind": kind, "message": message, "distance_m": distance_m});
+                if !motions.is_empty() {
+                    o["motions"] = motions.iter().map(RobotMotion::to_json).collect();
+                }
+                o
+            }
         }
     }
 
@@ -753,11 +848,13 @@ impl Data {
                     }
                     _ => None,
                 },
+                motions: RobotMotion::list_from_json(d.get("motions"))?,
             },
             Kind::Warning | Kind::Error => Data::Issue {
                 kind: s("kind")?,
                 message: s("message")?,
                 distance_m: f("distance_m"),
+                motions: RobotMotion::list_from_json(d.get("motions"))?,
             },
             Kind::MotionEnd | Kind::DelayEnd | Kind::Join | Kind::End => Data::None,
         })
@@ -772,6 +869,22 @@ impl TraceEvent {
         self.robot
             .and_then(|r| cell.robots.get(r))
             .map(|r| r.module.file_of(pos))
+    }
+
+    /// The line logged, if this is a `log` event of a robot's program.
+    pub fn log_line(&self, cell: &Cell) -> Option<LogLine> {
+        let Detail::Vm(EventKind::Log { text }) = &self.detail else {
+            return None;
+        };
+        let robot = cell.robots.get(self.robot?)?;
+        Some(LogLine {
+            time_ns: self.time,
+            robot: robot.name.clone(),
+            text: text.clone(),
+            file: self.file(cell).map(str::to_string),
+            line: self.pos.map_or(0, |p| p.line),
+            col: self.pos.map_or(0, |p| p.col),
+        })
     }
 
     /// The details as trace lines show them (empty when there are none).
@@ -823,16 +936,19 @@ impl TraceEvent {
                 a: c.a.clone(),
                 b: c.b.clone(),
                 contact: Some((c.depth, c.point)),
+                motions: c.motions.clone(),
             },
             (Detail::CollisionEnd(pair), _) => Data::Collision {
                 a: pair.0.clone(),
                 b: pair.1.clone(),
                 contact: None,
+                motions: Vec::new(),
             },
             (Detail::Issue(issue), _) => Data::Issue {
                 kind: issue.kind.clone(),
                 message: issue.message.clone(),
                 distance_m: issue.distance_m,
+                motions: issue.motions.clone(),
             },
         }
     }
@@ -859,11 +975,19 @@ impl TraceEvent {
     /// The trace line: `time_ns robot kind details file:line:col`, `-` for empty fields;
     /// control characters (in the workcell's names) escaped as in log texts.
     pub fn line(&self, cell: &Cell) -> String {
+        self.line_as(cell, Times::Nanoseconds)
+    }
+
+    /// The trace line with times written as `times` says (`run --trace` shows seconds).
+    pub fn line_as(&self, cell: &Cell, times: Times) -> String {
         let robot = self
             .robot
             .and_then(|r| cell.robots.get(r))
             .map_or("-", |r| r.name.as_str());
-        let mut details = self.details(cell);
+        let mut details = match times {
+            Times::Nanoseconds => self.details(cell),
+            _ => self.resolve(cell).details_as(times),
+        };
         if details.is_empty() {
             details.push('-');
         }
@@ -873,7 +997,8 @@ impl TraceEvent {
         };
         escape_controls_owned(format!(
             "{} {robot} {} {details} {pos}",
-            self.time, self.kind
+            times.write(self.time),
+            self.kind
         ))
     }
 }
@@ -952,6 +1077,7 @@ fn vm_data(kind: &EventKind, m: &Module) -> Data {
             kind: "runtime".into(),
             message: message.clone(),
             distance_m: None,
+            motions: Vec::new(),
         },
         EventKind::EnableWhen { handler: h }
         | EventKind::WhenFire { handler: h }
@@ -1059,6 +1185,24 @@ mod tests {
                     a: "r1.link_4".into(),
                     b: "table".into(),
                     contact: Some((0.002, [0.1, -0.2, 0.3])),
+                    motions: vec![
+                        RobotMotion {
+                            robot: "r1".into(),
+                            moving: true,
+                            file: Some("/x/r1.wsl".into()),
+                            line: 7,
+                            col: 9,
+                            statement: "move_l above speed 250mm/s;".into(),
+                        },
+                        RobotMotion {
+                            robot: "r2".into(),
+                            moving: false,
+                            file: None,
+                            line: 0,
+                            col: 0,
+                            statement: String::new(),
+                        },
+                    ],
                 },
             ),
             (
@@ -1067,6 +1211,7 @@ mod tests {
                     a: "r1.link_4".into(),
                     b: "table".into(),
                     contact: None,
+                    motions: Vec::new(),
                 },
             ),
             (
@@ -1075,6 +1220,14 @@ mod tests {
                     kind: "near_miss".into(),
                     message: "near miss".into(),
                     distance_m: Some(0.00245),
+                    motions: vec![RobotMotion {
+                        robot: "r2".into(),
+                        moving: false,
+                        file: Some("r2.mod".into()),
+                        line: 12,
+                        col: 5,
+                        statement: "MoveL p20, v500, fine, tool0;".into(),
+                    }],
                 },
             ),
             (Kind::End, Data::None),
@@ -1092,6 +1245,51 @@ mod tests {
             };
             assert_eq!(Event::from_json(&e.to_json()), Ok(e.clone()), "{kind}");
         }
+    }
+
+    /// Seconds by hand: exact to the nanosecond, trailing zeros dropped.
+    #[test]
+    fn seconds_are_exact_and_short() {
+        assert_eq!(seconds(7_220_474_304), "7.220474304 s");
+        assert_eq!(seconds(1_300_000_000), "1.3 s");
+        assert_eq!(seconds(0), "0 s");
+        assert_eq!(seconds(10_000_000), "0.01 s");
+        assert_eq!(seconds(1), "0.000000001 s");
+        assert_eq!(seconds(-500_000_000), "-0.5 s");
+        assert_eq!(seconds(i64::MIN), "-9223372036.854775808 s");
+        let motion = Data::Motion {
+            command: "move_l".into(),
+            duration_ns: 1_300_000_000,
+            zone_m: None,
+            blend_m: None,
+        };
+        assert_eq!(motion.text(), "move_l duration=1300000000");
+        assert_eq!(motion.text_as(Times::Seconds), "move_l duration=1.3 s");
+        let wait = Data::WaitSignal {
+            signal: "go".into(),
+            deadline_ns: Some(2_500_000_000),
+        };
+        assert_eq!(wait.text_as(Times::Seconds), "signal=go deadline=2.5 s");
+        let e = Event {
+            time_ns: 7_220_474_304,
+            robot: Some("r1".into()),
+            kind: Kind::Delay,
+            details: "duration=1300000000".into(),
+            data: Data::Delay {
+                duration_ns: 1_300_000_000,
+            },
+            file: Some("/x/r1.wsl".into()),
+            line: 3,
+            col: 5,
+        };
+        assert_eq!(
+            e.line(),
+            "7220474304 r1 delay duration=1300000000 r1.wsl:3:5"
+        );
+        assert_eq!(
+            e.line_as(Times::Seconds),
+            "7.220474304 s r1 delay duration=1.3 s r1.wsl:3:5"
+        );
     }
 
     #[test]

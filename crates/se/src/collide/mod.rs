@@ -54,6 +54,9 @@ pub struct Contact {
     pub depth: f64,
     /// A contact point in the cell frame (m).
     pub point: [f64; 3],
+    /// Each robot whose body is in the pair and the motion it was making (filled in by
+    /// the engine, which knows the programs; the collider leaves it empty).
+    pub motions: Vec<crate::place::RobotMotion>,
 }
 
 /// What a boundary check found.
@@ -658,6 +661,7 @@ impl Collider {
                                 b: b.name.clone(),
                                 depth: -dist,
                                 point,
+                                motions: Vec::new(),
                             },
                         ));
                     }
@@ -812,6 +816,18 @@ impl Collider {
     fn static_pair(&self, (i, j): (usize, usize)) -> bool {
         let moves = |o: Owner| matches!(o, Owner::Link { .. }) || self.is_held(o);
         !moves(self.bodies[i].owner) && !moves(self.bodies[j].owner)
+    }
+
+    /// The robot that moves the body named `name`: a link's robot, or the robot holding a
+    /// part; `None` for a device or a part lying still. (A scan of the bodies: for
+    /// collisions and near misses as they start, not per cycle.)
+    pub fn robot_moving(&self, name: &str) -> Option<usize> {
+        let body = self.bodies.iter().find(|b| b.name == name)?;
+        match body.owner {
+            Owner::Link { robot, .. } => Some(robot),
+            Owner::Part(p) => self.world.held[p].map(|(r, _)| r),
+            Owner::Device => None,
+        }
     }
 
     fn is_held(&self, o: Owner) -> bool {

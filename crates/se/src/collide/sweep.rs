@@ -319,6 +319,7 @@ impl Collider {
                     b: self.bodies[second].name.clone(),
                     depth: -d,
                     point: p,
+                    motions: Vec::new(),
                 });
             }
             // Safe for `safe / speed` seconds; at least the minimum step.

@@ -26,6 +26,7 @@ use vworks_vm::machine::{Event, EventKind, Next, Vm, VmConfig};
 use vworks_vm::types::fmt_quantity;
 
 use crate::collide::{Collider, Contact};
+use crate::place::RobotMotion;
 pub use crate::result::{Outcome, RunResult};
 use crate::sink::{RunEnd, RunSink};
 use crate::stats::Fold;
@@ -100,6 +101,8 @@ pub struct Simulation {
     log_error: Option<String>,
     /// Whether each robot moves at the boundary being processed (reused).
     moving: Vec<bool>,
+    /// Each robot's last `motion_start`: the statement a collision or near miss names.
+    last_motion: Vec<Option<SrcPos>>,
     /// Whether every robot has been queued (the first step does it).
     started: bool,
     /// Time up to which contacts between boundaries have been swept for.
@@ -213,6 +216,7 @@ impl Simulation {
                 line: d.at.line,
                 col: d.at.col,
                 distance_m: None,
+                motions: Vec::new(),
             })
             .collect();
         Simulation {
@@ -246,6 +250,7 @@ impl Simulation {
             sinks: Vec::new(),
             log_error: None,
             moving: Vec::with_capacity(cell.robots.len()),
+            last_motion: vec![None; n],
             started: false,
             swept: 0,
             sweep: true,
@@ -520,7 +525,40 @@ impl Simulation {
             line: pos.map_or(0, |p| p.line),
             col: pos.map_or(0, |p| p.col),
             distance_m: None,
+            motions: Vec::new(),
         }
+    }
+
+    /// The robots that move bodies `a` and `b` (each once, in that order), and the motion
+    /// each was making at `t`, or last made.
+    fn motions_of(&self, a: &str, b: &str, t: i64) -> Vec<RobotMotion> {
+        let ra = self.collider.robot_moving(a);
+        let rb = self.collider.robot_moving(b).filter(|r| Some(*r) != ra);
+        [ra, rb]
+            .into_iter()
+            .flatten()
+            .map(|r| {
+                let robot = self.cell.robots[r].name.clone();
+                match self.last_motion[r] {
+                    Some(pos) => RobotMotion {
+                        robot,
+                        moving: self.vms[r].moving_at(t),
+                        file: Some(self.cell.robots[r].module.file_of(pos).to_string()),
+                        line: pos.line,
+                        col: pos.col,
+                        statement: crate::place::statement_at(&self.cell, r, pos),
+                    },
+                    None => RobotMotion {
+                        robot,
+                        moving: false,
+                        file: None,
+                        line: 0,
+                        col: 0,
+                        statement: String::new(),
+                    },
+                }
+            })
+            .collect()
     }
 
     /// Runs to the end (or to `until` ns).
@@ -651,8 +689,9 @@ impl Simulation {
     }
 
     /// Records a collision that started; true if the run stops on it.
-    fn collision_started(&mut self, contact: Contact) -> bool {
+    fn collision_started(&mut self, mut contact: Contact) -> bool {
         let t = contact.time_ns;
+        contact.motions = self.motions_of(&contact.a, &contact.b, t);
         let detail = Detail::Collision(Box::new(contact.clone()));
         self.record(t, None, Kind::CollisionStart, detail, None);
         self.collisions.push(contact);
@@ -730,6 +769,15 @@ impl Simulation {
                         );
                         let mut issue = self.issue("near_miss", m, None, None);
                         issue.distance_m = Some(dist);
+                        issue.motions = self.motions_of(&a, &bname, b);
+                        // The warning's own place: the first robot moving (else the
+                        // first robot's last motion).
+                        let main = issue.motions.iter().find(|m| m.moving);
+                        if let Some(first) = main.or(issue.motions.first()) {
+                            issue.robot = Some(first.robot.clone());
+                            issue.file.clone_from(&first.file);
+                            (issue.line, issue.col) = (first.line, first.col);
+                        }
                         self.add_issue(b, None, None, Kind::Warning, issue);
                     }
                 }
@@ -780,6 +828,7 @@ impl Simulation {
             self.fold.event(e.time, Some(r), kind);
         }
         if let EventKind::MotionStart { .. } = e.kind {
+            self.last_motion[r] = Some(e.pos);
             // Speed bounds behind skipped collision queries change with the motion.
             self.collider.motion_started(r);
         }
@@ -992,6 +1041,11 @@ impl Simulation {
             errors: self.errors,
             global_values,
             globals,
+            logs: self
+                .trace
+                .iter()
+                .filter_map(|e| e.log_line(&self.cell))
+                .collect(),
             trace: self.trace,
             cycles: self.cycles,
             queries: self.collider.queries,

@@ -425,9 +425,15 @@ impl McapLog {
         };
         if let Some(level) = level {
             let message = match &ev.data {
-                Data::Text { text } => text.as_str(),
-                Data::Issue { message, .. } => message.as_str(),
-                _ => ev.details.as_str(),
+                Data::Text { text } => text.clone(),
+                // A near miss names each robot's motion, a line each.
+                Data::Issue {
+                    message, motions, ..
+                } => std::iter::once(message.clone())
+                    .chain(motions.iter().map(|m| m.describe()))
+                    .collect::<Vec<_>>()
+                    .join("\n"),
+                _ => ev.details.clone(),
             };
             let v = serde_json::json!({"timestamp": scene::ts(e.time), "level": level, "message": message, "name": ev.robot.as_deref().unwrap_or("cell"), "file": ev.file.as_deref().unwrap_or_default(), "line": ev.line});
             self.write(LOG, e.time, &v)?;
