@@ -1,14 +1,17 @@
 //! `vworks`, the command-line front end.
 //!
 //! - `vworks check FILE…`: compile each program and print every diagnostic; exit 1 on any
-//!   error.
+//!   error. Given a workcell (`cell.toml`, or a folder holding one), check the whole cell
+//!   without running it (module `check`).
 //! - `vworks build FILE [-o OUT.wslb]`: compile one program to bytecode.
 //! - `vworks disasm FILE.wslb|FILE.wsl`: list the bytecode with the source beside it.
 //!
-//! - `vworks run CELL [--log run.mcap]`: simulate a workcell and print the summary.
+//! - `vworks run CELL [--log run.mcap]`: simulate a workcell (a `cell.toml`, or a folder
+//!   holding one) and print the summary.
 //! - `vworks log info|events FILE.mcap`: read a run's log.
 //! - `vworks report FILE.mcap [-o report.html]`: the run's HTML report.
-//! - `vworks new NAME`: a new workcell folder, ready to run.
+//! - `vworks new NAME [--model M]`: a new workcell folder, ready to run.
+//! - `vworks sweep SWEEP.toml`: run the variants of a workcell (module `sweep`).
 //! - `vworks completions SHELL`: a shell completion script.
 
 use std::io::IsTerminal;
@@ -17,6 +20,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+mod check;
 mod sweep;
 use vworks_se::result::issue_json as json_issue;
 use vworks_vm::Module;
@@ -39,15 +43,21 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Compile programs and report every problem found (exit 1 if any is an error).
+    /// Compile programs, or check a whole workcell without running it, and report every
+    /// problem found (exit 1 if any is an error).
     Check {
-        /// The program files (.wsl, or RAPID .mod/.modx/.sys/.prg).
+        /// The program files (.wsl, or RAPID .mod/.modx/.sys/.prg), or workcells (a
+        /// cell.toml, or a folder holding one): its models, programs, homes, constant
+        /// targets and the bodies at the start are checked.
         #[arg(required = true)]
         files: Vec<PathBuf>,
         /// Check the files as one robot's program (a RAPID task's modules, a WSL program
         /// and its library files) instead of each on its own.
         #[arg(long)]
         task: bool,
+        /// For a workcell: print the problems as one JSON object.
+        #[arg(long)]
+        json: bool,
     },
     /// Compile one program (one file, or the files of one robot task) to a bytecode file.
     Build {
@@ -66,7 +76,7 @@ enum Command {
     },
     /// Simulate a workcell and print a summary (exit 1 on collision stop, deadlock or error).
     Run {
-        /// The workcell file (cell.toml).
+        /// The workcell file (cell.toml), or a folder holding one.
         cell: PathBuf,
         /// Stop at this simulated time ("10s", "250ms", or seconds).
         #[arg(long, allow_hyphen_values = true)]
@@ -122,6 +132,9 @@ enum Command {
     New {
         /// The folder to create (its name becomes the cell's name).
         name: PathBuf,
+        /// The robot's model: a built-in arm (irb120, kr6r900, lrmate200id, ur5).
+        #[arg(long, default_value = "irb120")]
+        model: String,
     },
     /// Print a shell completion script (e.g. `vworks completions bash > ~/.local/share/bash-completion/completions/vworks`).
     Completions {
@@ -182,7 +195,7 @@ macro_rules! out {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = Cli::try_parse().unwrap_or_else(|e| with_suggestion(e).exit());
     let color =
         !cli.no_color && std::env::var_os("NO_COLOR").is_none() && std::io::stderr().is_terminal();
     match run(cli.command, color) {
@@ -192,6 +205,89 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// clap's error for an unknown subcommand, with the nearest subcommand suggested where
+/// clap's own similarity finds none (`vworks rn`: `run`).
+fn with_suggestion(mut e: clap::Error) -> clap::Error {
+    use clap::error::{ContextKind, ContextValue, ErrorKind};
+    if e.kind() != ErrorKind::InvalidSubcommand || e.get(ContextKind::SuggestedSubcommand).is_some()
+    {
+        return e;
+    }
+    let Some(ContextValue::String(typed)) = e.get(ContextKind::InvalidSubcommand) else {
+        return e;
+    };
+    use clap::CommandFactory as _;
+    let cmd = Cli::command();
+    let names = cmd.get_subcommands().map(|c| c.get_name());
+    if let Some(near) = vworks_wslc::nearest(&typed.to_ascii_lowercase(), names) {
+        let near = near.to_string();
+        e.insert(
+            ContextKind::SuggestedSubcommand,
+            ContextValue::Strings(vec![near]),
+        );
+    }
+    e
+}
+
+/// The workcell file that `command` was given as `path`: the path itself, or the
+/// `cell.toml` of a folder. A program file, or a folder without a `cell.toml`, is an
+/// error saying what to give instead.
+fn cell_file(path: &Path, command: &str) -> Result<PathBuf, String> {
+    if path.is_dir() {
+        let file = path.join("cell.toml");
+        if file.is_file() {
+            return Ok(file);
+        }
+        let mut tomls: Vec<String> = std::fs::read_dir(path)
+            .map(|entries| {
+                entries
+                    .filter_map(Result::ok)
+                    .map(|e| e.file_name().to_string_lossy().into_owned())
+                    .filter(|n| n.ends_with(".toml"))
+                    .collect()
+            })
+            .unwrap_or_default();
+        tomls.sort();
+        let there = if tomls.is_empty() {
+            "; `vworks new NAME` creates a workcell folder".to_string()
+        } else {
+            let named: Vec<String> = tomls
+                .iter()
+                .map(|n| format!("`{}`", path.join(n).display()))
+                .collect();
+            format!("; name the workcell file: {}", named.join(", "))
+        };
+        return Err(format!(
+            "`{}` is a folder without a cell.toml: `vworks {command}` takes a workcell file{there}",
+            path.display()
+        ));
+    }
+    if check::is_program(path) {
+        let name = path
+            .file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+        let cell = path
+            .parent()
+            .map_or_else(|| PathBuf::from("cell.toml"), |d| d.join("cell.toml"));
+        let what = format!(
+            "`{}` is a program, but `vworks {command}` takes a workcell: a cell.toml naming the robots, their models and their programs",
+            path.display()
+        );
+        if cell.is_file() {
+            return Err(format!(
+                "{what}; the one beside it: `vworks {command} {}`",
+                cell.display()
+            ));
+        }
+        return Err(format!(
+            "{what}. Write one beside the program:\n\n    [[robot]]\n    name = \"r1\"\n    model = \"irb120\"\n    program = \"{name}\"\n\nthen `vworks {command} {}`; or `vworks new NAME` creates a workcell folder ready to run (`vworks check {}` compiles the program alone)",
+            cell.display(),
+            path.display()
+        ));
+    }
+    Ok(path.to_path_buf())
 }
 
 /// A file named on the command line: a regular file within the size limit
@@ -352,9 +448,9 @@ clearance = "5mm"      # closer than this is a near-miss warning
 
 [[robot]]
 name = "r1"
-model = "irb120"       # built in: irb120, kr6r900, lrmate200id, ur5, turntable, track
+model = "{model}"{pad} # built in: irb120, kr6r900, lrmate200id, ur5, turntable, track
 program = "r1.wsl"
-home = ["0deg", "-30deg", "30deg", "0deg", "60deg", "0deg"]
+home = {home}
 
 [[device]]
 name = "table"
@@ -380,11 +476,46 @@ proc main() {
     ),
     (
         "README.md",
-        "# {name}\n\nA vworks workcell: `vworks run {name}/cell.toml --log run.mcap`, then `vworks report run.mcap`.\n",
+        "# {name}\n\nA vworks workcell: `vworks check {name}` checks it without running it; `vworks run {name} --log run.mcap` runs it, then `vworks report run.mcap`.\n",
     ),
 ];
 
-fn new_cell(dir: &Path) -> Result<ExitCode, String> {
+/// The arms `vworks new --model` can start a cell with, and a home for each: the tool
+/// pointing down above the table, from where the program's targets are straight-line
+/// moves within reach and the joint limits (`cli.rs` runs the new cell of each).
+const NEW_ARMS: &[(&str, &str)] = &[
+    (
+        "irb120",
+        r#"["0deg", "-30deg", "30deg", "0deg", "60deg", "0deg"]"#,
+    ),
+    (
+        "kr6r900",
+        r#"["0deg", "-75deg", "140deg", "0deg", "25deg", "0deg"]"#,
+    ),
+    (
+        "lrmate200id",
+        r#"["0deg", "0deg", "-35deg", "0deg", "-55deg", "0deg"]"#,
+    ),
+    (
+        "ur5",
+        r#"["0deg", "-95deg", "-90deg", "95deg", "-90deg", "90deg"]"#,
+    ),
+];
+
+fn new_cell(dir: &Path, model: &str) -> Result<ExitCode, String> {
+    let arms: Vec<&str> = NEW_ARMS.iter().map(|(m, _)| *m).collect();
+    let Some((model, home)) = NEW_ARMS.iter().find(|(m, _)| *m == model) else {
+        let what = if vworks_model::builtin::names().contains(&model) {
+            format!("`{model}` is not an arm (a new cell's program moves a tool over a table)")
+        } else {
+            format!("`{model}` is not a built-in model")
+        };
+        return Err(format!(
+            "--model {}: {what}; choose one of the arms {} (a URDF robot: write its `urdf` in cell.toml after `vworks new`)",
+            vworks_model::text::escape_controls(model),
+            arms.join(", ")
+        ));
+    };
     let name = dir
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
@@ -405,13 +536,18 @@ fn new_cell(dir: &Path) -> Result<ExitCode, String> {
         .map_err(|e| format!("cannot create the folder `{}`: {e}", dir.display()))?;
     for (file, text) in NEW_CELL {
         let path = dir.join(file);
-        std::fs::write(&path, text.replace("{name}", &name))
+        let text = text
+            .replace("{name}", &name)
+            .replace("{model}", model)
+            .replace("{pad}", &" ".repeat(12usize.saturating_sub(model.len())))
+            .replace("{home}", home);
+        std::fs::write(&path, text)
             .map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
     }
     eprintln!(
-        "created {}: cell.toml (one irb120 and a table), r1.wsl, README.md\nrun it: vworks run {}",
+        "created {}: cell.toml (one {model} and a table), r1.wsl, README.md\nrun it: vworks run {}",
         dir.display(),
-        dir.join("cell.toml").display()
+        dir.display()
     );
     Ok(ExitCode::SUCCESS)
 }
@@ -427,11 +563,11 @@ fn write_report(log: &Path, output: Option<PathBuf>) -> Result<ExitCode, String>
 fn report_to(log: &Path, out: &Path) -> Result<(vworks_report::Written, ExitCode), String> {
     let written = vworks_report::write_report(log, out).map_err(|e| e.to_string())?;
     eprintln!(
-        "wrote {} ({} robots, {} events, {} collisions{})",
+        "wrote {} ({}, {}, {}{})",
         out.display(),
-        written.report.timelines.len(),
-        written.events,
-        written.report.collisions.len(),
+        plural(written.report.timelines.len(), "robot"),
+        plural(written.events, "event"),
+        plural(written.report.collisions.len(), "collision"),
         if written.has_view {
             ""
         } else {
@@ -910,7 +1046,15 @@ fn plural(n: usize, word: &str) -> String {
 
 fn run(cmd: Command, color: bool) -> Result<ExitCode, String> {
     match cmd {
-        Command::Check { files, task } => {
+        Command::Check { files, task, json } => {
+            if files.iter().any(|f| check::is_cell(f)) {
+                return check::check_cells(&files, task, json, color);
+            }
+            if json {
+                return Err(
+                    "--json is for a workcell (`vworks check CELL --json`); programs are checked without it".into(),
+                );
+            }
             let (mut errors, mut warnings) = (0, 0);
             let programs: Vec<&[PathBuf]> = if task {
                 vec![&files]
@@ -963,7 +1107,17 @@ fn run(cmd: Command, color: bool) -> Result<ExitCode, String> {
             quiet,
             set,
         } => run_cell(
-            &cell,
+            &match cell_file(&cell, "run") {
+                Ok(c) => c,
+                Err(m) => {
+                    if json {
+                        let issue = json_issue("usage", &m, None, Some(&display(&cell)), 0, 0);
+                        let v = serde_json::json!({"outcome": "error", "errors": [issue]});
+                        out!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+                    }
+                    return Err(m);
+                }
+            },
             RunOptions {
                 set: &set,
                 until: until.as_deref(),
@@ -984,7 +1138,7 @@ fn run(cmd: Command, color: bool) -> Result<ExitCode, String> {
         Command::Report { log, output } => write_report(&log, output),
         Command::View { log } => view(&log),
         Command::Sweep(args) => sweep::sweep(args),
-        Command::New { name } => new_cell(&name),
+        Command::New { name, model } => new_cell(&name, &model),
         Command::Completions { shell } => {
             use clap::CommandFactory as _;
             let mut cmd = Cli::command();

@@ -22,7 +22,8 @@ use vworks_sweep::{Row, Sweep, run_streamed};
 /// What `vworks sweep` was asked.
 #[derive(clap::Args, Debug)]
 pub(crate) struct Args {
-    /// The sweep file (sweep.toml; see docs/sweep.md), or with --variables the workcell.
+    /// The sweep file (sweep.toml; see docs/sweep.md), or with --variables the workcell
+    /// (a cell.toml, or a folder holding one).
     pub(crate) file: PathBuf,
     /// Threads (default: one per core).
     #[arg(short, long, default_value_t = 0)]
@@ -107,7 +108,7 @@ impl Tally {
 
 pub(crate) fn sweep(a: Args) -> Result<ExitCode, String> {
     if a.variables {
-        return list_variables(&a.file);
+        return list_variables(&crate::cell_file(&a.file, "sweep --variables")?);
     }
     // Everything is checked before the first variant runs.
     let sweep = Sweep::read(&a.file, &Disk).map_err(|e| e.to_string())?;

@@ -1,0 +1,702 @@
+//! `vworks check CELL`: a whole workcell checked without running it.
+//!
+//! The workcell is loaded as `vworks run` loads it (`vworks_cell::load`: every key, the
+//! models, the homes within the joint limits, the programs compiled and linked), and then
+//! what a run would only find later but can be known exactly beforehand:
+//!
+//! - each `move_j`/`move_l`/`move_c` whose target is a constant (`pose(…)`, `joints(…)`,
+//!   a `const`, or an expression of constants the compiler folded): a `move_j` to joints
+//!   outside an axis's limits, and a pose target that no configuration of the arm reaches
+//!   within its limits (arms with an analytic solver: every solution is known), with the
+//!   robot's workcell tool (a program that changes its tool in a motion is not checked);
+//! - the bodies at the start: every robot at its home against the other robots, devices
+//!   and parts, as the run's first collision check sees them (the same pairs skipped and
+//!   allowed): a collision at 0 s is an error, a near miss within the clearance a warning.
+//!   A robot touching a part its program grips is left to the run (the grip may come first).
+//!
+//! Every problem names its file and line (the workcell key's line, the statement's line),
+//! what is wrong and what to do. The loader stops at the first workcell problem; the
+//! programs' diagnostics are all reported.
+
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::Arc;
+
+use vworks_cell::{Cell, CellError};
+use vworks_model::math::Iso;
+use vworks_se::collide::{Collider, CollisionEvent};
+use vworks_se::result::issue_json;
+use vworks_vm::bytecode::{MoveFlags, ProcInfo};
+use vworks_vm::machine::{Vm, VmConfig};
+use vworks_vm::{ConstValue, Instr, Module};
+
+/// True for a program file (by its extension): WSL, RAPID, or bytecode.
+pub(crate) fn is_program(path: &Path) -> bool {
+    let text = path.to_string_lossy();
+    let ext = path.extension().map(|e| e.to_string_lossy().to_lowercase());
+    matches!(ext.as_deref(), Some("wsl" | "wslb")) || vworks_wslc::rapid::is_rapid_path(&text)
+}
+
+/// True for what `check` takes as a workcell: a `.toml` file, or a folder.
+pub(crate) fn is_cell(path: &Path) -> bool {
+    path.is_dir()
+        || path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
+}
+
+/// One problem found, at a place in a file (line 0: the file as a whole).
+struct Problem {
+    error: bool,
+    /// What kind: `workcell`, `reach`, `limits`, `collision`, `clearance`.
+    kind: &'static str,
+    robot: Option<String>,
+    file: String,
+    line: u32,
+    col: u32,
+    /// Characters to underline from `col` (at least 1).
+    width: usize,
+    message: String,
+}
+
+/// What checking one cell found.
+struct Report {
+    name: String,
+    programs: usize,
+    problems: Vec<Problem>,
+    /// The programs' compile and link diagnostics, rendered with their source lines.
+    rendered: String,
+    /// The same diagnostics, as JSON issues, and their counts.
+    diagnostics: Vec<(bool, serde_json::Value)>,
+    /// The texts of the files the problems name: (path, text).
+    sources: Vec<(String, String)>,
+}
+
+/// `vworks check CELL…`: each workcell checked; exit 1 if any has an error.
+pub(crate) fn check_cells(
+    files: &[PathBuf],
+    task: bool,
+    json: bool,
+    color: bool,
+) -> Result<ExitCode, String> {
+    if task {
+        return Err("--task is for program files; a workcell's `program` says which files make each robot's program: `vworks check CELL`".into());
+    }
+    if let Some(p) = files.iter().find(|f| !is_cell(f)) {
+        return Err(format!(
+            "`{}` is not a workcell: check workcells (cell.toml, or a folder holding one) and program files in separate commands",
+            p.display()
+        ));
+    }
+    let mut failed = false;
+    let mut out = Vec::new();
+    for f in files {
+        let path = crate::cell_file(f, "check")?;
+        let r = check_cell(&path, color);
+        let errors = r.problems.iter().filter(|p| p.error).count()
+            + r.diagnostics.iter().filter(|(e, _)| *e).count();
+        let warnings = r.problems.len() + r.diagnostics.len() - errors;
+        failed |= errors > 0;
+        if json {
+            let issue = |p: &Problem| {
+                let mut v = issue_json(
+                    p.kind,
+                    &p.message,
+                    p.robot.as_deref(),
+                    Some(&p.file),
+                    p.line,
+                    p.col,
+                );
+                v["severity"] = if p.error { "error" } else { "warning" }.into();
+                (p.error, v)
+            };
+            let all: Vec<(bool, serde_json::Value)> = r
+                .diagnostics
+                .iter()
+                .cloned()
+                .chain(r.problems.iter().map(issue))
+                .collect();
+            let pick = |e: bool| -> Vec<serde_json::Value> {
+                all.iter()
+                    .filter(|(x, _)| *x == e)
+                    .map(|(_, v)| v.clone())
+                    .collect()
+            };
+            out.push(serde_json::json!({
+                "cell": r.name,
+                "file": path.display().to_string(),
+                "programs": r.programs,
+                "errors": pick(true),
+                "warnings": pick(false),
+            }));
+            continue;
+        }
+        eprint!("{}", r.rendered);
+        for p in &r.problems {
+            eprint!("{}", render(p, &r.sources, color));
+        }
+        eprintln!(
+            "checked cell {}: {}, {}, {}",
+            vworks_se::trace::escape_controls(&r.name),
+            crate::plural(r.programs, "program"),
+            crate::plural(errors, "error"),
+            crate::plural(warnings, "warning")
+        );
+    }
+    if json {
+        let v = match out.len() {
+            1 => out.swap_remove(0),
+            _ => serde_json::Value::Array(out),
+        };
+        crate::out!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+    }
+    Ok(if failed {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+/// Checks the workcell file `path`.
+fn check_cell(path: &Path, color: bool) -> Report {
+    let file = path.display().to_string();
+    let text = crate::read(path).unwrap_or_default();
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let mut report = Report {
+        name: stem,
+        programs: 0,
+        problems: Vec::new(),
+        rendered: String::new(),
+        diagnostics: Vec::new(),
+        sources: vec![(file.clone(), text.clone())],
+    };
+    let cell = match vworks_cell::load(path) {
+        Ok(cell) => cell,
+        Err(e) => {
+            // What the file says, as far as it parses: the name and the programs.
+            if let Ok(t) = text.parse::<toml::Table>() {
+                if let Some(n) = t.get("name").and_then(|n| n.as_str()) {
+                    report.name = n.to_string();
+                }
+                let mut programs: Vec<String> = t
+                    .get("robot")
+                    .and_then(|r| r.as_array())
+                    .into_iter()
+                    .flatten()
+                    .filter_map(|r| r.get("program").map(|p| p.to_string()))
+                    .collect();
+                programs.sort();
+                programs.dedup();
+                report.programs = programs.len();
+            }
+            workcell_error(e, &file, &text, &mut report);
+            return report;
+        }
+    };
+    report.name = cell.name.clone();
+    let mut programs: Vec<&[String]> = cell.robots.iter().map(|r| &r.module.files[..]).collect();
+    programs.sort();
+    programs.dedup();
+    report.programs = programs.len();
+    report.rendered = cell.render_warnings(color);
+    report.diagnostics = cell
+        .warnings
+        .iter()
+        .map(|d| (false, diagnostic_json(d)))
+        .collect();
+    report.sources = cell.sources.clone();
+    targets(&cell, &mut report.problems);
+    at_the_start(&cell, &text, &mut report.problems);
+    report
+}
+
+fn diagnostic_json(d: &vworks_wslc::Diagnostic) -> serde_json::Value {
+    let mut v = issue_json(
+        d.code.as_str(),
+        &d.message,
+        None,
+        Some(&d.at.file),
+        d.at.line,
+        d.at.col,
+    );
+    v["severity"] = if d.is_error() { "error" } else { "warning" }.into();
+    v
+}
+
+/// A workcell that does not load: the loader's error, placed at its key's line.
+fn workcell_error(e: CellError, file: &str, text: &str, report: &mut Report) {
+    let mut at = |key: Option<&str>, message: String| {
+        let (line, col, width) = key
+            .and_then(|k| locate(text, k))
+            .map_or((0, 0, 1), |r| line_col(text, r));
+        report.problems.push(Problem {
+            error: true,
+            kind: "workcell",
+            robot: None,
+            file: file.to_string(),
+            line,
+            col,
+            width,
+            message,
+        });
+    };
+    match e {
+        CellError::Program {
+            diagnostics,
+            rendered,
+        } => {
+            report.rendered = rendered;
+            report.diagnostics = diagnostics
+                .iter()
+                .map(|d| (d.is_error(), diagnostic_json(d)))
+                .collect();
+        }
+        // A TOML syntax error's key is its place, which the location line shows.
+        CellError::Invalid { key, message, .. } if key.starts_with("line ") => {
+            at(Some(&key), message);
+        }
+        CellError::Invalid { key, message, .. } => {
+            at(Some(&key), format!("{key}: {message}"));
+        }
+        CellError::Model { robot, source, .. } => {
+            let key = robot_key(text, &robot, "urdf");
+            at(key.as_deref(), format!("robot `{robot}`: {source}"));
+        }
+        other => at(None, other.to_string()),
+    }
+}
+
+/// The key of robot `name`'s `field` (`robot[1].urdf`), if the file has that robot.
+fn robot_key(text: &str, name: &str, field: &str) -> Option<String> {
+    let t = text.parse::<toml::Table>().ok()?;
+    let robots = t.get("robot")?.as_array()?;
+    let i = robots
+        .iter()
+        .position(|r| r.get("name").and_then(|n| n.as_str()) == Some(name))?;
+    Some(format!("robot[{i}].{field}"))
+}
+
+/// The constant motion targets of every robot's program, checked against its model.
+fn targets(cell: &Cell, problems: &mut Vec<Problem>) {
+    for r in &cell.robots {
+        let m = &r.module;
+        // A motion may change the tool (`tool` operand): the TCP of later motions is then
+        // only known at run time.
+        let tool_changes = m.code.iter().any(|i| {
+            matches!(i, Instr::MoveJ(f) | Instr::MoveL(f) | Instr::MoveC(f) if f.has(MoveFlags::TOOL))
+        });
+        let n = r.model.dof();
+        for proc in &m.procs {
+            let start = proc.code_start as usize;
+            let end = start + proc.code_len as usize;
+            for pc in start..end.min(m.code.len()) {
+                let (f, joint_move) = match m.code[pc] {
+                    Instr::MoveJ(f) => (f, true),
+                    Instr::MoveL(f) | Instr::MoveC(f) => (f, false),
+                    _ => continue,
+                };
+                let Some(target) = constant_target(m, proc, pc, f) else {
+                    continue;
+                };
+                let pos = m.pos_of(pc as u32);
+                let mut problem = |kind: &'static str, message: String| {
+                    let file = m.file_of(pos).to_string();
+                    let p = Problem {
+                        error: true,
+                        kind,
+                        robot: Some(r.name.clone()),
+                        file,
+                        line: pos.line,
+                        col: pos.col,
+                        width: 1,
+                        message: format!(
+                            "robot `{}` ({}): {message}",
+                            vworks_se::trace::escape_controls(&r.name),
+                            r.model.name
+                        ),
+                    };
+                    // A program shared by robots of one model: said once per robot.
+                    if !problems
+                        .iter()
+                        .any(|q| q.file == p.file && q.line == p.line && q.message == p.message)
+                    {
+                        problems.push(p);
+                    }
+                };
+                match target {
+                    ConstValue::Joints(q) if joint_move => {
+                        for (i, v) in q.iter().enumerate().take(n) {
+                            let j = r.model.axis(i);
+                            if *v < j.lower - 1e-9 || *v > j.upper + 1e-9 {
+                                problem(
+                                    "limits",
+                                    format!(
+                                        "joint limit exceeded: axis {} `{}` would go to {}, outside its range {} to {}; choose a target within the range",
+                                        i + 1,
+                                        j.name,
+                                        j.display(*v),
+                                        j.display(j.lower),
+                                        j.display(j.upper)
+                                    ),
+                                );
+                                break;
+                            }
+                        }
+                    }
+                    ConstValue::Pose(p) if !tool_changes => {
+                        let tcp = Iso::from_xyz_rpy([p[0], p[1], p[2]], [p[3], p[4], p[5]]);
+                        let flange = tcp.mul(&r.tool.inverse());
+                        let mut out = [[0.0; 6]; 8];
+                        if let Some(Err(e)) = r.model.ik_analytic_all(&flange, &r.home, &mut out) {
+                            problem(
+                                "reach",
+                                format!("unreachable pose: {}", e.at_position(tcp.t)),
+                            );
+                        }
+                    }
+                    _ => {}
+                }
+            }
+        }
+    }
+}
+
+/// The target of the motion at `pc` if a constant pushed it (`PushConst` of a pose or
+/// joints, the operands above it pushed by straight-line code: no jump lands between).
+fn constant_target(m: &Module, proc: &ProcInfo, pc: usize, f: MoveFlags) -> Option<ConstValue> {
+    let start = proc.code_start as usize;
+    let effect = m.code[pc].stack_effect(m, proc)?;
+    let width = if f.has(MoveFlags::TARGET_JOINTS) {
+        vworks_vm::MAX_AXES as u32
+    } else {
+        6
+    };
+    let via = match m.code[pc] {
+        Instr::MoveC(_) if f.has(MoveFlags::VIA_JOINTS) => vworks_vm::MAX_AXES as u32,
+        Instr::MoveC(_) => 6,
+        _ => 0,
+    };
+    // Slots above the target's top: the speed, zone, tool … operands.
+    let mut above = effect.pops.checked_sub(width + via)?;
+    let lands = |at: usize| {
+        m.code[start..start + proc.code_len as usize]
+            .iter()
+            .any(|i| i.jump_target().is_some_and(|t| start + t as usize == at))
+    };
+    let mut k = pc;
+    while k > start {
+        if lands(k) {
+            return None;
+        }
+        k -= 1;
+        let ins = m.code[k];
+        if ins.ends_block() || ins.jump_target().is_some() {
+            return None;
+        }
+        let e = ins.stack_effect(m, proc)?;
+        if above < e.pushes {
+            // This instruction pushed the target's top slot: a constant of the target's
+            // width, with nothing of it below, or something only the run knows.
+            return match ins {
+                Instr::PushConst(c) if above == 0 && e.pushes == width => {
+                    let value = m.consts.get(c as usize)?.value.clone();
+                    matches!(value, ConstValue::Pose(_) | ConstValue::Joints(_)).then_some(value)
+                }
+                _ => None,
+            };
+        }
+        above = above - e.pushes + e.pops;
+    }
+    None
+}
+
+/// The bodies at the start (every robot at its home): collisions and near misses, as the
+/// run's first collision check finds them.
+fn at_the_start(cell: &Cell, text: &str, problems: &mut Vec<Problem>) {
+    let vms: Vec<Vm> = cell
+        .robots
+        .iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let cfg = VmConfig {
+                cycle_ns: cell.cycle_ns,
+                default_speed: r.default_speed,
+                default_zone: r.default_zone,
+                tool: r.tool,
+                start_joints: r.home.clone(),
+                robot: i as u32,
+                ..VmConfig::default()
+            };
+            Vm::new(Arc::clone(&r.module), Arc::clone(&r.model), cfg, r.entry)
+        })
+        .collect();
+    let mut collider = Collider::new(cell);
+    let moving = vec![false; vms.len()];
+    let file = cell.file.display().to_string();
+    // The workcell key a body's place is written at: a robot's home, a device's pose.
+    let key_of = |body: &str| -> Option<String> {
+        let owner = |name: &str| {
+            body == name
+                || body
+                    .strip_prefix(name)
+                    .is_some_and(|rest| rest.starts_with('.'))
+        };
+        if let Some(i) = cell.robots.iter().position(|r| owner(&r.name)) {
+            return Some(format!("robot[{i}].home"));
+        }
+        if let Some(i) = cell.devices.iter().position(|d| d.name == body) {
+            return Some(format!("device[{i}].pose"));
+        }
+        let i = cell.parts.iter().position(|p| p.name == body)?;
+        Some(format!("part[{i}].pose"))
+    };
+    // A robot touching a part its program grips: the grip may come before the first check.
+    let grips = |a: &str, b: &str| {
+        let Some(p) = cell.parts.iter().find(|p| p.name == b) else {
+            return false;
+        };
+        cell.robots.iter().any(|r| {
+            a.strip_prefix(&r.name).is_some_and(|l| l.starts_with('.'))
+                && r.module
+                    .parts
+                    .iter()
+                    .any(|s| r.module.str(s.part) == p.name)
+        })
+    };
+    let place = |a: &str, b: &str| {
+        let key = key_of(a)
+            .and_then(|k| locate(text, &k).map(|r| (k, r)))
+            .or_else(|| key_of(b).and_then(|k| locate(text, &k).map(|r| (k, r))));
+        key.map_or((0, 0, 1), |(_, r)| line_col(text, r))
+    };
+    let esc = |s: &str| vworks_se::trace::escape_controls(s).into_owned();
+    for event in collider.check(cell, &vms, 0, &moving) {
+        match event {
+            CollisionEvent::Start(c) => {
+                if grips(&c.a, &c.b) || grips(&c.b, &c.a) {
+                    continue;
+                }
+                let (line, col, width) = place(&c.a, &c.b);
+                let (a, b) = (esc(&c.a), esc(&c.b));
+                let then = if cell.stop_on_collision {
+                    "the run would stop with a collision at 0 s"
+                } else {
+                    "the run would report a collision at 0 s"
+                };
+                problems.push(Problem {
+                    error: true,
+                    kind: "collision",
+                    robot: None,
+                    file: file.clone(),
+                    line,
+                    col,
+                    width,
+                    message: format!(
+                        "`{a}` and `{b}` overlap at the start (depth {:.1} mm): {then}; change the robot's home or the body's pose, or allow the pair (`allow_collision = [[\"{a}\", \"{b}\"]]`)",
+                        c.depth * 1e3
+                    ),
+                });
+            }
+            CollisionEvent::NearMiss(a, b, d) => {
+                let (line, col, width) = place(&a, &b);
+                problems.push(Problem {
+                    error: false,
+                    kind: "clearance",
+                    robot: None,
+                    file: file.clone(),
+                    line,
+                    col,
+                    width,
+                    message: format!(
+                        "`{}` and `{}` are {:.1} mm apart at the start, within the cell's clearance of {:.1} mm",
+                        esc(&a),
+                        esc(&b),
+                        d * 1e3,
+                        cell.clearance * 1e3
+                    ),
+                });
+            }
+            CollisionEvent::End(..) => {}
+        }
+    }
+}
+
+/// Where a workcell key the loader names (`robot[0] \`r1\`.home[2]`, `cycle`, `line 3,
+/// column 5`) is written: the byte range of the deepest part of it found in `text`.
+fn locate(text: &str, key: &str) -> Option<Range<usize>> {
+    if let Some(rest) = key.strip_prefix("line ") {
+        let (line, col) = rest.split_once(", column ")?;
+        let (line, col) = (line.parse::<usize>().ok()?, col.parse::<usize>().ok()?);
+        let start: usize = text
+            .split_inclusive('\n')
+            .take(line.saturating_sub(1))
+            .map(str::len)
+            .sum();
+        let in_line = text.get(start..)?.chars().take(col.saturating_sub(1));
+        let at = start + in_line.map(char::len_utf8).sum::<usize>();
+        return Some(at..at);
+    }
+    enum Seg {
+        Key(String),
+        Index(usize),
+    }
+    // The key's parts; a name in backticks (`robot[0] \`r1\``) is only a reminder.
+    let mut segs = Vec::new();
+    let mut word = String::new();
+    let mut chars = key.chars().peekable();
+    let flush = |word: &mut String, segs: &mut Vec<Seg>| {
+        let w = std::mem::take(word);
+        if !w.trim().is_empty() {
+            segs.push(Seg::Key(w.trim().to_string()));
+        }
+    };
+    while let Some(c) = chars.next() {
+        match c {
+            '`' => {
+                for c in chars.by_ref() {
+                    if c == '`' {
+                        break;
+                    }
+                }
+            }
+            '.' => flush(&mut word, &mut segs),
+            '[' => {
+                flush(&mut word, &mut segs);
+                let digits: String = chars.by_ref().take_while(|c| *c != ']').collect();
+                segs.push(Seg::Index(digits.trim().parse().ok()?));
+            }
+            c => word.push(c),
+        }
+    }
+    flush(&mut word, &mut segs);
+    let root = toml::de::DeTable::parse(text).ok()?;
+    let mut best = None;
+    let mut table = Some(root.get_ref());
+    let mut value: Option<&toml::de::DeValue<'_>> = None;
+    for seg in &segs {
+        match seg {
+            Seg::Key(k) => {
+                let t = match (table, value) {
+                    (Some(t), _) => t,
+                    (None, Some(toml::de::DeValue::Table(t))) => t,
+                    _ => break,
+                };
+                let Some((name, v)) = t
+                    .iter()
+                    .find(|(name, _)| name.get_ref().as_ref() == k.as_str())
+                else {
+                    break;
+                };
+                best = Some(name.span());
+                table = None;
+                value = Some(v.get_ref());
+            }
+            Seg::Index(i) => {
+                let Some(toml::de::DeValue::Array(a)) = value else {
+                    break;
+                };
+                let Some(e) = a.get(*i) else { break };
+                // An element of an array of tables (`[[robot]]`) has no span of its own
+                // worth pointing at: keep the key's.
+                if !matches!(e.get_ref(), toml::de::DeValue::Table(_)) || e.span().start > 0 {
+                    let s = e.span();
+                    if s.end > s.start {
+                        best = Some(s);
+                    }
+                }
+                table = None;
+                value = Some(e.get_ref());
+            }
+        }
+    }
+    best
+}
+
+/// The 1-based line and column (in characters) of a byte range, and its width in
+/// characters on its line (at least 1).
+fn line_col(text: &str, r: Range<usize>) -> (u32, u32, usize) {
+    let start = r.start.min(text.len());
+    let before = text.get(..start).unwrap_or_default();
+    let line = before.matches('\n').count() + 1;
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    let col = before[line_start..].chars().count() + 1;
+    let end = r.end.min(text.len()).max(start);
+    let piece = text.get(start..end).unwrap_or_default();
+    let width = if piece.is_empty() {
+        // A place, not a span (a TOML syntax error): the word there.
+        let rest = text.get(start..).unwrap_or_default();
+        rest.chars()
+            .take_while(|c| c.is_alphanumeric() || *c == '_' || *c == '-')
+            .count()
+    } else {
+        piece.lines().next().map_or(0, |l| l.chars().count())
+    };
+    let width = width.max(1);
+    (line as u32, col as u32, width)
+}
+
+/// A problem as the compiler's diagnostics print: the message, the place, the source line
+/// with a caret under the place.
+fn render(p: &Problem, sources: &[(String, String)], color: bool) -> String {
+    let (sev, on, off) = match (p.error, color) {
+        (true, true) => ("error", "\x1b[1;31m", "\x1b[0m"),
+        (false, true) => ("warning", "\x1b[1;33m", "\x1b[0m"),
+        (true, false) => ("error", "", ""),
+        (false, false) => ("warning", "", ""),
+    };
+    let mut s = format!("{on}{sev}[{}]{off}: {}\n", p.kind, p.message);
+    if p.line == 0 {
+        s.push_str(&format!("  --> {}\n\n", p.file));
+        return s;
+    }
+    s.push_str(&format!("  --> {}:{}:{}\n", p.file, p.line, p.col));
+    let source = sources
+        .iter()
+        .find(|(f, _)| *f == p.file)
+        .and_then(|(_, t)| t.lines().nth(p.line as usize - 1));
+    if let Some(src) = source {
+        let num = p.line.to_string();
+        let pad = " ".repeat(num.len());
+        let src = vworks_se::trace::escape_controls(src);
+        let lead: String = src
+            .chars()
+            .take(p.col as usize - 1)
+            .map(|c| if c == '\t' { '\t' } else { ' ' })
+            .collect();
+        s.push_str(&format!(
+            "{pad} |\n{num} | {src}\n{pad} | {lead}{on}{}{off}\n",
+            "^".repeat(p.width)
+        ));
+    }
+    s.push('\n');
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    const CELL: &str = "name = \"c\"\ncycle = \"4ms\"\n\n[[robot]]\nname = \"r1\"\nmodel = \"irb120\"\nhome = [\"0deg\", \"200deg\"]\n\n[[device]]\nname = \"t\"\npose = { xyz = [\"1m\", \"0m\", \"0m\"] }\n";
+
+    fn at(key: &str) -> (u32, u32, usize) {
+        line_col(CELL, locate(CELL, key).unwrap())
+    }
+
+    #[test]
+    fn a_key_the_loader_names_is_found_at_its_line() {
+        assert_eq!(at("cycle"), (2, 1, 5));
+        assert_eq!(at("robot[0] `r1`.home[1]"), (7, 17, 8));
+        assert_eq!(at("robot[0] `r1`.home"), (7, 1, 4));
+        assert_eq!(at("device[0] `t`.pose.xyz[0]"), (11, 17, 4));
+        // A key that is not written: its nearest written part.
+        assert_eq!(at("robot[0] `r1`.base.xyz[0]").0, 4);
+        assert_eq!(at("line 5, column 3"), (5, 3, 2));
+        assert_eq!(at("line 4, column 3"), (4, 3, 5));
+        assert!(locate(CELL, "clearance").is_none());
+    }
+}
