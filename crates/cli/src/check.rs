@@ -49,7 +49,7 @@ pub(crate) fn is_cell(path: &Path) -> bool {
 /// One problem found, at a place in a file (line 0: the file as a whole).
 struct Problem {
     error: bool,
-    /// What kind: `workcell`, `reach`, `limits`, `collision`, `clearance`.
+    /// What kind: `workcell`, `reach`, `limits`, `collision`, `near_miss`.
     kind: &'static str,
     robot: Option<String>,
     file: String,
@@ -505,7 +505,7 @@ fn at_the_start(cell: &Cell, text: &str, problems: &mut Vec<Problem>) {
                 let (line, col, width) = place(&a, &b);
                 problems.push(Problem {
                     error: false,
-                    kind: "clearance",
+                    kind: "near_miss",
                     robot: None,
                     file: file.clone(),
                     line,

@@ -451,6 +451,7 @@ name = "r1"
 model = "{model}"{pad} # built in: irb120, kr6r900, lrmate200id, ur5, turntable, track
 program = "r1.wsl"
 home = {home}
+{extra}
 
 [[device]]
 name = "table"
@@ -482,29 +483,34 @@ proc main() {
 
 /// The arms `vworks new --model` can start a cell with, and a home for each: the tool
 /// pointing down above the table, from where the program's targets are straight-line
-/// moves within reach and the joint limits (`cli.rs` runs the new cell of each).
-const NEW_ARMS: &[(&str, &str)] = &[
+/// moves within reach and the joint limits (`cli.rs` runs the new cell of each); and
+/// lines the robot's table needs besides.
+const NEW_ARMS: &[(&str, &str, &str)] = &[
     (
         "irb120",
         r#"["0deg", "-30deg", "30deg", "0deg", "60deg", "0deg"]"#,
+        "",
     ),
     (
         "kr6r900",
         r#"["0deg", "-75deg", "140deg", "0deg", "25deg", "0deg"]"#,
+        "",
     ),
     (
         "lrmate200id",
         r#"["0deg", "0deg", "-35deg", "0deg", "-55deg", "0deg"]"#,
+        "",
     ),
     (
         "ur5",
-        r#"["0deg", "-95deg", "-90deg", "95deg", "-90deg", "90deg"]"#,
+        r#"["0deg", "-95deg", "-90deg", "-95deg", "90deg", "0deg"]"#,
+        "# The model's base and upper-arm shapes lie 1 mm apart by design (closer than the\n# clearance): not a near miss to warn of.\nallow_collision = [[\"r1.base_link\", \"r1.upper_arm_link\"]]\n",
     ),
 ];
 
 fn new_cell(dir: &Path, model: &str) -> Result<ExitCode, String> {
-    let arms: Vec<&str> = NEW_ARMS.iter().map(|(m, _)| *m).collect();
-    let Some((model, home)) = NEW_ARMS.iter().find(|(m, _)| *m == model) else {
+    let arms: Vec<&str> = NEW_ARMS.iter().map(|(m, _, _)| *m).collect();
+    let Some((model, home, extra)) = NEW_ARMS.iter().find(|(m, _, _)| *m == model) else {
         let what = if vworks_model::builtin::names().contains(&model) {
             format!("`{model}` is not an arm (a new cell's program moves a tool over a table)")
         } else {
@@ -540,7 +546,8 @@ fn new_cell(dir: &Path, model: &str) -> Result<ExitCode, String> {
             .replace("{name}", &name)
             .replace("{model}", model)
             .replace("{pad}", &" ".repeat(12usize.saturating_sub(model.len())))
-            .replace("{home}", home);
+            .replace("{home}", home)
+            .replace("{extra}\n", extra);
         std::fs::write(&path, text)
             .map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
     }

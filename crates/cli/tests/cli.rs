@@ -653,4 +653,185 @@ fn log_events_match_the_run_trace_in_both_styles() {
     assert_eq!(text(&seconds.stdout), text(&run_s.stdout));
     assert!(text(&seconds.stdout).starts_with("0 s left motion_start move_j duration="));
     let _ = std::fs::remove_dir_all(&d);
+
+/// `vworks check mycell/cell.toml` read the workcell as a WSL program, and `vworks check
+/// mycell/` said "Is a directory": a workcell (or its folder) is checked as `run` loads
+/// it, and more, without running it. Every example checks clean: what check reports, a
+/// run would too.
+#[test]
+fn check_takes_a_workcell_or_its_folder() {
+    let examples = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../workcells");
+    let mut names: Vec<String> = std::fs::read_dir(&examples)
+        .unwrap()
+        .filter_map(|e| {
+            let e = e.unwrap();
+            e.path()
+                .join("cell.toml")
+                .is_file()
+                .then(|| e.file_name().to_string_lossy().into_owned())
+        })
+        .collect();
+    names.sort();
+    assert!(names.len() >= 8, "{names:?}");
+    for name in &names {
+        let folder = examples.join(name);
+        let out = vworks(&["check", folder.to_str().unwrap()]);
+        let err = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(0), "{name}: {err}");
+        assert!(err.contains(" 0 errors, 0 warnings"), "{name}: {err}");
+    }
+    let out = vworks(&["check", &workcell("handoff")]);
+    assert_eq!(out.status.code(), Some(0));
+    assert_eq!(
+        text(&out.stderr),
+        "checked cell handoff: 2 programs, 0 errors, 0 warnings\n"
+    );
+    // The run agrees that the cell is sound, and check ran nothing: no output but the line.
+    assert!(text(&out.stdout).is_empty());
+}
+
+#[test]
+fn check_json_lists_each_problem_with_its_place() {
+    let d = temp_dir("check-json");
+    std::fs::write(
+        d.join("cell.toml"),
+        "name = \"c\"\n[[robot]]\nname = \"r1\"\nmodel = \"kr6r900\"\nprogram = \"r1.wsl\"\nhome = [\"0deg\", \"-90deg\", \"90deg\", \"0deg\", \"30deg\", \"0deg\"]\n",
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("r1.wsl"),
+        "proc main() {\n    move_j joints(0deg, -90deg, 90deg, 0deg, 130deg, 0deg);\n    move_l pose(3000mm, 0mm, 500mm, 180deg, 0deg, 0deg);\n}\n",
+    )
+    .unwrap();
+    let out = vworks(&["check", d.to_str().unwrap(), "--json"]);
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout)
+        .unwrap_or_else(|e| panic!("{e}: {}", text(&out.stdout)));
+    assert_eq!(v["cell"], "c");
+    assert_eq!(v["programs"], 1);
+    let errors = v["errors"].as_array().unwrap();
+    let places: Vec<(String, u64, String)> = errors
+        .iter()
+        .map(|e| {
+            (
+                e["kind"].as_str().unwrap().to_string(),
+                e["line"].as_u64().unwrap(),
+                e["file"]
+                    .as_str()
+                    .unwrap()
+                    .rsplit('/')
+                    .next()
+                    .unwrap()
+                    .to_string(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        places,
+        [
+            ("limits".to_string(), 2, "r1.wsl".to_string()),
+            ("reach".to_string(), 3, "r1.wsl".to_string())
+        ]
+    );
+    assert!(
+        errors[0]["message"]
+            .as_str()
+            .unwrap()
+            .contains("axis 5 `joint_a5` would go to 130.0deg"),
+        "{v}"
+    );
+    assert_eq!(v["warnings"], serde_json::json!([]));
+    // The human form says the same on stderr, and nothing is printed on stdout.
+    let out = vworks(&["check", d.join("cell.toml").to_str().unwrap()]);
+    assert!(text(&out.stdout).is_empty());
+    assert!(
+        text(&out.stderr).ends_with("checked cell c: 1 program, 2 errors, 0 warnings\n"),
+        "{}",
+        text(&out.stderr)
+    );
+}
+
+#[test]
+fn run_takes_a_workcells_folder() {
+    let folder = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../workcells/handoff");
+    let out = vworks(&["run", folder.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stdout).starts_with("cell handoff: completed at 63.418 s"),
+        "{}",
+        text(&out.stdout)
+    );
+    // With --json, a program given instead is still one JSON object, its message in it.
+    let out = vworks(&[
+        "run",
+        &folder.join("r1.wsl").display().to_string(),
+        "--json",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["outcome"], "error");
+    assert!(
+        v["errors"][0]["message"]
+            .as_str()
+            .unwrap()
+            .contains("takes a workcell"),
+        "{v}"
+    );
+}
+
+/// `vworks new --model M` for every built-in arm: the cell checks clean and runs to the
+/// end without a collision (its home, its targets and its table suit the model).
+#[test]
+fn new_makes_a_cell_that_runs_for_every_arm() {
+    let d = temp_dir("new-arms");
+    for model in ["irb120", "kr6r900", "lrmate200id", "ur5"] {
+        let cell = d.join(model);
+        let out = vworks(&["new", cell.to_str().unwrap(), "--model", model]);
+        assert_eq!(out.status.code(), Some(0), "{model}: {}", text(&out.stderr));
+        assert!(
+            text(&out.stderr).contains(&format!("one {model} and a table")),
+            "{}",
+            text(&out.stderr)
+        );
+        let toml = std::fs::read_to_string(cell.join("cell.toml")).unwrap();
+        assert!(toml.contains(&format!("model = \"{model}\"")), "{toml}");
+        let out = vworks(&["check", cell.to_str().unwrap()]);
+        assert_eq!(
+            text(&out.stderr),
+            format!("checked cell {model}: 1 program, 0 errors, 0 warnings\n")
+        );
+        let out = vworks(&["run", cell.to_str().unwrap(), "--json"]);
+        assert_eq!(out.status.code(), Some(0), "{model}: {}", text(&out.stdout));
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(v["outcome"], "completed", "{model}: {v}");
+        assert_eq!(v["collisions"], serde_json::json!([]), "{model}");
+        assert_eq!(v["errors"], serde_json::json!([]), "{model}");
+        assert_eq!(v["warnings"], serde_json::json!([]), "{model}");
+        // Six motions (three rounds of two), every one made.
+        assert_eq!(v["robots"][0]["motions"], 6, "{model}: {v}");
+    }
+}
+
+/// The report's line counted `1 robots`.
+#[test]
+fn the_report_line_counts_in_words() {
+    let d = temp_dir("report-plural");
+    let cell = d.join("one");
+    assert_eq!(
+        vworks(&["new", cell.to_str().unwrap()]).status.code(),
+        Some(0)
+    );
+    let log = d.join("run.mcap");
+    let out = vworks(&[
+        "run",
+        cell.to_str().unwrap(),
+        "--log",
+        log.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let out = vworks(&["report", log.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let err = text(&out.stderr);
+    assert!(err.contains("(1 robot, "), "{err}");
+    assert!(err.contains(" events, 0 collisions)"), "{err}");
 }
