@@ -383,7 +383,9 @@ fn constant_target(m: &Module, proc: &ProcInfo, pc: usize, f: MoveFlags) -> Opti
     // Slots above the target's top: the speed, zone, tool … operands.
     let mut above = effect.pops.checked_sub(width + via)?;
     let lands = |at: usize| {
-        m.code[start..start + proc.code_len as usize]
+        m.code
+            .get(start..start + proc.code_len as usize)
+            .unwrap_or_default()
             .iter()
             .any(|i| i.jump_target().is_some_and(|t| start + t as usize == at))
     };
@@ -658,13 +660,14 @@ fn render(p: &Problem, sources: &[(String, String)], color: bool) -> String {
         .iter()
         .find(|(f, _)| *f == p.file)
         .and_then(|(_, t)| t.lines().nth(p.line as usize - 1));
+    // (Line 0 returned above.)
     if let Some(src) = source {
         let num = p.line.to_string();
         let pad = " ".repeat(num.len());
         let src = vworks_se::trace::escape_controls(src);
         let lead: String = src
             .chars()
-            .take(p.col as usize - 1)
+            .take((p.col as usize).saturating_sub(1))
             .map(|c| if c == '\t' { '\t' } else { ' ' })
             .collect();
         s.push_str(&format!(
