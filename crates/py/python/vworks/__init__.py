@@ -36,7 +36,7 @@ from ._vworks import (
     read_log,
     write_report,
 )
-from ._sweep import sweep
+from ._sweep import SweepTable, sweep
 
 __all__ = [
     "Cell",
@@ -55,6 +55,7 @@ __all__ = [
     "RobotStats",
     "Simulation",
     "SimulationError",
+    "SweepTable",
     "__version__",
     "compile",
     "compile_files",

@@ -10,14 +10,98 @@ from __future__ import annotations
 
 import itertools
 import os
-from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, Iterator, List, Mapping, Optional, Sequence, Tuple, Union, overload
 
 from . import _vworks
 
 Value = Union[float, int, str, bool]
 Variant = List[Tuple[str, Value]]
+#: One cell of a sweep table: a number, a text, or None where the table is empty (a
+#: variable a variant leaves out, the cycle time of a robot that did not end, no clearance
+#: measured).
+Entry = Optional[Union[float, int, str]]
 
-__all__ = ["sweep", "variants_of"]
+__all__ = ["SweepTable", "sweep", "variants_of"]
+
+
+class SweepTable:
+    """The table a sweep returns: one row per variant, in variant order, as plain Python
+    values (numbers, strings, None where the table is empty); no pandas needed.
+
+    ``table.columns`` are the names, ``table.rows`` the rows (tuples, in column order);
+    ``len(table)`` counts the rows; ``table["end_time"]`` is a column as a list;
+    ``table[i]`` is row ``i`` as a dict; iterating gives each row as a dict.
+    ``to_pandas()`` makes a pandas DataFrame of it (None becomes NaN in numeric columns).
+    Two tables are equal when their columns and rows are.
+    """
+
+    def __init__(self, columns: Sequence[str], rows: Sequence[Sequence[Entry]]) -> None:
+        self._columns = list(columns)
+        self._rows = [tuple(r) for r in rows]
+        self._index = {name: i for i, name in enumerate(self._columns)}
+        for r in self._rows:
+            if len(r) != len(self._columns):
+                raise ValueError(f"a row of {len(r)} values in a table of {len(self._columns)} columns")
+
+    @property
+    def columns(self) -> List[str]:
+        """The column names: ``variant``, each variable, ``outcome``, ``end_time``,
+        ``cycle_time.ROBOT`` per robot, ``collisions``, ``min_clearance``, ``error``."""
+        return list(self._columns)
+
+    @property
+    def rows(self) -> List[Tuple[Entry, ...]]:
+        """The rows, in variant order, each a tuple of values in column order."""
+        return list(self._rows)
+
+    def column(self, name: str) -> List[Entry]:
+        """The column `name` as a list, in variant order; `KeyError` naming the columns if
+        there is none of that name."""
+        i = self._index.get(name)
+        if i is None:
+            raise KeyError(f"no column {name!r}; the columns are {', '.join(self._columns)}")
+        return [r[i] for r in self._rows]
+
+    def to_dicts(self) -> List[Dict[str, Entry]]:
+        """The rows as dicts, column name to value, in variant order."""
+        return [dict(zip(self._columns, r)) for r in self._rows]
+
+    def to_pandas(self) -> Any:
+        """The table as a pandas DataFrame with the same columns and rows (None is NaN in
+        a numeric column). Needs pandas: `ImportError` saying what to install otherwise."""
+        try:
+            import pandas as pd  # type: ignore[import-untyped, import-not-found, unused-ignore]
+        except ImportError as e:
+            raise ImportError(
+                "SweepTable.to_pandas needs pandas: pip install pandas (or 'vworks[pandas]')"
+            ) from e
+        return pd.DataFrame([list(r) for r in self._rows], columns=self._columns)
+
+    def __len__(self) -> int:
+        return len(self._rows)
+
+    @overload
+    def __getitem__(self, key: str) -> List[Entry]: ...
+    @overload
+    def __getitem__(self, key: int) -> Dict[str, Entry]: ...
+    def __getitem__(self, key: Union[str, int]) -> Union[List[Entry], Dict[str, Entry]]:
+        if isinstance(key, str):
+            return self.column(key)
+        if isinstance(key, bool) or not isinstance(key, int):
+            raise TypeError(f"a sweep table is indexed by a column name or a row number, not {key!r}")
+        return dict(zip(self._columns, self._rows[key]))
+
+    def __iter__(self) -> Iterator[Dict[str, Entry]]:
+        for r in self._rows:
+            yield dict(zip(self._columns, r))
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, SweepTable):
+            return NotImplemented
+        return self._columns == other._columns and self._rows == other._rows
+
+    def __repr__(self) -> str:
+        return f"<SweepTable of {len(self._rows)} variants: {', '.join(self._columns)}>"
 
 
 def _paths(key: Union[str, Sequence[str]]) -> List[str]:
@@ -90,14 +174,6 @@ def _run_batch(
     return native.run_variants(cell, batch, variables, jobs=1, until=until, files=files, offset=offset)
 
 
-def _frame(columns: List[str], rows: List[List[Any]]) -> Any:
-    try:
-        import pandas as pd  # type: ignore[import-untyped, import-not-found, unused-ignore]
-    except ImportError as e:  # pragma: no cover - pandas is a test dependency
-        raise ImportError("vworks.sweep returns a pandas DataFrame: pip install vworks[pandas]") from e
-    return pd.DataFrame(rows, columns=columns)
-
-
 def sweep(
     cell: Union[str, "os.PathLike[str]"],
     variables: Union[Mapping[Any, Sequence[Value]], Sequence[Mapping[str, Value]]],
@@ -105,8 +181,9 @@ def sweep(
     jobs: Optional[int] = None,
     until: Optional[float] = None,
     batch: Optional[int] = None,
-) -> Any:
-    """Runs every variant of the workcell `cell` and returns the table as a pandas DataFrame.
+) -> SweepTable:
+    """Runs every variant of the workcell `cell` and returns the table, a `SweepTable`
+    (plain Python values; `to_pandas()` for a DataFrame, with pandas installed).
 
     `variables` maps dotted paths into the workcell (``"robot.r2.base.xyz.0"``,
     ``"params.speed"``; a tuple of paths for tied values) to lists of values, whose product
@@ -128,7 +205,7 @@ def sweep(
     names, variants = variants_of(variables)
     if backend == "local":
         columns, rows = _vworks.run_variants(cell, variants, names, jobs=jobs, until=until)
-        return _frame(columns, rows)
+        return SweepTable(columns, rows)
     files = _vworks.cell_files(cell)
     if backend == "ray":
         try:
@@ -169,4 +246,4 @@ def sweep(
         raise ValueError(f"backend is 'local', 'ray' or 'dask', not {backend!r}")
     columns = results[0][0] if results else ["variant", *names]
     rows = [row for _, part in results for row in part]
-    return _frame(columns, rows)
+    return SweepTable(columns, rows)
