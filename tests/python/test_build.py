@@ -53,6 +53,10 @@ def test_the_relay_keeps_lines_and_turns_the_bar_into_status_lines():
         "vworks: compiling the Rust extension: 0/3 steps; now c",
         "vworks: compiling the Rust extension: 1/3 steps; now parry3d-f64",  # once, not twice
     ]
+    # While one crate compiles for minutes, the clock on the line moves.
+    relay.start -= 61
+    relay.refresh()
+    assert re.fullmatch(r"vworks: compiling the Rust extension: 1/3 steps, 1m0[12]s; now parry3d-f64", status[-1])
 
 
 def test_pip_wheel_shows_cargos_progress_on_the_terminal(tmp_path):

@@ -23,7 +23,7 @@ import re
 import sys
 import threading
 import time
-from typing import Any, Callable, Iterator, Mapping, Optional, TextIO
+from typing import Any, Callable, Iterator, Mapping, Optional, TextIO, Tuple
 
 import maturin  # type: ignore[import-untyped, unused-ignore]
 
@@ -49,6 +49,8 @@ class Relay:
         self.start = start
         self.pending = b""
         self.last = ""
+        self.bar: Optional[Tuple[str, str, str]] = None  # done, total, what is compiling
+        self.lock = threading.Lock()
 
     def feed(self, data: bytes) -> None:
         self.pending += data
@@ -64,10 +66,20 @@ class Relay:
                 if segment.strip() or end == b"\n":
                     self.forward(segment + end)
                 continue
-            done, total, now = bar.group(1).decode(), bar.group(2).decode(), (bar.group(3) or b"").decode(errors="replace")
-            line = f"vworks: compiling the Rust extension: {done}/{total} steps, {_elapsed(self.start)}"
-            if now:
-                line += f"; now {now.split(',')[0].strip()}"
+            now = (bar.group(3) or b"").decode(errors="replace").split(",")[0].strip()
+            self.bar = (bar.group(1).decode(), bar.group(2).decode(), now)
+            self.refresh()
+
+    def refresh(self) -> None:
+        """Shows the last progress with the time now (called again while one crate takes
+        minutes to compile, so that the clock moves)."""
+        if self.bar is None:
+            return
+        done, total, now = self.bar
+        line = f"vworks: compiling the Rust extension: {done}/{total} steps, {_elapsed(self.start)}"
+        if now:
+            line += f"; now {now}"
+        with self.lock:
             if line != self.last:
                 self.last = line
                 self.status(line)
@@ -136,11 +148,21 @@ def _progress() -> Iterator[None]:
 
     thread = threading.Thread(target=pump, daemon=True)
     thread.start()
+    ticking = threading.Event()
+
+    def tick() -> None:
+        while not ticking.wait(1.0):
+            relay.refresh()
+
+    ticker = threading.Thread(target=tick, daemon=True)
+    ticker.start()
     ok = False
     try:
         yield
         ok = True
     finally:
+        ticking.set()
+        ticker.join()
         sys.stderr.flush()
         os.dup2(saved_err, 2)  # the pipe's last writer goes: the pump sees its end
         # ... unless a process cargo started lives on with it (a compiler cache's server):
