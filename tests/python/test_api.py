@@ -223,6 +223,46 @@ def test_result_fields():
     assert "completed" in repr(r)
 
 
+def test_logs_are_the_programs_log_lines(tmp_path):
+    """By hand (docs/language.md, docs/engine.md "One instant, one serial order"): r1 logs
+    at 0 s and after its 1.5 s delay and set; r2, released by that set, logs after r1."""
+    cell = write_cell(
+        tmp_path,
+        {
+            "r1": 'global go = false;\nproc main() {\n    log "r1 begins";\n    delay 1500ms;\n'
+            '    go = true;\n    log "r1 done";\n}\n',
+            "r2": 'global go = false;\nproc main() {\n    wait_until go;\n'
+            '    log "r2 released after ", 1500ms;\n}\n',
+        },
+    )
+    r = vworks.load_cell(cell).run()
+    got = [(l.time_ns, l.robot, l.text, pathlib.Path(l.file).name, l.line, l.col) for l in r.logs]
+    assert got == [
+        (0, "r1", "r1 begins", "r1.wsl", 3, 5),
+        (1_500_000_000, "r1", "r1 done", "r1.wsl", 6, 5),
+        (1_500_000_000, "r2", "r2 released after 1.5s", "r2.wsl", 4, 5),
+    ]
+    assert all(isinstance(l, vworks.LogLine) and l.time == l.time_ns / 1e9 for l in r.logs)
+    assert r.to_dict()["logs"][2]["text"] == "r2 released after 1.5s"
+    assert "r2 released" in repr(r.logs[2])
+
+
+def test_a_collision_names_each_robots_motion():
+    """workcells/crash: both arms reach for each other with their one move_j (line 3)."""
+    r = vworks.load_cell(ROOT / "workcells" / "crash" / "cell.toml").run()
+    (c,) = r.collisions
+    statement = "move_j joints(0deg, 60deg, -30deg, 0deg, 30deg, 0deg) speed 50%;"
+    assert [(m.robot, m.moving, pathlib.Path(m.file).name, m.line, m.col, m.statement) for m in c.motions] == [
+        ("left", True, "left.wsl", 3, 5, statement),
+        ("right", True, "right.wsl", 3, 5, statement),
+    ]
+    assert c.motions[0].describe() == f"left moving: left.wsl:3:5 {statement}"
+    (near,) = [w for w in r.warnings if w.kind == "near_miss"]
+    assert [m.robot for m in near.motions] == ["left", "right"]
+    assert (near.robot, pathlib.Path(near.file).name, near.line) == ("left", "left.wsl", 3)
+    assert r.to_dict()["collisions"][0]["motions"][1]["statement"] == statement
+
+
 def test_events_to_pandas():
     import pandas as pd  # installed in the test environment (requirements-dev.txt)
 
@@ -460,7 +500,8 @@ def test_warnings_are_issues():
     (w,) = r.warnings
     assert isinstance(w, vworks.Issue)
     assert w.kind == "near_miss" and "left.link_6 and right.link_6" in w.message
-    assert (w.robot, w.file, w.line, w.col) == (None, None, 0, 0)
+    # Its place is the first moving robot's motion (both move: left's), no longer unknown.
+    assert (w.robot, pathlib.Path(w.file).name, w.line, w.col) == ("left", "left.wsl", 3, 5)
     assert "near_miss" in repr(w)
     # The message rounds to hundredths of a millimetre; the distance is exact.
     assert "come within 2.45 mm" in w.message

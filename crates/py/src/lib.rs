@@ -27,6 +27,7 @@ use vworks_se::engine::{Issue, Outcome, RunResult, TraceEvent, Value};
 use vworks_se::mcaplog::{LoggedEvent, McapLog};
 
 mod interrupt;
+mod place;
 mod program;
 mod sweep;
 
@@ -436,6 +437,8 @@ struct Collision {
     depth: f64,
     /// A contact point in the cell (m).
     point: (f64, f64, f64),
+    /// Each robot whose body is in the pair and the motion it was making.
+    motions: Vec<place::PyRobotMotion>,
 }
 
 #[pymethods]
@@ -466,6 +469,8 @@ struct PyIssue {
     col: u32,
     /// For a near miss, how close the bodies came (m).
     distance_m: Option<f64>,
+    /// For a near miss, each robot in the pair and the motion it was making.
+    motions: Vec<place::PyRobotMotion>,
 }
 
 #[pymethods]
@@ -484,6 +489,7 @@ fn issue(i: &Issue) -> PyIssue {
         line: i.line,
         col: i.col,
         distance_m: i.distance_m,
+        motions: place::motions(&i.motions),
     }
 }
 
@@ -507,6 +513,7 @@ struct RunReport {
     errors: Vec<PyIssue>,
     globals: Vec<(String, Value)>,
     events: Vec<Event>,
+    logs: Vec<place::PyLogLine>,
     cycles: u64,
     log_counts: Vec<(String, u64)>,
     log_error: Option<String>,
@@ -544,12 +551,14 @@ impl RunReport {
                     b: c.b.clone(),
                     depth: c.depth,
                     point: (c.point[0], c.point[1], c.point[2]),
+                    motions: place::motions(&c.motions),
                 })
                 .collect(),
             warnings: r.warnings.iter().map(issue).collect(),
             errors: r.errors.iter().map(issue).collect(),
             globals: r.global_values.clone(),
             events: r.trace.iter().map(|e| event(cell, e)).collect(),
+            logs: r.logs.iter().map(place::log_line).collect(),
             cycles: r.cycles,
             log_counts: r
                 .log_counts
@@ -664,6 +673,12 @@ impl RunReport {
         EventList {
             events: self.events.clone(),
         }
+    }
+
+    /// The lines the programs logged, in order (`log` statements; also in `events`).
+    #[getter]
+    fn logs(&self) -> Vec<place::PyLogLine> {
+        self.logs.clone()
     }
 
     /// Cycle boundaries passed.
@@ -1034,6 +1049,8 @@ fn _vworks(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<RobotStats>()?;
     m.add_class::<Collision>()?;
     m.add_class::<PyIssue>()?;
+    m.add_class::<place::PyRobotMotion>()?;
+    m.add_class::<place::PyLogLine>()?;
     m.add_class::<Event>()?;
     m.add_class::<EventList>()?;
     m.add_class::<Simulation>()?;
