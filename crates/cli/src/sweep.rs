@@ -2,22 +2,27 @@
 //! runs every variant on all cores (or `--jobs N`) with a progress bar on a terminal,
 //! streams the table (CSV, or JSON lines for `.jsonl`) as rows finish, then writes the
 //! page (a chart of the objective and the best variants) from the table and prints the
-//! best. Every output goes through a temporary file (`vworks_model::output`). See
-//! `docs/sweep.md`.
+//! best. The table file states its columns' units (`robot.r2.base.xyz.0 [mm]`,
+//! `end_time [s]`) and shows a variable in the unit its values were written in. With
+//! `--keep-logs DIR` it writes the variants' logs, or only some (`--keep-logs-variants
+//! 3,7,10-12`, `--keep-logs-best N`: a log leaves the folder as soon as its variant has
+//! dropped out of the best N, so the folder never holds many more than N). Every output
+//! goes through a temporary file (`vworks_model::output`). See `docs/sweep.md`.
 
+use std::collections::BTreeSet;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Duration;
 
 use vworks_cell::{Cell, Disk, Loader};
 use vworks_model::output::{Output, OutputError};
-use vworks_sweep::run::RunOptions;
+use vworks_sweep::run::{RunOptions, VariantSet};
 use vworks_sweep::stream::{Format, TableFile, TableWriter};
 use vworks_sweep::table::{self, Best, Value};
-use vworks_sweep::{Row, Sweep, run_streamed};
+use vworks_sweep::{Row, Sweep, Unit, per_second, run_streamed};
 
 /// What `vworks sweep` was asked.
 #[derive(clap::Args, Debug)]
@@ -36,8 +41,15 @@ pub(crate) struct Args {
     #[arg(long)]
     pub(crate) html: Option<PathBuf>,
     /// Write each variant's MCAP log into this folder (variant-00000.mcap, …).
-    #[arg(long)]
+    #[arg(long, value_name = "DIR")]
     pub(crate) keep_logs: Option<PathBuf>,
+    /// With --keep-logs: keep only the logs of the N best variants by the objective
+    /// (and of --keep-logs-variants); the others are removed as the sweep goes.
+    #[arg(long, value_name = "N", requires = "keep_logs", value_parser = clap::value_parser!(u64).range(1..))]
+    pub(crate) keep_logs_best: Option<u64>,
+    /// With --keep-logs: write only these variants' logs, e.g. 3,7,10-12.
+    #[arg(long, value_name = "LIST", requires = "keep_logs")]
+    pub(crate) keep_logs_variants: Option<String>,
     /// Stop a variant that runs longer than this wall time (e.g. 30s): its row's outcome
     /// is `timeout`.
     #[arg(long, value_name = "TIME")]
@@ -52,7 +64,7 @@ pub(crate) struct Args {
     /// No progress bar.
     #[arg(short, long)]
     pub(crate) quiet: bool,
-    /// List every value of the workcell FILE a sweep may vary, and stop.
+    /// List every value of the workcell FILE a sweep may vary, with its value, and stop.
     #[arg(long)]
     pub(crate) variables: bool,
 }
@@ -81,13 +93,140 @@ fn timeout(s: &str) -> Result<Duration, String> {
     }
 }
 
-/// `vworks sweep --variables CELL`: every value a sweep may vary, one per line.
+/// `vworks sweep --variables CELL`: every value a sweep may vary, one per line, with
+/// its value: as the workcell file writes it (`robot.r2.base.xyz.0 = 600mm`), else the
+/// value it has without it, marked `(not in the file)` (a param's, as its program
+/// declares it).
 fn list_variables(cell: &Path) -> Result<ExitCode, String> {
     let loader = Loader::new(cell, &Disk).map_err(|e| e.to_string())?;
+    // The loader read it just now; read again for the values as written.
+    let text = std::fs::read_to_string(cell)
+        .map_err(|e| format!("cannot read `{}`: {e}", cell.display()))?;
+    let file: toml::Table = text
+        .parse()
+        .map_err(|e: toml::de::Error| format!("{}: {}", cell.display(), e.message()))?;
     for v in loader.variables() {
-        crate::out!("{v}");
+        match written_at(&file, v) {
+            Some(x) => crate::out!("{v} = {}", as_written(x)),
+            None => crate::out!("{v} = {}  (not in the file)", default_of(loader.base(), v)),
+        }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The value at a variable's dotted path in the workcell file, if the file writes it
+/// (robots, devices and parts found by name, arrays by index).
+fn written_at<'t>(file: &'t toml::Table, path: &str) -> Option<&'t toml::Value> {
+    let parts: Vec<&str> = path.split('.').collect();
+    let (mut at, rest) = match parts.as_slice() {
+        [section @ ("robot" | "device" | "part"), name, rest @ ..] => (
+            file.get(*section)?
+                .as_array()?
+                .iter()
+                .find(|i| i.get("name").and_then(toml::Value::as_str) == Some(*name))?,
+            rest,
+        ),
+        [first, rest @ ..] => (file.get(*first)?, rest),
+        [] => return None,
+    };
+    for key in rest {
+        at = match at {
+            toml::Value::Table(t) => t.get(*key)?,
+            toml::Value::Array(items) => items.get(key.parse::<usize>().ok()?)?,
+            _ => return None,
+        };
+    }
+    Some(at)
+}
+
+/// A workcell value as its file writes it: `600mm` (a string without its quotes), `0.6`.
+fn as_written(v: &toml::Value) -> String {
+    match v {
+        toml::Value::String(s) => s.clone(),
+        other => other.to_string(),
+    }
+}
+
+/// A variable's value when the workcell file does not write it: the loaded workcell's (a
+/// default, or a param's value as its program declares it).
+fn default_of(cell: &Cell, path: &str) -> String {
+    use vworks_vm::Dim;
+    let parts: Vec<&str> = path.split('.').collect();
+    let robot = |name: &str| cell.robots.iter().find(|r| r.name == name);
+    let pose = |iso: &vworks_model::math::Iso, part: &str, k: &str| -> Option<String> {
+        let k = k.parse::<usize>().ok().filter(|k| *k < 3)?;
+        Some(match part {
+            "xyz" => quantity(iso.t[k], Dim::LENGTH),
+            "rpy" => quantity(iso.rpy()[k], Dim::ANGLE),
+            _ => return None,
+        })
+    };
+    let param = |r: &vworks_cell::Robot, name: &str| {
+        vworks_cell::params::declared(&r.module)
+            .into_iter()
+            .find(|(n, ..)| n == name)
+            .map(|(_, ty, value)| match (ty, value) {
+                (vworks_vm::Type::Num(dim), vworks_vm::ConstValue::Num(x)) => quantity(x, dim),
+                (_, vworks_vm::ConstValue::Int(i)) => i.to_string(),
+                (_, vworks_vm::ConstValue::Bool(b)) => b.to_string(),
+                (_, other) => format!("{other:?}"),
+            })
+    };
+    let found = match parts.as_slice() {
+        ["cycle"] => Some(quantity(cell.cycle_ns as f64 / 1e9, Dim::TIME)),
+        ["clearance"] => Some(quantity(cell.clearance, Dim::LENGTH)),
+        ["grip_distance"] => Some(quantity(cell.grip_distance, Dim::LENGTH)),
+        ["params", name] => {
+            let each: Vec<String> = cell
+                .robots
+                .iter()
+                .filter_map(|r| Some(format!("{} in {}'s program", param(r, name)?, r.name)))
+                .collect();
+            (!each.is_empty()).then(|| each.join(", "))
+        }
+        ["robot", name, rest @ ..] => robot(name).and_then(|r| match rest {
+            ["params", p] => param(r, p),
+            ["default_speed"] => Some(quantity(r.default_speed, Dim::SPEED)),
+            ["default_zone"] => Some(
+                r.default_zone
+                    .map_or("fine".into(), |z| quantity(z, Dim::LENGTH)),
+            ),
+            ["grip_distance"] => Some(quantity(r.grip_distance, Dim::LENGTH)),
+            ["base", part, k] => pose(&r.base, part, k),
+            ["tool", part, k] => pose(&r.tool, part, k),
+            _ => None,
+        }),
+        [section @ ("device" | "part"), name, "pose", part, k] => {
+            let bodies = if *section == "device" {
+                &cell.devices
+            } else {
+                &cell.parts
+            };
+            bodies
+                .iter()
+                .find(|b| b.name == *name)
+                .and_then(|b| pose(&b.pose, part, k))
+        }
+        _ => None,
+    };
+    found.unwrap_or_else(|| "–".into())
+}
+
+/// An SI value in the unit a workcell file would use for its dimension (mm, deg, mm/s, s).
+fn quantity(x: f64, dim: vworks_vm::Dim) -> String {
+    use vworks_vm::Dim;
+    let (scale, unit) = match dim {
+        Dim::LENGTH => (1e3, "mm"),
+        Dim::ANGLE => (180.0 / std::f64::consts::PI, "deg"),
+        Dim::SPEED => (1e3, "mm/s"),
+        Dim::TIME if x.abs() < 1.0 => (1e3, "ms"),
+        Dim::TIME => (1.0, "s"),
+        Dim::PLAIN => (1.0, ""),
+        _ => return format!("{x} ({dim} in SI)"),
+    };
+    // 12 significant digits: no noise of the conversion (0.1 m is 100mm, not 100.00000000000001).
+    let v: f64 = format!("{:.11e}", x * scale).parse().unwrap_or(x * scale);
+    format!("{}{unit}", v + 0.0)
 }
 
 /// What the rows said, counted as they pass, and the best kept.
@@ -123,13 +262,28 @@ pub(crate) fn sweep(a: Args) -> Result<ExitCode, String> {
         .map(|r| r.name.clone())
         .collect();
     let objective = a.minimize.clone().unwrap_or(sweep.minimize.clone());
-    sweep
+    let objective = sweep
         .check_objective(&objective, &robots)
         .map_err(|m| match a.minimize {
             Some(_) => format!("--minimize: {m}"),
             None => format!("{}: minimize: {m}", a.file.display()),
         })?;
     let variant_timeout = a.variant_timeout.as_deref().map(timeout).transpose()?;
+    let count = sweep.count();
+    let keep_list = a
+        .keep_logs_variants
+        .as_deref()
+        .map(VariantSet::parse)
+        .transpose()
+        .map_err(|m| format!("--keep-logs-variants: {m}"))?;
+    if let Some(last) = keep_list.as_ref().and_then(VariantSet::last)
+        && last >= count
+    {
+        return Err(format!(
+            "--keep-logs-variants: variant {last} is not one of this sweep's {count} (0 to {})",
+            count.saturating_sub(1)
+        ));
+    }
     let stem = a.file.with_extension("");
     let out = a.out.clone().unwrap_or_else(|| stem.with_extension("csv"));
     let html = a
@@ -145,30 +299,50 @@ pub(crate) fn sweep(a: Args) -> Result<ExitCode, String> {
         std::fs::create_dir_all(dir)
             .map_err(|e| format!("cannot create `{}`: {e}", dir.display()))?;
     }
-    let names: Vec<String> = sweep.variables.iter().map(|v| v.path.clone()).collect();
+    let names = sweep.names();
+    let units = sweep.units();
     let columns = table::columns(&names, &robots);
+    // The file's header states the units; the rows are matched by `columns`.
+    let headers = table::headers(&names, &units, &robots);
     let format = Format::of_path(&out);
     let table_error = |e: std::io::Error| OutputError::write(&out, &e).to_string();
-    let mut writer = TableWriter::new(table_out, format, columns.clone());
+    let mut writer = TableWriter::new(table_out, format, headers.clone());
     // A table that cannot be written does not stop the sweep: the best are still printed.
     let mut write_error = writer.start().err();
     let options = RunOptions {
         jobs: a.jobs,
         until_ns: sweep.until_ns,
         keep_logs: a.keep_logs.clone(),
+        // The best are known only as rows pass: every log is written, the others removed.
+        keep_logs_of: if a.keep_logs_best.is_some() {
+            None
+        } else {
+            keep_list.clone()
+        },
         variant_timeout,
     };
+    let mut pruner = match (&a.keep_logs, a.keep_logs_best) {
+        (Some(dir), Some(n)) => Some(Pruner {
+            dir: dir.clone(),
+            best: Best::new(
+                &columns,
+                &objective,
+                usize::try_from(n).unwrap_or(usize::MAX),
+            ),
+            list: keep_list.clone(),
+            failed: Vec::new(),
+        }),
+        _ => None,
+    };
+    // Variants started whose row has not passed yet: those left at the end were stopped
+    // (Ctrl-C), and their logs go too.
+    let running: Mutex<BTreeSet<usize>> = Mutex::new(BTreeSet::new());
+    let pruning = pruner.is_some();
     let stop = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&stop);
     let _ = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed));
-    let count = sweep.count();
-    let bar = (!a.quiet && std::io::stderr().is_terminal()).then(|| {
-        let style = indicatif::ProgressStyle::with_template(
-            "{bar:40} {pos}/{len} variants, {per_sec}, {eta} left",
-        )
-        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
-        indicatif::ProgressBar::new(count as u64).with_style(style)
-    });
+    let bar = (!a.quiet && std::io::stderr().is_terminal())
+        .then(|| indicatif::ProgressBar::new(count as u64).with_style(progress_style()));
     let mut tally = Tally {
         rows: 0,
         feasible: 0,
@@ -181,7 +355,15 @@ pub(crate) fn sweep(a: Args) -> Result<ExitCode, String> {
     run_streamed(
         &loader,
         count,
-        &|i| sweep.variant(i),
+        &|i| {
+            if pruning {
+                running
+                    .lock()
+                    .unwrap_or_else(PoisonError::into_inner)
+                    .insert(i);
+            }
+            sweep.variant(i)
+        },
         &options,
         &|done| {
             if let Some(b) = &bar {
@@ -190,7 +372,7 @@ pub(crate) fn sweep(a: Args) -> Result<ExitCode, String> {
         },
         Some(&stop),
         &mut |row: Row| {
-            let values = table::row_values(&names, &robots, &row);
+            let values = table::row_values_in(&names, &units, &robots, &row);
             tally.rows += 1;
             tally.feasible += usize::from(row.feasible());
             tally.collided += usize::from(row.collisions > 0);
@@ -200,8 +382,19 @@ pub(crate) fn sweep(a: Args) -> Result<ExitCode, String> {
             if write_error.is_none() {
                 write_error = writer.write(&values).err();
             }
+            if let Some(p) = &mut pruner {
+                running
+                    .lock()
+                    .unwrap_or_else(PoisonError::into_inner)
+                    .remove(&row.index);
+                p.offer(row.index, &columns, &values);
+            }
         },
     );
+    if let Some(p) = &mut pruner {
+        let stopped = std::mem::take(&mut *running.lock().unwrap_or_else(PoisonError::into_inner));
+        stopped.into_iter().for_each(|i| p.remove(i));
+    }
     let seconds = started.elapsed().as_secs_f64();
     if let Some(b) = &bar {
         b.finish_and_clear();
@@ -224,9 +417,9 @@ pub(crate) fn sweep(a: Args) -> Result<ExitCode, String> {
                 &a.file,
                 &out,
                 format,
-                columns.clone(),
-                &names,
-                &objective,
+                headers.clone(),
+                &header_of(&names, &headers),
+                &headers[columns.iter().position(|c| *c == objective).unwrap_or(0)],
                 &tally.best,
             ) {
                 Ok(()) => eprintln!("wrote {} and {}", out.display(), html.display()),
@@ -241,6 +434,36 @@ pub(crate) fn sweep(a: Args) -> Result<ExitCode, String> {
             "{m}; the page is made from the table: not written either"
         )),
     }
+    if let Some(dir) = &a.keep_logs {
+        let list = a.keep_logs_variants.as_deref().unwrap_or_default();
+        match &pruner {
+            Some(p) => {
+                let best: Vec<String> = p.kept().iter().map(usize::to_string).collect();
+                eprintln!(
+                    "kept in {} the logs of the {} best variants by {objective}{}{}",
+                    dir.display(),
+                    best.len(),
+                    if best.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" ({})", best.join(", "))
+                    },
+                    if list.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" and of variants {list}")
+                    },
+                );
+                for m in &p.failed {
+                    fail(m.clone());
+                }
+            }
+            None if !list.is_empty() => {
+                eprintln!("kept in {} the logs of variants {list}", dir.display());
+            }
+            None => {}
+        }
+    }
     if tally.logs_failed > 0 {
         fail(format!(
             "the logs of {} variants could not be written (`--keep-logs`): their rows say why",
@@ -252,9 +475,9 @@ pub(crate) fn sweep(a: Args) -> Result<ExitCode, String> {
         n => n,
     };
     eprintln!(
-        "{} variants in {seconds:.2} s ({:.0} variants/s, {jobs} jobs): {} completed, {} with a collision, {} deadlocked, {} with an error, {} stopped at `until`, {} timed out, {} invalid{}",
+        "{} variants in {seconds:.2} s ({} variants/s, {jobs} jobs): {} completed, {} with a collision, {} deadlocked, {} with an error, {} stopped at `until`, {} timed out, {} invalid{}",
         tally.rows,
-        tally.rows as f64 / seconds.max(1e-9),
+        per_second(tally.rows as f64 / seconds.max(1e-9)),
         tally.feasible,
         tally.collided,
         tally.count("deadlock"),
@@ -264,7 +487,7 @@ pub(crate) fn sweep(a: Args) -> Result<ExitCode, String> {
         tally.count("invalid"),
         if interrupted { " (interrupted)" } else { "" },
     );
-    print_best(&columns, &names, &objective, &tally.best);
+    print_best(&columns, &names, &units, &objective, &tally.best);
     Ok(if failed {
         ExitCode::FAILURE
     } else if interrupted {
@@ -293,7 +516,83 @@ fn write_page(
     page.commit().map_err(|e| e.to_string())
 }
 
-fn print_best(columns: &[String], names: &[String], objective: &str, best: &Best) {
+/// The progress bar: the rate with three significant digits (`466/s`, `12.5/s`).
+fn progress_style() -> indicatif::ProgressStyle {
+    indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} variants, {rate}, {eta} left")
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+        .with_key(
+            "rate",
+            |state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+                let _ = write!(w, "{}/s", per_second(state.per_sec()));
+            },
+        )
+}
+
+/// The headers (with units) of the variable columns `names`.
+fn header_of(names: &[String], headers: &[String]) -> Vec<String> {
+    // The variables are the columns after `variant`, in order.
+    headers.iter().skip(1).take(names.len()).cloned().collect()
+}
+
+/// `--keep-logs-best N`: the logs of the N best variants so far stay in the folder (and
+/// those of `--keep-logs-variants`); a variant's log is removed as soon as its row passes
+/// without being among them, or when a later one pushes it out.
+struct Pruner {
+    dir: PathBuf,
+    best: Best,
+    list: Option<VariantSet>,
+    /// Logs that could not be removed (the message).
+    failed: Vec<String>,
+}
+
+impl Pruner {
+    /// The variants among the best, best first.
+    fn kept(&self) -> Vec<usize> {
+        self.best
+            .rows()
+            .iter()
+            .filter_map(|r| match r.first() {
+                Some(Value::Int(i)) => usize::try_from(*i).ok(),
+                _ => None,
+            })
+            .collect()
+    }
+
+    fn offer(&mut self, index: usize, columns: &[String], values: &[Value]) {
+        let before = self.kept();
+        self.best.offer(columns, values);
+        let after = self.kept();
+        for i in before.into_iter().chain([index]) {
+            if !after.contains(&i) {
+                self.remove(i);
+            }
+        }
+    }
+
+    /// Removes variant `i`'s log, unless it is listed to keep.
+    fn remove(&mut self, i: usize) {
+        if self.list.as_ref().is_some_and(|l| l.contains(i)) {
+            return;
+        }
+        let path = self.dir.join(format!("variant-{i:05}.mcap"));
+        match std::fs::remove_file(&path) {
+            Ok(()) => {}
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => self.failed.push(format!(
+                "cannot remove `{}` (--keep-logs-best): {e}",
+                path.display()
+            )),
+        }
+    }
+}
+
+fn print_best(
+    columns: &[String],
+    names: &[String],
+    units: &[Option<Unit>],
+    objective: &str,
+    best: &Best,
+) {
     let column = |n: &str| columns.iter().position(|c| c == n);
     let best = best.rows();
     if best.is_empty() {
@@ -301,15 +600,36 @@ fn print_best(columns: &[String], names: &[String], objective: &str, best: &Best
         return;
     }
     let k = column(objective).unwrap_or(0);
+    // The objective's unit: a fixed column's (s, m) or a variable's.
+    let unit = table::fixed_unit(objective)
+        .map(str::to_string)
+        .or_else(|| {
+            let v = names.iter().position(|n| n == objective)?;
+            units.get(v)?.as_ref().map(|u| u.name.clone())
+        });
     crate::out!("best by {objective} (completed, no collision):");
     for row in best {
         let values: Vec<String> = names
             .iter()
-            .filter_map(|n| column(n))
-            .map(|c| format!("{} = {}", columns[c], cell(&row[c])))
+            .zip(units)
+            .filter_map(|(n, u)| Some((column(n)?, u)))
+            .map(|(c, u)| {
+                let unit = match (&row[c], u) {
+                    (Value::Num(_) | Value::Int(_), Some(u)) => u.name.as_str(),
+                    _ => "",
+                };
+                format!("{} = {}{unit}", columns[c], cell(&row[c]))
+            })
             .collect();
+        let objective_unit = match (&row[k], &unit) {
+            (Value::Num(_) | Value::Int(_), Some(u)) if table::fixed_unit(objective).is_some() => {
+                format!(" {u}")
+            }
+            (Value::Num(_) | Value::Int(_), Some(u)) => u.clone(),
+            _ => String::new(),
+        };
         crate::out!(
-            "  variant {}: {objective} {}  ({})",
+            "  variant {}: {objective} {}{objective_unit}  ({})",
             cell(&row[0]),
             cell(&row[k]),
             values.join(", ")

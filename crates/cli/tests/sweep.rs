@@ -328,3 +328,249 @@ fn a_device_output_is_neither_replaced_nor_removed() {
     }
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// A fresh folder with `files` (name, text).
+fn dir_with(name: &str, files: &[(&str, &str)]) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("vworks-sweep-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    for (f, text) in files {
+        std::fs::write(d.join(f), text).unwrap();
+    }
+    d
+}
+
+/// One robot whose program waits its param `wait` (1 s unless set): the run ends then.
+const WAITING_CELL: &str = "cycle = \"8ms\"\n[[robot]]\nname = \"r1\"\nmodel = \"irb120\"\nprogram = \"r1.wsl\"\nbase = { xyz = [\"650mm\", 0.1, \"0mm\"] }\n";
+const WAITING_PROGRAM: &str = "param wait = 1s;\nproc main() {\n    delay wait;\n}\n";
+
+/// `sweep --variables` listed names only: now each with its value, as the file writes it,
+/// or the value it has without the file saying (marked).
+#[test]
+fn variables_are_listed_with_their_values() {
+    let d = dir_with(
+        "variables",
+        &[("cell.toml", WAITING_CELL), ("r1.wsl", WAITING_PROGRAM)],
+    );
+    let out = vworks_in(&d, &["sweep", "--variables", "cell.toml"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let listed = text(&out.stdout);
+    let lines: Vec<&str> = listed.lines().collect();
+    for want in [
+        "cycle = 8ms",
+        "robot.r1.base.xyz.0 = 650mm",
+        "robot.r1.base.xyz.1 = 0.1",
+        "robot.r1.base.xyz.2 = 0mm",
+        "robot.r1.base.rpy.2 = 0deg  (not in the file)",
+        "robot.r1.params.wait = 1s  (not in the file)",
+        "params.wait = 1s in r1's program  (not in the file)",
+        "robot.r1.default_zone = fine  (not in the file)",
+    ] {
+        assert!(lines.contains(&want), "no `{want}` in:\n{listed}");
+    }
+    // Every line names a variable and a value.
+    assert!(
+        lines
+            .iter()
+            .all(|l| l.split_once(" = ").is_some_and(|(_, v)| !v.is_empty())),
+        "{listed}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// `robot.r2.base.xyz.0 = 0.5` for 500 mm: a variable written with a unit is shown in
+/// it, in the table's header and values, in the best variants and on the page; the
+/// objective may be named with or without its unit; the rate has three digits.
+#[test]
+fn results_keep_the_units_they_were_written_in() {
+    let d = dir_with(
+        "units",
+        &[
+            ("cell.toml", WAITING_CELL),
+            ("r1.wsl", WAITING_PROGRAM),
+            (
+                "s.toml",
+                "cell = \"cell.toml\"\n\
+                 [[variable]]\npath = \"robot.r1.base.xyz.0\"\nvalues = [\"450mm\", 0.5]\n\
+                 [[variable]]\npath = \"robot.r1.base.rpy.2\"\nrange = { from = \"0deg\", to = \"10deg\", steps = 3 }\n\
+                 [[variable]]\npath = \"params.wait\"\nvalues = [\"1500ms\", \"1s\"]\n",
+            ),
+        ],
+    );
+    let out = vworks_in(
+        &d,
+        &[
+            "sweep",
+            "s.toml",
+            "--best",
+            "2",
+            "--minimize",
+            "end_time [s]",
+        ],
+    );
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    let table = std::fs::read_to_string(d.join("s.csv")).unwrap();
+    let mut lines = table.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "variant,robot.r1.base.xyz.0 [mm],robot.r1.base.rpy.2 [deg],params.wait [ms],outcome,end_time [s],cycle_time.r1 [s],collisions,min_clearance [m],error"
+    );
+    // The product: the last variable changes fastest. 0.5 m is 500 mm; 1 s is 1000 ms.
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 12, "{table}");
+    let cells = |k: usize| rows.iter().map(|r| r[k]).collect::<Vec<_>>();
+    assert_eq!(
+        cells(1)[..7],
+        ["450", "450", "450", "450", "450", "450", "500"]
+    );
+    assert_eq!(cells(2)[..6], ["0", "0", "5", "5", "10", "10"]);
+    assert_eq!(cells(3)[..2], ["1500", "1000"]);
+    assert_eq!(cells(5)[..2], ["1.5", "1"]);
+    // The best: 1 s waits, smallest first (ties in variant order), in their units.
+    let best = text(&out.stdout);
+    assert_eq!(
+        best,
+        "best by end_time (completed, no collision):\n  \
+         variant 1: end_time 1 s  (robot.r1.base.xyz.0 = 450mm, robot.r1.base.rpy.2 = 0deg, params.wait = 1000ms)\n  \
+         variant 3: end_time 1 s  (robot.r1.base.xyz.0 = 450mm, robot.r1.base.rpy.2 = 5deg, params.wait = 1000ms)\n"
+    );
+    // The summary's rate: three significant digits (12 variants over the time it says).
+    let summary = err.lines().find(|l| l.contains(" variants in ")).unwrap();
+    let (seconds, rate) = summary
+        .strip_prefix("12 variants in ")
+        .and_then(|s| s.split_once(" s ("))
+        .map(|(t, rest)| (t, rest.split(' ').next().unwrap()))
+        .unwrap_or_else(|| panic!("{summary}"));
+    // Decimals only below 100, and then three significant digits at most.
+    let significant = rate
+        .chars()
+        .filter(char::is_ascii_digit)
+        .skip_while(|c| *c == '0')
+        .count();
+    assert!(!rate.contains('.') || significant <= 3, "{summary}");
+    let (seconds, rate): (f64, f64) = (seconds.parse().unwrap(), rate.parse().unwrap());
+    // The time is said to 10 ms: the rate lies between 12 over its ends (± its rounding).
+    let (slow, fast) = (12.0 / (seconds + 0.005), 12.0 / (seconds - 0.005).max(1e-9));
+    assert!(
+        rate >= slow * 0.995 - 0.5 && rate <= fast * 1.005 + 0.5,
+        "{summary}"
+    );
+    // JSON lines: the same keys as the CSV's header.
+    let out = vworks_in(&d, &["sweep", "s.toml", "-o", "t.jsonl", "-q"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let first = std::fs::read_to_string(d.join("t.jsonl")).unwrap();
+    assert!(
+        first.starts_with("{\"variant\":0,\"robot.r1.base.xyz.0 [mm]\":450.0,\"robot.r1.base.rpy.2 [deg]\":0.0,\"params.wait [ms]\":1500.0,\"outcome\":\"completed\",\"end_time [s]\":1.5,"),
+        "{first}"
+    );
+    // The page names the columns with their units.
+    let page = std::fs::read_to_string(d.join("s.html")).unwrap();
+    assert!(page.contains("robot.r1.base.xyz.0 [mm]") && page.contains("id=\"colorbar\""));
+    // A unit that is not the column's is no column.
+    let out = vworks_in(&d, &["sweep", "s.toml", "--minimize", "end_time [ms]"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        text(&out.stderr).contains("--minimize: `end_time [ms]` is not a numeric column"),
+        "{}",
+        text(&out.stderr)
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// The files of a logs folder, sorted.
+fn logs_in(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(|e| Some(e.ok()?.file_name().to_string_lossy().into_owned()))
+        .collect();
+    names.sort();
+    names
+}
+
+/// `--keep-logs` kept every variant's log: `--keep-logs-variants` writes only the listed
+/// ones, `--keep-logs-best N` keeps the N best by the objective (and the listed).
+#[test]
+fn keep_logs_can_keep_only_some_variants() {
+    let d = dir_with(
+        "keep",
+        &[
+            ("cell.toml", WAITING_CELL),
+            ("r1.wsl", WAITING_PROGRAM),
+            (
+                "s.toml",
+                "cell = \"cell.toml\"\n[[variable]]\npath = \"params.wait\"\nvalues = [\"3s\", \"1s\", \"2s\", \"500ms\", \"4s\", \"2500ms\"]\n",
+            ),
+        ],
+    );
+    let log = |i: usize| format!("variant-{i:05}.mcap");
+    let out = vworks_in(
+        &d,
+        &[
+            "sweep",
+            "s.toml",
+            "-q",
+            "--keep-logs",
+            "a",
+            "--keep-logs-variants",
+            "4,0-1",
+        ],
+    );
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert_eq!(logs_in(&d.join("a")), [log(0), log(1), log(4)]);
+    assert!(
+        err.contains("kept in a the logs of variants 4,0-1"),
+        "{err}"
+    );
+    // The best 2 by end_time: 500ms (3) and 1s (1); with variant 5 listed too.
+    let out = vworks_in(
+        &d,
+        &[
+            "sweep",
+            "s.toml",
+            "-q",
+            "--jobs",
+            "2",
+            "--keep-logs",
+            "b",
+            "--keep-logs-best",
+            "2",
+            "--keep-logs-variants",
+            "5",
+        ],
+    );
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert_eq!(logs_in(&d.join("b")), [log(1), log(3), log(5)]);
+    assert!(
+        err.contains(
+            "kept in b the logs of the 2 best variants by end_time (3, 1) and of variants 5"
+        ),
+        "{err}"
+    );
+    // Wrong lists and numbers are errors before anything runs.
+    for (args, says) in [
+        (
+            &["--keep-logs", "c", "--keep-logs-variants", "2,x"][..],
+            "--keep-logs-variants: `x` is not a variant number",
+        ),
+        (
+            &["--keep-logs", "c", "--keep-logs-variants", "6"],
+            "--keep-logs-variants: variant 6 is not one of this sweep's 6 (0 to 5)",
+        ),
+        (&["--keep-logs-best", "2"], "--keep-logs"),
+        (
+            &["--keep-logs", "c", "--keep-logs-best", "0"],
+            "--keep-logs-best",
+        ),
+    ] {
+        let out = vworks_in(&d, &[&["sweep", "s.toml"][..], args].concat());
+        let err = text(&out.stderr);
+        assert_ne!(out.status.code(), Some(0), "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err}");
+        assert!(!err.contains("variants in"), "{args:?} ran: {err}");
+    }
+    assert!(!d.join("c").exists());
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -103,6 +103,7 @@ pub(crate) fn run_variants<'py>(
             jobs: jobs.unwrap_or(0),
             until_ns,
             keep_logs: None,
+            keep_logs_of: None,
             variant_timeout: None,
         };
         let mut rows = vworks_sweep::run_variants(&loader, &parsed, &options, &|_| {}, Some(&stop));

@@ -1,13 +1,17 @@
 //! The sweep's page: one self-contained HTML file (inline SVG, no script, nothing loaded)
 //! with the objective over one variable (a scatter) or two (a heatmap), the best variants
-//! and the whole table.
+//! and the whole table. The columns are named as the table file names them, with their
+//! units (`robot.r2.base.xyz.0 [mm]`, `end_time [s]`): the axes' titles and the colour
+//! bar's say them, and the ticks are the values in those units.
 //!
-//! - One numeric variable: the objective of each variant against it; feasible variants
-//!   (completed, no collision) as blue dots, collisions as red crosses, other outcomes
-//!   grey.
-//! - Two or more: a heatmap over the first two, each cell the best feasible objective over
-//!   the other variables (lighter is smaller), red where every variant of the cell
-//!   collided, grey where none completed.
+//! - One numeric variable: the objective of each variant against it, with ticks on both
+//!   axes; feasible variants (completed, no collision) as blue dots, collisions as red
+//!   crosses, other outcomes (deadlock, error, timeout, `until`) grey; a legend says so.
+//! - Two or more: a heatmap over the first two, a tick at each value; each cell the best
+//!   feasible objective over the other variables, on a colour bar from dark blue
+//!   (smallest: best) to light grey (largest); red where none completed without a
+//!   collision and one collided, grey where none completed, white where no variant ran;
+//!   a legend says so, with how many cells each.
 
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
@@ -81,6 +85,9 @@ pub fn write_page(
 body {{ font: 14px/1.4 system-ui, sans-serif; margin: 24px; color: #222; }}
 table {{ border-collapse: collapse; }} th, td {{ padding: 2px 8px; border-bottom: 1px solid #eee; text-align: right; font-variant-numeric: tabular-nums; }}
 th {{ background: #f6f6f6; }} .none {{ color: #888; }}
+#legend {{ list-style: none; padding: 0; margin: 8px 0 16px; display: flex; flex-wrap: wrap; gap: 6px 20px; }}
+#legend li {{ display: flex; align-items: center; gap: 6px; }}
+.swatch {{ display: inline-block; width: 14px; height: 14px; border: 1px solid #aaa; }}
 </style></head><body>
 <h1>vworks sweep: {t}</h1>
 <p>{n} variants · objective: {o} (smaller is better) · {feasible_count} completed without collision</p>
@@ -143,10 +150,20 @@ fn table_row(out: &mut dyn Write, row: &[Value]) -> io::Result<()> {
     out.write_all(s.as_bytes())
 }
 
-const W: f64 = 720.0;
-const H: f64 = 420.0;
-const L: f64 = 80.0;
-const B: f64 = 50.0;
+const W: f64 = 760.0;
+const H: f64 = 460.0;
+/// The plot's left edge (room for the y ticks and title).
+const L: f64 = 96.0;
+/// Below the plot: the x ticks and title.
+const B: f64 = 64.0;
+/// Above the plot.
+const T: f64 = 16.0;
+/// Right of the plot: room for the heatmap's colour bar.
+const R: f64 = 170.0;
+
+const BLUE: &str = "#2f6fdf";
+const RED: &str = "#d62728";
+const GREY: &str = "#bbbbbb";
 
 fn span(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
@@ -161,17 +178,75 @@ fn span(values: impl Iterator<Item = f64>) -> (f64, f64) {
     }
 }
 
-/// The titles of the chart's axes: `x` under it, `y` turned along its left side.
-fn axis_titles(s: &mut String, x: &str, y: &str) {
+/// A value as a tick shows it: 12 significant digits at most (no conversion noise).
+fn label(v: f64) -> String {
+    let v: f64 = format!("{v:.11e}").parse().unwrap_or(v);
+    format!("{}", v + 0.0)
+}
+
+/// Ticks at round numbers (1, 2 or 5 × 10ⁿ apart) from `lo` to `hi`, about `n` of them.
+fn nice_ticks(lo: f64, hi: f64, n: usize) -> Vec<f64> {
+    let raw = (hi - lo) / n.max(1) as f64;
+    if !(raw.is_finite() && raw > 0.0) {
+        return vec![lo];
+    }
+    let mag = 10f64.powf(raw.log10().floor());
+    let step = [1.0, 2.0, 5.0, 10.0]
+        .iter()
+        .map(|m| m * mag)
+        .find(|s| *s >= raw)
+        .unwrap_or(10.0 * mag);
+    let first = (lo / step).ceil() as i64;
+    let last = (hi / step).floor() as i64;
+    (first..=last).map(|k| k as f64 * step).collect()
+}
+
+/// The titles of the chart's axes: `x` under the plot, `y` turned along its left side.
+fn axis_titles(s: &mut String, right: f64, x: &str, y: &str) {
     let _ = write!(
         s,
-        r##"<text x="{cx:.1}" y="{ty:.1}" font-size="13" text-anchor="middle">{x}</text><text x="14" y="{cy:.1}" font-size="13" transform="rotate(-90 14 {cy:.1})" text-anchor="middle">{y}</text>"##,
-        cx = (L + W - 20.0) / 2.0,
-        ty = H - 12.0,
-        cy = (H - B) / 2.0,
+        r##"<text class="axis-title" id="x-title" x="{cx:.1}" y="{ty:.1}" font-size="13" text-anchor="middle">{x}</text><text class="axis-title" id="y-title" x="16" y="{cy:.1}" font-size="13" transform="rotate(-90 16 {cy:.1})" text-anchor="middle">{y}</text>"##,
+        cx = (L + right) / 2.0,
+        ty = H - 14.0,
+        cy = (T + H - B) / 2.0,
         x = esc(x),
         y = esc(y),
     );
+}
+
+/// A tick under the plot at `at` (x) or left of it (y), with its label.
+fn tick(s: &mut String, axis: char, at: f64, text: &str) {
+    let text = esc(text);
+    let _ = match axis {
+        'x' => write!(
+            s,
+            r##"<g class="tick x-tick"><line x1="{at:.1}" y1="{y0:.1}" x2="{at:.1}" y2="{y1:.1}" stroke="#666"/><text x="{at:.1}" y="{ty:.1}" font-size="11" text-anchor="middle">{text}</text></g>"##,
+            y0 = H - B,
+            y1 = H - B + 5.0,
+            ty = H - B + 18.0,
+        ),
+        _ => write!(
+            s,
+            r##"<g class="tick y-tick"><line x1="{x0:.1}" y1="{at:.1}" x2="{L:.1}" y2="{at:.1}" stroke="#666"/><text x="{tx:.1}" y="{ty:.1}" font-size="11" text-anchor="end">{text}</text></g>"##,
+            x0 = L - 5.0,
+            tx = L - 8.0,
+            ty = at + 4.0,
+        ),
+    };
+}
+
+/// The legend under the chart: a swatch (or a mark) and what it means, per entry.
+fn legend(out: &mut dyn Write, entries: &[(String, String)]) -> io::Result<()> {
+    let mut s = String::from("<ul id=\"legend\">");
+    for (mark, text) in entries {
+        let _ = write!(s, "<li>{mark}<span>{}</span></li>", esc(text));
+    }
+    s.push_str("</ul>\n");
+    out.write_all(s.as_bytes())
+}
+
+fn swatch(colour: &str, class: &str) -> String {
+    format!("<span class=\"swatch {class}\" style=\"background:{colour}\"></span>")
 }
 
 /// A number ordered by `total_cmp`: a key of the sets of distinct values.
@@ -205,6 +280,7 @@ fn scatter(out: &mut dyn Write, rows: &dyn Rows, x: usize, o: usize) -> io::Resu
     let none = (f64::INFINITY, f64::NEG_INFINITY);
     let (mut xr, mut yr) = (none, none);
     let widen = |r: &mut (f64, f64), v: f64| *r = (r.0.min(v), r.1.max(v));
+    let mut counts = [0usize; 3];
     rows.for_each_row(&mut |r| {
         if let Some(xv) = r[x].number() {
             widen(&mut xr, xv);
@@ -215,28 +291,26 @@ fn scatter(out: &mut dyn Write, rows: &dyn Rows, x: usize, o: usize) -> io::Resu
     })?;
     let (x0, x1) = span([xr.0, xr.1].into_iter().filter(|v| v.is_finite()));
     let (y0, y1) = span([yr.0, yr.1].into_iter().filter(|v| v.is_finite()));
-    let px = |v: f64| L + (W - L - 20.0) * (v - x0) / (x1 - x0);
-    let py = |v: f64| H - B - (H - B - 20.0) * (v - y0) / (y1 - y0);
+    let right = W - 24.0;
+    let px = |v: f64| L + 8.0 + (right - L - 16.0) * (v - x0) / (x1 - x0);
+    let py = |v: f64| H - B - 8.0 - (H - B - T - 16.0) * (v - y0) / (y1 - y0);
     let mut s = format!(
-        r##"<svg id="chart" xmlns="http://www.w3.org/2000/svg" viewBox="0 0 {W} {H}" width="{W}" role="img"><rect x="{L}" y="20" width="{w}" height="{h}" fill="none" stroke="#ccc"/>"##,
-        w = W - L - 20.0,
-        h = H - B - 20.0
+        r##"<svg id="chart" xmlns="http://www.w3.org/2000/svg" viewBox="0 0 {W} {H}" width="{W}" role="img"><rect x="{L}" y="{T}" width="{w}" height="{h}" fill="none" stroke="#ccc"/>"##,
+        w = right - L,
+        h = H - B - T
     );
-    for (v, at) in [(x0, px(x0)), (x1, px(x1))] {
+    for v in nice_ticks(x0, x1, 6) {
+        tick(&mut s, 'x', px(v), &label(v));
+    }
+    for v in nice_ticks(y0, y1, 6) {
         let _ = write!(
             s,
-            r##"<text x="{at:.1}" y="{y:.1}" font-size="11" text-anchor="middle">{v:.4}</text>"##,
-            y = H - B + 16.0
+            r##"<line x1="{L}" y1="{at:.1}" x2="{right}" y2="{at:.1}" stroke="#eee"/>"##,
+            at = py(v)
         );
+        tick(&mut s, 'y', py(v), &label(v));
     }
-    for (v, at) in [(y0, py(y0)), (y1, py(y1))] {
-        let _ = write!(
-            s,
-            r##"<text x="{x:.1}" y="{at:.1}" font-size="11" text-anchor="end">{v:.4}</text>"##,
-            x = L - 6.0
-        );
-    }
-    axis_titles(&mut s, &columns[x], &columns[o]);
+    axis_titles(&mut s, right, &columns[x], &columns[o]);
     out.write_all(s.as_bytes())?;
     let mut failed = Ok(());
     rows.for_each_row(&mut |r| {
@@ -245,29 +319,64 @@ fn scatter(out: &mut dyn Write, rows: &dyn Rows, x: usize, o: usize) -> io::Resu
         };
         let (cx, cy) = (px(xv), py(yv));
         let i = num(&r[0]);
+        let at = format!("{} = {}, {} = {}", columns[x], label(xv), columns[o], label(yv));
+        let at = esc(&at);
         let dot = if feasible(columns, r) {
+            counts[0] += 1;
             format!(
-                r##"<circle class="feasible" cx="{cx:.1}" cy="{cy:.1}" r="4" fill="#2f6fdf"><title>variant {i}</title></circle>"##
+                r##"<circle class="feasible" cx="{cx:.1}" cy="{cy:.1}" r="4" fill="{BLUE}"><title>variant {i}: {at}</title></circle>"##
             )
         } else if collided(columns, r) {
+            counts[1] += 1;
             format!(
-                r##"<path class="collision" d="M{a:.1} {b:.1} l8 8 m0 -8 l-8 8" stroke="#d62728" stroke-width="2"><title>variant {i}: collision</title></path>"##,
+                r##"<path class="collision" d="M{a:.1} {b:.1} l8 8 m0 -8 l-8 8" stroke="{RED}" stroke-width="2"><title>variant {i}: collision, {at}</title></path>"##,
                 a = cx - 4.0,
                 b = cy - 4.0
             )
         } else {
+            counts[2] += 1;
             format!(
-                r##"<circle class="other" cx="{cx:.1}" cy="{cy:.1}" r="3" fill="#999"><title>variant {i}</title></circle>"##
+                r##"<circle class="other" cx="{cx:.1}" cy="{cy:.1}" r="3" fill="#999"><title>variant {i}: {at}</title></circle>"##
             )
         };
         failed = out.write_all(dot.as_bytes());
     })?;
     failed?;
-    out.write_all(b"</svg>\n")
+    out.write_all(b"</svg>\n")?;
+    legend(
+        out,
+        &[
+            (
+                format!(
+                    r##"<svg width="14" height="14"><circle cx="7" cy="7" r="4" fill="{BLUE}"/></svg>"##
+                ),
+                format!("completed without a collision ({})", counts[0]),
+            ),
+            (
+                format!(
+                    r##"<svg width="14" height="14"><path d="M3 3 l8 8 m0 -8 l-8 8" stroke="{RED}" stroke-width="2"/></svg>"##
+                ),
+                format!("collision ({})", counts[1]),
+            ),
+            (
+                r##"<svg width="14" height="14"><circle cx="7" cy="7" r="3" fill="#999"/></svg>"##
+                    .to_string(),
+                format!(
+                    "did not complete: deadlock, error, timeout or stopped at `until` ({})",
+                    counts[2]
+                ),
+            ),
+        ],
+    )
 }
 
 /// Cells of a heatmap at most: more distinct values than this are not charted.
 const MAX_CELLS: usize = 250_000;
+
+/// The heatmap's colour of `t` in 0..=1: dark blue (0, the smallest) to light grey (1).
+fn colour(t: f64) -> (f64, f64, f64) {
+    (40.0 + 200.0 * t, 90.0 + 150.0 * t, 200.0 + 40.0 * t)
+}
 
 fn heatmap(out: &mut dyn Write, rows: &dyn Rows, x: usize, y: usize, o: usize) -> io::Result<()> {
     let columns = rows.columns();
@@ -312,42 +421,154 @@ fn heatmap(out: &mut dyn Write, rows: &dyn Rows, x: usize, y: usize, o: usize) -
         }
     })?;
     let (lo, hi) = span(cells.iter().filter_map(|c| c.0));
-    let cw = (W - L - 20.0) / xs.len() as f64;
-    let ch = (H - B - 20.0) / ys.len() as f64;
+    let right = W - R;
+    let cw = (right - L) / xs.len() as f64;
+    let ch = (H - B - T) / ys.len() as f64;
     let mut s = format!(
         r##"<svg id="chart" xmlns="http://www.w3.org/2000/svg" viewBox="0 0 {W} {H}" width="{W}" role="img">"##
     );
+    let mut counts = [0usize; 4];
     for (b, yv) in ys.iter().enumerate() {
         for (a, xv) in xs.iter().enumerate() {
             let (best, hit, n) = cells[b * xs.len() + a];
             let (fill, what) = match best {
                 Some(v) => {
-                    let t = (v - lo) / (hi - lo);
-                    let (r, g, bl) = (40.0 + 200.0 * t, 90.0 + 150.0 * t, 200.0 + 40.0 * t);
-                    (format!("rgb({r:.0},{g:.0},{bl:.0})"), format!("{v:.6}"))
+                    counts[0] += 1;
+                    let (r, g, bl) = colour((v - lo) / (hi - lo));
+                    (
+                        format!("rgb({r:.0},{g:.0},{bl:.0})"),
+                        format!("{} = {}", columns[o], label(v)),
+                    )
                 }
-                None if hit => ("#d62728".to_string(), "collision".to_string()),
-                None if n > 0 => ("#bbbbbb".to_string(), "did not complete".to_string()),
-                None => ("#ffffff".to_string(), "no variant".to_string()),
+                None if hit => {
+                    counts[1] += 1;
+                    (RED.to_string(), "collision".to_string())
+                }
+                None if n > 0 => {
+                    counts[2] += 1;
+                    (GREY.to_string(), "did not complete".to_string())
+                }
+                None => {
+                    counts[3] += 1;
+                    ("#ffffff".to_string(), "no variant".to_string())
+                }
             };
             let _ = write!(
                 s,
                 r##"<rect class="cell" x="{rx:.1}" y="{ry:.1}" width="{cw:.1}" height="{ch:.1}" fill="{fill}" stroke="#fff"><title>{xn} = {xv}, {yn} = {yv}: {what}</title></rect>"##,
                 rx = L + a as f64 * cw,
-                ry = 20.0 + (ys.len() - 1 - b) as f64 * ch,
+                ry = T + (ys.len() - 1 - b) as f64 * ch,
                 xn = esc(&columns[x]),
                 yn = esc(&columns[y]),
+                xv = label(*xv),
+                yv = label(*yv),
+                what = esc(&what),
             );
         }
     }
-    let range = |name: &str, v: &[f64]| {
-        let (a, b) = (
-            v.first().copied().unwrap_or(0.0),
-            v.last().copied().unwrap_or(0.0),
+    // A tick at each value (every k-th when there are many), centred on its column/row.
+    let every = |n: usize, room: f64| (n as f64 / room).ceil().max(1.0) as usize;
+    let kx = every(xs.len(), (right - L) / 40.0);
+    for (a, v) in xs.iter().enumerate().filter(|(a, _)| a % kx == 0) {
+        tick(&mut s, 'x', L + (a as f64 + 0.5) * cw, &label(*v));
+    }
+    let ky = every(ys.len(), (H - B - T) / 20.0);
+    for (b, v) in ys.iter().enumerate().filter(|(b, _)| b % ky == 0) {
+        tick(
+            &mut s,
+            'y',
+            T + (ys.len() - 1 - b) as f64 * ch + ch / 2.0,
+            &label(*v),
         );
-        format!("{name} ({a} … {b})")
-    };
-    axis_titles(&mut s, &range(&columns[x], &xs), &range(&columns[y], &ys));
+    }
+    axis_titles(&mut s, right, &columns[x], &columns[y]);
+    colour_bar(&mut s, lo, hi, counts[0] > 0, &columns[o]);
     s.push_str("</svg>\n");
-    out.write_all(s.as_bytes())
+    out.write_all(s.as_bytes())?;
+    legend(
+        out,
+        &[
+            (
+                r##"<span class="swatch scale" style="background:linear-gradient(90deg, rgb(40,90,200), rgb(240,240,240))"></span>"##.to_string(),
+                format!(
+                    "the best {} of the variants here that completed without a collision, on the colour bar: darker is smaller (better) ({} cells)",
+                    columns[o], counts[0]
+                ),
+            ),
+            (
+                swatch(RED, "collision"),
+                format!(
+                    "none completed without a collision, and one or more collided ({} cells)",
+                    counts[1]
+                ),
+            ),
+            (
+                swatch(GREY, "incomplete"),
+                format!(
+                    "none completed: deadlock, error, timeout, stopped at `until`, or invalid ({} cells)",
+                    counts[2]
+                ),
+            ),
+            (
+                swatch("#ffffff", "empty"),
+                format!("no variant ({} cells)", counts[3]),
+            ),
+        ],
+    )
+}
+
+/// The heatmap's colour bar, right of the plot: the gradient from `lo` (bottom, dark) to
+/// `hi` (top, light), ticks with the objective's values, and its name (with its unit).
+fn colour_bar(s: &mut String, lo: f64, hi: f64, any: bool, name: &str) {
+    let (x, w) = (W - R + 24.0, 16.0);
+    let (top, bottom) = (T, H - B);
+    let (r0, g0, b0) = colour(0.0);
+    let (r1, g1, b1) = colour(1.0);
+    let _ = write!(
+        s,
+        r##"<g id="colorbar"><defs><linearGradient id="scale" x1="0" y1="1" x2="0" y2="0"><stop offset="0" stop-color="rgb({r0:.0},{g0:.0},{b0:.0})"/><stop offset="1" stop-color="rgb({r1:.0},{g1:.0},{b1:.0})"/></linearGradient></defs><rect x="{x}" y="{top}" width="{w}" height="{h}" fill="url(#scale)" stroke="#999"/>"##,
+        h = bottom - top,
+    );
+    if any {
+        let at = |v: f64| bottom - (bottom - top) * (v - lo) / (hi - lo);
+        let mut ticks = nice_ticks(lo, hi, 5);
+        // The ends too, unless a round tick is about there.
+        for end in [lo, hi] {
+            if ticks.iter().all(|t| (at(*t) - at(end)).abs() > 12.0) {
+                ticks.push(end);
+            }
+        }
+        ticks.sort_by(f64::total_cmp);
+        // The ends to a hundredth of the ticks' step (not every digit of 65.656295395).
+        let step = nice_ticks(lo, hi, 5)
+            .windows(2)
+            .map(|w| w[1] - w[0])
+            .next()
+            .unwrap_or(hi - lo);
+        let decimals = (2.0 - step.log10().floor()).clamp(0.0, 12.0) as usize;
+        for v in ticks {
+            let text = if v == lo || v == hi {
+                label(format!("{v:.decimals$}").parse().unwrap_or(v))
+            } else {
+                label(v)
+            };
+            let _ = write!(
+                s,
+                r##"<g class="tick bar-tick"><line x1="{x1:.1}" y1="{y:.1}" x2="{x2:.1}" y2="{y:.1}" stroke="#666"/><text x="{tx:.1}" y="{ty:.1}" font-size="11">{t}</text></g>"##,
+                x1 = x + w,
+                x2 = x + w + 4.0,
+                y = at(v),
+                tx = x + w + 7.0,
+                ty = at(v) + 4.0,
+                t = esc(&text),
+            );
+        }
+    }
+    let cy = (top + bottom) / 2.0;
+    let tx = W - 14.0;
+    let _ = write!(
+        s,
+        r##"<text class="axis-title" id="colorbar-title" x="{tx}" y="{cy:.1}" font-size="13" transform="rotate(-90 {tx} {cy:.1})" text-anchor="middle">{n}</text></g>"##,
+        n = esc(name),
+    );
 }

@@ -40,7 +40,7 @@ pub mod stream;
 pub mod table;
 
 pub use run::{Row, run_streamed, run_variants};
-pub use table::Table;
+pub use table::{Table, Unit};
 
 /// Why a sweep could not be set up (a run that fails is a row of the table, not this).
 #[derive(Debug, thiserror::Error)]
@@ -127,6 +127,10 @@ pub struct Variable {
     pub paths: Vec<String>,
     /// Its values, as the workcell file would write them.
     pub values: Values,
+    /// The unit its values were written in (`"450mm"`: mm), in which the table and the
+    /// page show them; `None` for plain numbers (shown as they are). See
+    /// [`Unit::of_values`].
+    pub unit: Option<Unit>,
 }
 
 /// A variable's values: a list, or made when asked for (a range or random samples of
@@ -333,10 +337,17 @@ impl Sweep {
                     ));
                 }
             };
+            let unit = match (&v.values, &v.range, &v.random) {
+                (Some(list), ..) => Unit::of_values(list),
+                (_, Some(r), _) => Unit::of_values(&[r.from.clone(), r.to.clone()]),
+                (.., Some(r)) => Unit::of_values(&[r.from.clone(), r.to.clone()]),
+                _ => None,
+            };
             variables.push(Variable {
                 path: paths[0].clone(),
                 paths,
                 values,
+                unit,
             });
         }
         let count = match combine {
@@ -424,16 +435,23 @@ impl Sweep {
     }
 
     /// Checks that `objective` is a numeric column of the table this sweep makes of a
-    /// cell with these `robots` (before any variant runs); `Err` names the columns.
-    pub fn check_objective(&self, objective: &str, robots: &[String]) -> Result<(), String> {
+    /// cell with these `robots` (before any variant runs), named as the table file's
+    /// header does (`end_time [s]`, `robot.r2.base.xyz.0 [mm]`) or without its unit
+    /// (`end_time`); `Ok` is the column's name without the unit. `Err` names the columns.
+    pub fn check_objective(&self, objective: &str, robots: &[String]) -> Result<String, String> {
         let variables: Vec<(String, bool)> = self
             .variables
             .iter()
             .map(|v| (v.path.clone(), v.values.numeric()))
             .collect();
         let numeric = table::numeric_columns(&variables, robots);
-        if numeric.iter().any(|c| c == objective) {
-            return Ok(());
+        let units = self.units();
+        let keys = table::columns(&self.names(), robots);
+        let headers = table::headers(&self.names(), &units, robots);
+        if let Some(k) = table::find_column(&keys, &headers, objective)
+            && numeric.contains(&keys[k])
+        {
+            return Ok(keys[k].clone());
         }
         Err(format!(
             "`{objective}` is not a numeric column of the table; choose one of {}",
@@ -441,9 +459,38 @@ impl Sweep {
         ))
     }
 
+    /// The variables' names (their first paths): the table's variable columns.
+    pub fn names(&self) -> Vec<String> {
+        self.variables.iter().map(|v| v.path.clone()).collect()
+    }
+
+    /// The unit each variable is shown in (see [`Variable::unit`]).
+    pub fn units(&self) -> Vec<Option<Unit>> {
+        self.variables.iter().map(|v| v.unit.clone()).collect()
+    }
+
     /// Every variant, in order (for a few; a large sweep asks for [`Sweep::variant`]).
     pub fn variants(&self) -> Vec<Vec<Override>> {
         (0..self.count()).map(|i| self.variant(i)).collect()
+    }
+}
+
+/// A rate (per second) as the progress bar and the summary show it: three significant
+/// digits, and no decimals from 100 up (`467`, `12.5`, `3.21`, `0.0123`).
+pub fn per_second(x: f64) -> String {
+    if !x.is_finite() || x < 0.0 {
+        return "–".into();
+    }
+    if x == 0.0 {
+        return "0".into();
+    }
+    // The digits after the point that leave three significant ones (none from 100 up).
+    let decimals = (2 - x.log10().floor() as i32).clamp(0, 12) as usize;
+    let s = format!("{x:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
     }
 }
 
@@ -527,4 +574,27 @@ fn splitmix64_unit(seed: u64, k: usize) -> f64 {
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     z ^= z >> 31;
     (z >> 11) as f64 / (1u64 << 53) as f64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rates_have_three_significant_digits() {
+        for (x, want) in [
+            (466.6466, "467"),
+            (1234.6, "1235"),
+            (99.96, "100"),
+            (65.32, "65.3"),
+            (12.5, "12.5"),
+            (20.0, "20"),
+            (3.214, "3.21"),
+            (0.012345, "0.0123"),
+            (0.0, "0"),
+            (f64::NAN, "–"),
+        ] {
+            assert_eq!(per_second(x), want, "{x}");
+        }
+    }
 }

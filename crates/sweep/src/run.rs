@@ -125,8 +125,66 @@ pub struct RunOptions {
     pub until_ns: Option<i64>,
     /// Write each variant's MCAP log into this folder (`variant-00042.mcap`).
     pub keep_logs: Option<std::path::PathBuf>,
+    /// With `keep_logs`: only these variants' logs (`None`: every variant's).
+    pub keep_logs_of: Option<VariantSet>,
     /// Stop a variant that runs longer than this (wall time): its row is a `timeout`.
     pub variant_timeout: Option<Duration>,
+}
+
+/// Variant numbers, as `--keep-logs-variants 3,7,10-12` lists them: single numbers and
+/// ranges (both ends included), in any order.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct VariantSet {
+    /// Sorted, disjoint ranges (both ends included).
+    ranges: Vec<(usize, usize)>,
+}
+
+impl VariantSet {
+    /// Reads `3,7,10-12`; `Err` says which part is wrong and what to write.
+    pub fn parse(text: &str) -> Result<VariantSet, String> {
+        let mut ranges = Vec::new();
+        for part in text.split(',') {
+            let part = part.trim();
+            let number = |s: &str| s.trim().parse::<usize>().ok();
+            let range = match part.split_once('-') {
+                None => number(part).map(|n| (n, n)),
+                Some((a, b)) => number(a).zip(number(b)),
+            };
+            match range {
+                Some((a, b)) if a <= b => ranges.push((a, b)),
+                Some((a, b)) => {
+                    return Err(format!(
+                        "`{part}` is a range from {a} down to {b}; write it from the smaller: {b}-{a}"
+                    ));
+                }
+                None => {
+                    return Err(format!(
+                        "`{part}` is not a variant number or a range of them; write e.g. 3,7,10-12"
+                    ));
+                }
+            }
+        }
+        ranges.sort_unstable();
+        let mut merged: Vec<(usize, usize)> = Vec::new();
+        for (a, b) in ranges {
+            match merged.last_mut() {
+                Some(last) if a <= last.1.saturating_add(1) => last.1 = last.1.max(b),
+                _ => merged.push((a, b)),
+            }
+        }
+        Ok(VariantSet { ranges: merged })
+    }
+
+    /// Whether variant `i` is one of them.
+    pub fn contains(&self, i: usize) -> bool {
+        let at = self.ranges.partition_point(|(_, b)| *b < i);
+        self.ranges.get(at).is_some_and(|(a, _)| *a <= i)
+    }
+
+    /// The largest number listed.
+    pub fn last(&self) -> Option<usize> {
+        self.ranges.last().map(|(_, b)| *b)
+    }
 }
 
 /// Rows started at most this far past the first one not yet done: the rows held
@@ -400,7 +458,12 @@ fn run_with(
     if let Some(stop) = stop {
         sim = sim.with_stop(Arc::clone(stop));
     }
-    if let Some(dir) = &options.keep_logs {
+    if let Some(dir) = &options.keep_logs
+        && options
+            .keep_logs_of
+            .as_ref()
+            .is_none_or(|of| of.contains(index))
+    {
         let path = dir.join(format!("variant-{index:05}.mcap"));
         match McapLog::create(Path::new(&path), &cell, 1) {
             Ok(log) => sim = sim.with_log(log),
@@ -455,6 +518,23 @@ mod tests {
         let want: Vec<usize> = (0..count).filter(|i| i % 7 != 3).collect();
         assert_eq!(got, want);
         assert!(held < window, "{held} rows held, the window is {window}");
+    }
+
+    #[test]
+    fn variant_sets_read_numbers_and_ranges() {
+        let s = VariantSet::parse("10-12, 3,7,11-13").unwrap();
+        let got: Vec<usize> = (0..20).filter(|i| s.contains(*i)).collect();
+        assert_eq!(got, [3, 7, 10, 11, 12, 13]);
+        assert_eq!(s.last(), Some(13));
+        for (bad, says) in [
+            ("3,x", "`x` is not a variant number"),
+            ("", "`` is not a variant number"),
+            ("5-2", "write it from the smaller: 2-5"),
+            ("-1", "`-1` is not a variant number"),
+        ] {
+            let e = VariantSet::parse(bad).unwrap_err();
+            assert!(e.contains(says), "{bad}: {e}");
+        }
     }
 
     #[test]

@@ -1,8 +1,13 @@
 //! The sweep's table: one row per variant, the same columns for every row —
-//! `variant`, each variable (SI numbers where the value is a quantity), `outcome`,
-//! `end_time` (s), `cycle_time.ROBOT` (s) for each robot, `collisions`,
-//! `min_clearance` (m), `error` — written as CSV or JSON lines, and the best variants by
-//! an objective.
+//! `variant`, each variable, `outcome`, `end_time` (s), `cycle_time.ROBOT` (s) for each
+//! robot, `collisions`, `min_clearance` (m), `error` — written as CSV or JSON lines, and
+//! the best variants by an objective.
+//!
+//! A [`Table`] (what Python's `vworks.sweep` returns) names its columns without units and
+//! holds SI numbers. The table file that `vworks sweep` writes states the units in its
+//! header ([`headers`]: `robot.r2.base.xyz.0 [mm]`, `end_time [s]`) and shows a variable
+//! written with a unit in that unit ([`row_values_in`]: `"500mm"` is 500), as the sweep
+//! file wrote it.
 
 use std::fmt::Write as _;
 
@@ -76,6 +81,168 @@ fn shown(v: &toml::Value) -> Value {
         },
         other => Value::Text(other.to_string()),
     }
+}
+
+/// The unit a variable's values were written in, in which the table file and the page
+/// show them: its name as written and the size of one of it in SI.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Unit {
+    /// As written: `mm`, `deg`, `mm/s`, `%`.
+    pub name: String,
+    /// One of it in SI (`mm`: 0.001, `deg`: π/180).
+    pub si: f64,
+    dim: vworks_vm::Dim,
+}
+
+impl Unit {
+    /// The unit of these values (a variable's list, or a range's two ends): the first
+    /// unit written, if every value written with a unit has its dimension and every other
+    /// value is a plain number (SI, shown converted); else `None` (the values are shown
+    /// as SI numbers, or as text).
+    pub fn of_values(values: &[toml::Value]) -> Option<Unit> {
+        let mut unit: Option<Unit> = None;
+        for v in values {
+            match v {
+                toml::Value::Integer(_) | toml::Value::Float(_) => {}
+                toml::Value::String(s) => match written(s) {
+                    Some((_, u)) => match &unit {
+                        None => unit = Some(u),
+                        Some(first) if first.dim == u.dim => {}
+                        Some(_) => return None,
+                    },
+                    None if matches!(
+                        vworks_cell::parse_quantity(s),
+                        Some(vworks_cell::Quantity::Number(_))
+                    ) => {}
+                    None => return None,
+                },
+                _ => return None,
+            }
+        }
+        unit
+    }
+}
+
+/// A quantity as written, `"450mm"`: the number as written (450) and its unit (`mm`);
+/// `None` for anything else (a plain number, not a quantity).
+fn written(text: &str) -> Option<(f64, Unit)> {
+    use vworks_cell::{Quantity, parse_quantity};
+    let Some(Quantity::WithUnit(_, dim)) = parse_quantity(text) else {
+        return None;
+    };
+    let t = text.trim();
+    let (sign, body) = match t.strip_prefix('-') {
+        Some(rest) => (-1.0, rest.trim_start()),
+        None => (1.0, t),
+    };
+    // The number: digits, a fraction, an exponent (the lexer's grammar); then the unit.
+    let b = body.as_bytes();
+    let mut end = 0;
+    while end < b.len() && b[end].is_ascii_digit() {
+        end += 1;
+    }
+    if end + 1 < b.len() && b[end] == b'.' && b[end + 1].is_ascii_digit() {
+        end += 1;
+        while end < b.len() && b[end].is_ascii_digit() {
+            end += 1;
+        }
+    }
+    if end < b.len() && matches!(b[end], b'e' | b'E') {
+        let digits = match b.get(end + 1) {
+            Some(b'+' | b'-') => end + 2,
+            _ => end + 1,
+        };
+        if b.get(digits).is_some_and(u8::is_ascii_digit) {
+            end = digits;
+            while end < b.len() && b[end].is_ascii_digit() {
+                end += 1;
+            }
+        }
+    }
+    let number: f64 = body[..end].parse().ok()?;
+    let name = body[end..].trim().to_string();
+    let si = match parse_quantity(&format!("1{name}"))? {
+        Quantity::WithUnit(x, _) => x,
+        Quantity::Number(_) => return None,
+    };
+    Some((sign * number, Unit { name, si, dim }))
+}
+
+/// A number without the noise of a unit conversion (`0.3 / 0.001` is
+/// 299.99999999999994): rounded to 12 significant digits.
+fn tidy(x: f64) -> f64 {
+    format!("{x:.11e}").parse().unwrap_or(x)
+}
+
+/// A variable's value as the table file shows it in `unit`: the number as written if it
+/// was written in that unit (`"500mm"`: 500), else its SI value converted (0.5: 500).
+pub fn in_unit(v: &toml::Value, unit: Option<&Unit>) -> Value {
+    let Some(unit) = unit else {
+        return shown(v);
+    };
+    if let toml::Value::String(s) = v
+        && let Some((x, u)) = written(s)
+        && u.name == unit.name
+    {
+        return Value::Num(x);
+    }
+    match v {
+        toml::Value::String(s) if written(s).is_some_and(|(_, u)| u.dim != unit.dim) => shown(v),
+        _ => match shown(v).number() {
+            Some(x) => Value::Num(tidy(x / unit.si)),
+            None => shown(v),
+        },
+    }
+}
+
+/// The unit of a column that is not a variable's: `s` for `end_time` and
+/// `cycle_time.ROBOT`, `m` for `min_clearance`; `None` for the others.
+pub fn fixed_unit(column: &str) -> Option<&'static str> {
+    if column == "end_time" || column.starts_with("cycle_time.") {
+        Some("s")
+    } else if column == "min_clearance" {
+        Some("m")
+    } else {
+        None
+    }
+}
+
+/// A column's header in the table file: its name, and its unit in brackets if it has one
+/// (`end_time [s]`).
+pub fn header(name: &str, unit: Option<&str>) -> String {
+    match unit {
+        Some(u) if !u.is_empty() => format!("{name} [{u}]"),
+        _ => name.to_string(),
+    }
+}
+
+/// The table file's header: [`columns`] with their units (each variable's `units`, and
+/// the [`fixed_unit`]s).
+pub fn headers(variables: &[String], units: &[Option<Unit>], robots: &[String]) -> Vec<String> {
+    columns(variables, robots)
+        .iter()
+        .enumerate()
+        .map(|(k, c)| {
+            let unit = if (1..=variables.len()).contains(&k) {
+                units
+                    .get(k - 1)
+                    .and_then(Option::as_ref)
+                    .map(|u| u.name.as_str())
+            } else {
+                fixed_unit(c)
+            };
+            header(c, unit)
+        })
+        .collect()
+}
+
+/// The column a user named, by its name (`end_time`) or its header (`end_time [s]`).
+pub fn find_column(columns: &[String], headers: &[String], name: &str) -> Option<usize> {
+    let name = name.trim();
+    columns
+        .iter()
+        .position(|c| c == name)
+        .or_else(|| headers.iter().position(|h| h == name))
 }
 
 /// Rows of a table, visited in order: a [`Table`] in memory, or a table file read back
@@ -169,6 +336,23 @@ pub fn row_values(variables: &[String], robots: &[String], r: &Row) -> Vec<Value
     out.push(Value::Int(r.collisions as i64));
     out.push(r.min_clearance.map_or(Value::Empty, Value::Num));
     out.push(Value::Text(r.error.clone()));
+    out
+}
+
+/// One row of the table file: [`row_values`], each variable shown in its unit
+/// ([`in_unit`]).
+pub fn row_values_in(
+    variables: &[String],
+    units: &[Option<Unit>],
+    robots: &[String],
+    r: &Row,
+) -> Vec<Value> {
+    let mut out = row_values(variables, robots, r);
+    for (k, (v, unit)) in variables.iter().zip(units).enumerate() {
+        if let Some(x) = r.values.iter().rev().find(|(p, _)| p == v).map(|(_, x)| x) {
+            out[k + 1] = in_unit(x, unit.as_ref());
+        }
+    }
     out
 }
 

@@ -8,6 +8,7 @@ use std::sync::Arc;
 
 use vworks_cell::{Disk, Loader, MemoryFiles, Override};
 use vworks_sweep::run::{RunOptions, run_one};
+use vworks_sweep::table::{self, Value};
 use vworks_sweep::{Combine, Sweep, Table, run_variants};
 
 fn root() -> PathBuf {
@@ -269,8 +270,25 @@ fn the_objective_is_checked_before_running() {
         "robot.r2.base.xyz.0",
         "collisions",
     ] {
-        assert_eq!(sweep.check_objective(ok, &robots), Ok(()), "{ok}");
+        assert_eq!(
+            sweep.check_objective(ok, &robots),
+            Ok(ok.to_string()),
+            "{ok}"
+        );
     }
+    // Named as the table file's header names it, with its unit, too.
+    for (header, key) in [
+        ("end_time [s]", "end_time"),
+        ("cycle_time.r2 [s]", "cycle_time.r2"),
+        ("robot.r2.base.xyz.0 [mm]", "robot.r2.base.xyz.0"),
+    ] {
+        assert_eq!(
+            sweep.check_objective(header, &robots),
+            Ok(key.to_string()),
+            "{header}"
+        );
+    }
+    assert!(sweep.check_objective("end_time [ms]", &robots).is_err());
     let e = sweep.check_objective("cycle_time.r3", &robots).unwrap_err();
     assert!(
         e.starts_with("`cycle_time.r3` is not a numeric column of the table; choose one of variant, robot.r2.base.xyz.0, robot.r2.base.xyz.1, end_time, cycle_time.r1, cycle_time.r2, collisions, min_clearance"),
@@ -348,4 +366,66 @@ fn a_log_that_cannot_be_written_is_the_variants_error() {
     );
     assert_eq!(rows[1].outcome, "completed");
     assert!(!rows[1].log_failed);
+}
+
+/// `robot.r2.base.xyz.0 = 0.5` for 500 mm, `5deg` as 0.0873: a variable written with a
+/// unit is shown in it, its header says it, and plain numbers stay as they are.
+#[test]
+fn the_table_file_shows_each_variable_in_the_unit_it_was_written_in() {
+    let s = sweep_of(
+        "cell = \"c.toml\"\n\
+         [[variable]]\npath = \"robot.r2.base.xyz.0\"\nrange = { from = \"250mm\", to = \"750mm\", steps = 11 }\n\
+         [[variable]]\npath = \"robot.r2.base.rpy.2\"\nvalues = [\"5deg\", \"-12.5deg\", 0.5]\n\
+         [[variable]]\npath = \"params.speed\"\nvalues = [\"200mm/s\", 0.3]\n\
+         [[variable]]\npath = \"cycle\"\nvalues = [0.004, 0.008]\n\
+         [[variable]]\npath = \"clearance\"\nvalues = [\"5mm\", \"4ms\"]\n",
+    )
+    .unwrap();
+    let units: Vec<Option<String>> = s
+        .variables
+        .iter()
+        .map(|v| v.unit.as_ref().map(|u| u.name.clone()))
+        .collect();
+    // Plain numbers: no unit; values of two dimensions: none either (SI, as before).
+    assert_eq!(
+        units,
+        [Some("mm"), Some("deg"), Some("mm/s"), None, None].map(|u| u.map(String::from))
+    );
+    let robots = vec!["r1".to_string()];
+    assert_eq!(
+        table::headers(&s.names(), &s.units(), &robots),
+        [
+            "variant",
+            "robot.r2.base.xyz.0 [mm]",
+            "robot.r2.base.rpy.2 [deg]",
+            "params.speed [mm/s]",
+            "cycle",
+            "clearance",
+            "outcome",
+            "end_time [s]",
+            "cycle_time.r1 [s]",
+            "collisions",
+            "min_clearance [m]",
+            "error",
+        ]
+    );
+    let shown = |k: usize, v: usize| {
+        let value = s.variables[k].values.get(v);
+        table::in_unit(&value, s.variables[k].unit.as_ref())
+    };
+    // A range's values are made in SI (0.25 + 0.05 k m): shown in mm as the ends were.
+    let range: Vec<Value> = (0..11).map(|v| shown(0, v)).collect();
+    let want: Vec<Value> = (0..11)
+        .map(|k| Value::Num(250.0 + 50.0 * k as f64))
+        .collect();
+    assert_eq!(range, want);
+    // As written; a plain number is SI, shown converted: 0.5 rad is 180/π · 0.5 deg.
+    assert_eq!(shown(1, 0), Value::Num(5.0));
+    assert_eq!(shown(1, 1), Value::Num(-12.5));
+    let deg = shown(1, 2).number().unwrap();
+    assert!((deg - 0.5_f64.to_degrees()).abs() < 1e-9, "{deg}");
+    assert_eq!(shown(2, 0), Value::Num(200.0));
+    assert_eq!(shown(2, 1), Value::Num(300.0));
+    assert_eq!(shown(3, 1), Value::Num(0.008));
+    assert_eq!(shown(4, 0), Value::Num(0.005));
 }
