@@ -5,6 +5,7 @@ without pandas, and `to_pandas()` makes the DataFrame."""
 
 import csv
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -12,6 +13,7 @@ from pathlib import Path
 import pytest
 
 import vworks
+from browser import Browser
 
 ROOT = Path(__file__).resolve().parents[2]
 VWORKS = os.environ.get("VWORKS", str(ROOT / "target" / "debug" / "vworks"))
@@ -164,10 +166,16 @@ def test_the_cli_writes_the_same_table(local, tmp_path):
     with open(tmp_path / "sweep.csv") as f:
         rows = list(csv.DictReader(f))
     assert len(rows) == 40
+    # The file states units: x was written in mm (shown so); y in plain SI numbers (no
+    # unit); times in s. The Python table keeps SI numbers under the bare names.
+    assert list(rows[0])[:6] == ["variant", "robot.r2.base.xyz.0 [mm]", "robot.r2.base.xyz.1", "cycle [ms]",
+                                 "outcome", "end_time [s]"]
     for row, want in zip(rows, local):
         assert row["outcome"] == want["outcome"]
-        assert float(row["end_time"]) == want["end_time"]
+        assert float(row["end_time [s]"]) == want["end_time"]
+        assert float(row["robot.r2.base.xyz.0 [mm]"]) == pytest.approx(want["robot.r2.base.xyz.0"] * 1000, abs=1e-9)
         assert float(row["robot.r2.base.xyz.1"]) == want["robot.r2.base.xyz.1"]
+        assert float(row["cycle [ms]"]) == pytest.approx(want["cycle"] * 1000, abs=1e-12)
     page = (tmp_path / "sweep.html").read_text()
     assert '<svg id="chart"' in page and "class=\"cell\"" in page  # a heatmap over two variables
 
@@ -219,4 +227,133 @@ def test_keep_logs_writes_each_variants_log_with_its_values(tmp_path):
         (meta,) = [m for m in make_reader(f).iter_metadata() if m.name == "vworks"]
     assert meta.metadata["overrides"] == "robot.r2.base.xyz.0 = 0.65"
     lines = (tmp_path / "t.jsonl").read_text().splitlines()
-    assert len(lines) == 2 and lines[1].startswith('{"variant":1,"robot.r2.base.xyz.0":0.65,"outcome":"until"')
+    # 0.65 (SI) in the column of "600mm": 650 mm.
+    assert len(lines) == 2 and lines[1].startswith('{"variant":1,"robot.r2.base.xyz.0 [mm]":650.0,"outcome":"until"')
+
+
+@pytest.fixture(scope="module")
+def browser(tmp_path_factory):
+    with Browser(tmp_path_factory.mktemp("chromium")) as b:
+        yield b
+
+
+def open_page(b, page):
+    """Opens `page` in Chromium with this load's events only."""
+    b.events.clear()
+    b.open("about:blank")
+    b.events.clear()
+    b.open(page.as_uri())
+    b.frames(2)
+
+
+def clean(b, page):
+    """No console error or exception, and no request but the page itself."""
+    assert b.errors() == []
+    assert set(b.requests()) <= {page.as_uri(), "about:blank"}, b.requests()
+
+
+def handoff_in(tmp_path, sweep_text):
+    """The handoff cell copied into `tmp_path` with a sweep file; runs `vworks sweep` and
+    returns (the table's rows, the page's path)."""
+    for f in ("cell.toml", "r1.wsl", "r2.wsl"):
+        (tmp_path / f).write_text((ROOT / "workcells" / "handoff" / f).read_text())
+    (tmp_path / "sweep.toml").write_text(sweep_text)
+    out = subprocess.run([VWORKS, "sweep", str(tmp_path / "sweep.toml"), "-q"], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    with open(tmp_path / "sweep.csv") as f:
+        rows = list(csv.DictReader(f))
+    return rows, tmp_path / "sweep.html"
+
+
+def boxes(b, selector):
+    """The rendered boxes (x, y, width, height) of the elements matching `selector`."""
+    return b.eval(
+        f"Array.from(document.querySelectorAll({selector!r})).map(function (e) {{"
+        " var r = e.getBoundingClientRect(); return [r.x, r.y, r.width, r.height]; })"
+    )
+
+
+def texts(b, selector):
+    return b.eval(f"Array.from(document.querySelectorAll({selector!r})).map(function (e) {{ return e.textContent; }})")
+
+
+def test_the_heatmap_has_labelled_axes_a_colour_bar_and_a_legend(browser, tmp_path):
+    """The heatmap had no colour scale, no legend for red and grey, no ticks: in Chromium,
+    its axes are titled with their units and ticked with each value as written, the colour
+    bar spans the best end times, and the legend explains every colour, with counts that
+    match the table."""
+    xs, ys = ["250mm", "500mm", "600mm"], ["250mm", "450mm", "600mm"]
+    rows, page = handoff_in(
+        tmp_path,
+        'cell = "cell.toml"\n'
+        f'[[variable]]\npath = ["robot.r2.base.xyz.0", "robot.r2.params.base_x"]\nvalues = {xs!r}\n'.replace("'", '"')
+        + f'[[variable]]\npath = ["robot.r2.base.xyz.1", "robot.r2.params.base_y"]\nvalues = {ys!r}\n'.replace("'", '"'),
+    )
+    assert len(rows) == 9
+    open_page(browser, page)
+    clean(browser, page)
+    # Axes: titles with units, a tick per value, as written (without the unit), in order.
+    assert texts(browser, "#x-title") == ["robot.r2.base.xyz.0 [mm]"]
+    assert texts(browser, "#y-title") == ["robot.r2.base.xyz.1 [mm]"]
+    assert texts(browser, ".x-tick text") == [v.removesuffix("mm") for v in xs]
+    assert sorted(texts(browser, ".y-tick text"), key=float) == [v.removesuffix("mm") for v in ys]
+    x_ticks = boxes(browser, ".x-tick text")
+    assert all(w > 0 and h > 0 for _, _, w, h in x_ticks)
+    assert [x for x, *_ in x_ticks] == sorted(x for x, *_ in x_ticks)
+    # Left to right, each tick's label lies under its column of cells.
+    cells = boxes(browser, "rect.cell")
+    columns = sorted({round(x + w / 2) for x, _, w, _ in cells})
+    assert [round(x + w / 2) for x, _, w, _ in x_ticks] == pytest.approx(columns, abs=2)
+    # The colour bar: drawn, titled with the objective and its unit, ticked within the best
+    # end times of the variants that completed without a collision.
+    ((_, _, bar_w, bar_h),) = boxes(browser, "#colorbar rect")
+    assert bar_w > 5 and bar_h > 100
+    assert texts(browser, "#colorbar-title") == ["end_time [s]"]
+    feasible = [float(r["end_time [s]"]) for r in rows if r["outcome"] == "completed" and r["collisions"] == "0"]
+    assert len(feasible) >= 2
+    ticks = [float(t) for t in texts(browser, ".bar-tick text")]
+    assert len(ticks) >= 2
+    lo, hi = min(feasible), max(feasible)
+    assert all(lo - 1e-3 <= t <= hi + 1e-3 for t in ticks), (ticks, lo, hi)
+    # The legend: every colour said, with as many cells as the table gives.
+    legend = texts(browser, "#legend li")
+    assert len(legend) == 4, legend
+    assert all(w > 0 and h > 0 for _, _, w, h in boxes(browser, "#legend li"))
+    collided = sum(1 for r in rows if r["outcome"] == "collision")
+    others = sum(1 for r in rows if r["outcome"] not in ("completed", "collision"))
+    assert f"({len(feasible)} cells)" in legend[0] and "colour bar" in legend[0]
+    assert "collided" in legend[1] and f"({collided} cells)" in legend[1]
+    assert "none completed" in legend[2] and f"({others} cells)" in legend[2]
+    assert "no variant (0 cells)" in legend[3]
+    fills = browser.eval("Array.from(document.querySelectorAll('rect.cell')).map(function (e) { return e.getAttribute('fill'); })")
+    assert fills.count("#d62728") == collided and collided >= 1
+    # The tables' headers say the units too.
+    headers = texts(browser, "#all th")
+    assert "robot.r2.base.xyz.0 [mm]" in headers and "end_time [s]" in headers
+
+
+def test_the_one_variable_chart_has_ticks_and_a_legend(browser, tmp_path):
+    rows, page = handoff_in(
+        tmp_path,
+        'cell = "cell.toml"\n[[variable]]\npath = "robot.r2.base.rpy.2"\n'
+        'range = { from = "170deg", to = "190deg", steps = 5 }\n',
+    )
+    assert [r["robot.r2.base.rpy.2 [deg]"] for r in rows] == ["170", "175", "180", "185", "190"]
+    open_page(browser, page)
+    clean(browser, page)
+    assert texts(browser, "#x-title") == ["robot.r2.base.rpy.2 [deg]"]
+    assert texts(browser, "#y-title") == ["end_time [s]"]
+    x_ticks = [float(t) for t in texts(browser, ".x-tick text")]
+    assert len(x_ticks) >= 3 and x_ticks == sorted(x_ticks) and 170 <= x_ticks[0] and x_ticks[-1] <= 190
+    assert len(texts(browser, ".y-tick text")) >= 2
+    # The legend: each mark said, with as many variants as the table gives.
+    legend = texts(browser, "#legend li")
+    feasible = sum(1 for r in rows if r["outcome"] == "completed" and r["collisions"] == "0")
+    collided = sum(1 for r in rows if r["outcome"] == "collision")
+    assert legend[0] == f"completed without a collision ({feasible})"
+    assert legend[1] == f"collision ({collided})"
+    assert legend[2].startswith("did not complete") and legend[2].endswith(f"({5 - feasible - collided})")
+    assert browser.eval("document.querySelectorAll('#chart circle.feasible').length") == feasible
+    assert all(w > 0 for _, _, w, _ in boxes(browser, "#legend li"))
+    # Nothing from elsewhere: one file.
+    assert not re.search(r"""(src|href)=["']?(https?:|//)""", page.read_text())
