@@ -1,6 +1,7 @@
 //! `vworks sweep` as a user runs it — the table streamed as rows finish, Ctrl-C and a
-//! kill, the per-variant wall-time limit, checks before running, full disks — and every
-//! output of the CLI refusing to overwrite an input.
+//! kill, the per-variant wall-time limit, checks before running, full disks, the units of
+//! the table and the best, `--variables` with values, keeping only some variants' logs —
+//! and every output of the CLI refusing to overwrite an input.
 
 #![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)] // tests fail by panicking
 
@@ -572,5 +573,47 @@ fn keep_logs_can_keep_only_some_variants() {
         assert!(!err.contains("variants in"), "{args:?} ran: {err}");
     }
     assert!(!d.join("c").exists());
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// With `--keep-logs-best`, Ctrl-C leaves the best so far: the log of the variant that
+/// was stopped (it has no row) goes with those that were not among the best.
+#[cfg(unix)]
+#[test]
+fn keep_logs_best_after_ctrl_c_keeps_only_the_best() {
+    let d = sweep_dir("keepint", "[0, 0, 1, 0]");
+    let child = spawn_in(
+        &d,
+        &[
+            "sweep",
+            "s.toml",
+            "--jobs",
+            "1",
+            "-q",
+            "--keep-logs",
+            "logs",
+            "--keep-logs-best",
+            "1",
+        ],
+    );
+    partial_rows_named(&d, "s.csv", 2);
+    // Variant 2 (endless) is running: its log is being written.
+    for _ in 0..1200 {
+        if d.join("logs/variant-00002.mcap").exists() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    assert!(d.join("logs/variant-00002.mcap").exists());
+    signal(&child, "-INT");
+    let out = child.wait_with_output().unwrap();
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    // Variants 0 and 1 both end at 1 s: the earlier is the best.
+    assert_eq!(logs_in(&d.join("logs")), ["variant-00000.mcap"], "{err}");
+    assert!(
+        err.contains("kept in logs the logs of the 1 best variants by end_time (0)"),
+        "{err}"
+    );
     let _ = std::fs::remove_dir_all(&d);
 }
