@@ -4,12 +4,15 @@
 import os
 import sys
 
+import pytest
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(ROOT, "bench"))
 
 import compare  # noqa: E402
 
 
+@pytest.mark.oracle
 def test_pinocchio_and_pybullet_run_the_benchmark_cell(monkeypatch):
     monkeypatch.setattr(compare, "CYCLES", 25)
     qs, bases = compare.trajectory()
@@ -40,6 +43,7 @@ def test_vworks_also_sees_the_arms_35_cm_apart_collide(tmp_path):
     assert result.collisions, result.outcome
 
 
+@pytest.mark.oracle
 def test_the_simpy_models_count_their_events():
     ping_pong, ring = compare.simpy_models()
     assert ping_pong(100) >= 200

@@ -13,6 +13,8 @@ import time
 import zipfile
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[2]
 BACKEND = ROOT / "crates" / "py" / "build_backend" / "vworks_build.py"
 
@@ -59,6 +61,7 @@ def test_the_relay_keeps_lines_and_turns_the_bar_into_status_lines():
     assert re.fullmatch(r"vworks: compiling the Rust extension: 1/3 steps, 1m0[12]s; now parry3d-f64", status[-1])
 
 
+@pytest.mark.oracle
 def test_pip_wheel_shows_cargos_progress_on_the_terminal(tmp_path):
     """`pip wheel ./crates/py` (no -v) in a terminal: the backend's lines are there,
     cargo's own lines are not (pip kept them). Built with the dev profile, whose artifacts

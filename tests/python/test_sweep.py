@@ -123,6 +123,7 @@ def test_a_local_sweep_needs_no_pandas():
     assert lines[2] == "None"  # nothing replaced the block: pandas was never imported
 
 
+@pytest.mark.oracle
 def test_a_local_ray_cluster_gives_the_same_table(local):
     import ray
     ray.init(address="local", num_cpus=2, include_dashboard=False, _node_ip_address="127.0.0.1",
@@ -137,6 +138,7 @@ def test_a_local_ray_cluster_gives_the_same_table(local):
         ray.shutdown()
 
 
+@pytest.mark.oracle
 def test_a_dask_local_cluster_gives_the_same_table(local):
     from dask.distributed import Client, LocalCluster
 
