@@ -138,6 +138,17 @@ def test_a_collision_is_marked_in_the_chart_and_listed(browser, tmp_path):
     assert dom.count('class="collision"') == 1
     assert re.search(r"<table id=\"collisions\">.*left\.link_6 right\.link_6", dom, re.S)
     assert "near miss" in dom  # the warning before the collision
+    # The collision row names each robot's motion, as rendered text: both arms were in
+    # their one move_j (workcells/crash, left.wsl and right.wsl line 3).
+    statement = "move_j joints(0deg, 60deg, -30deg, 0deg, 30deg, 0deg) speed 50%;"
+    row = browser.eval("document.querySelector('#collisions tr:nth-child(2)').innerText")
+    assert f"left moving: left.wsl:3:5 {statement}" in row, row
+    assert f"right moving: right.wsl:3:5 {statement}" in row, row
+    near = browser.eval("document.querySelector('#issues tr:nth-child(2)').innerText")
+    assert "near miss" in near and f"left moving: left.wsl:3:5 {statement}" in near, near
+    # Durations in the event table are seconds, like its time column.
+    events = browser.eval("document.getElementById('events').innerText")
+    assert "move_j duration=" in events and " s\t" in events and "duration=0." in events, events[:400]
     browser.eval("document.getElementById('gantt').scrollIntoView()")
     left, top, right, bottom = rect(browser, "#gantt")
     shot = browser.screenshot(tmp_path / "crash.png")
