@@ -78,3 +78,9 @@ def test_the_readme_tour_prints_what_it_shows(tmp_path):
     # The cell check the tour describes in words.
     check = subprocess.run([vworks, "check", "mycell"], cwd=tmp_path, capture_output=True, text=True)
     assert check.stderr.endswith("checked cell mycell: 1 program, 0 errors, 0 warnings\n"), check.stderr
+
+
+def test_the_readme_counts_the_error_cases():
+    readme = (ROOT / "README.md").read_text()
+    (count,) = re.findall(r"`tests/errors/` holds (\d+) of them", readme)
+    assert int(count) == len(list((ROOT / "tests" / "errors").glob("*.case")))
