@@ -87,12 +87,12 @@ enum Command {
         #[arg(long)]
         json: bool,
         /// Print the event trace, one line per event, times in seconds
-        /// (`7.220474304 s r1 set gopartsready=1 r1.mod:37:7`).
-        #[arg(long)]
+        /// (`7.220474304 s r1 set gopartsready=1 r1.mod:37:7`); the summary goes to stderr.
+        #[arg(long, conflicts_with = "json")]
         trace: bool,
         /// Print the event trace with times in integer nanoseconds (`7220474304 r1 set …`):
         /// the format of `vworks log events` and the golden files.
-        #[arg(long, conflicts_with = "trace")]
+        #[arg(long, conflicts_with_all = ["trace", "json"])]
         trace_ns: bool,
         /// Write the run to this MCAP file (events, cycle states, geometry; opens in Foxglove).
         #[arg(long)]
@@ -157,7 +157,8 @@ enum LogCommand {
         /// The .mcap file.
         file: PathBuf,
     },
-    /// The event trace, in the same format as `run --trace`.
+    /// The event trace, in the same format as `run --trace-ns` (integer ns; `--seconds`:
+    /// as `run --trace`).
     Events {
         /// The .mcap file.
         file: PathBuf,
@@ -413,7 +414,8 @@ fn read_log(what: LogCommand) -> Result<ExitCode, String> {
             out!("{}", file.display());
             for (topic, n) in &log.counts {
                 let topic = vworks_se::trace::escape_controls(topic);
-                out!("  {topic:<10} {n:>8} messages");
+                let word = if *n == 1 { "message" } else { "messages" };
+                out!("  {topic:<10} {n:>8} {word}");
             }
             if let Some((first, last)) = log.span {
                 out!(
@@ -831,82 +833,14 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
             "{}",
             serde_json::to_string_pretty(&v).map_err(|e| e.to_string())?
         );
-    } else if trace.is_none() {
-        // Names and messages from the workcell, escaped as log texts are.
-        use vworks_se::trace::escape_controls as esc;
-        out!(
-            "cell {}: {} at {}",
-            esc(&cell.name),
-            r.outcome.name(),
-            secs(r.end_time_ns)
-        );
-        out!(
-            "{:<10} {:>10} {:>10} {:>10} {:>8}  ended",
-            "robot",
-            "moving",
-            "waiting",
-            "idle",
-            "motions"
-        );
-        for s in &r.robots {
-            out!(
-                "{:<10} {:>10} {:>10} {:>10} {:>8}  {} at {}",
-                esc(&s.name),
-                secs(s.moving_ns),
-                secs(s.waiting_ns),
-                secs(s.idle_ns),
-                s.motions,
-                s.ended.name(),
-                secs(s.end_time_ns)
-            );
-        }
-        for c in &r.collisions {
-            out!(
-                "collision at {}: {} and {} (depth {:.1} mm)",
-                secs(c.time_ns),
-                esc(&c.a),
-                esc(&c.b),
-                c.depth * 1e3
-            );
-            for m in &c.motions {
-                out!("  {}", esc(&m.describe()));
-            }
-        }
-        // (The compile and link warnings, which open the list, were printed with their
-        // source lines.)
-        for w in r.warnings.iter().skip(cell.warnings.len()) {
-            out!("warning[{}]: {}", w.kind, esc(&w.message));
-            for m in &w.motions {
-                out!("  {}", esc(&m.describe()));
-            }
-        }
-        for e in &r.errors {
-            let at = e.file.as_ref().map_or(String::new(), |f| {
-                format!(" ({}:{}:{})", esc(f), e.line, e.col)
-            });
-            out!("error[{}]: {}{at}", e.kind, esc(&e.message));
-        }
-        if !r.globals.is_empty() {
-            let g: Vec<String> = r.globals.iter().map(|(k, v)| format!("{k}={v}")).collect();
-            out!("globals: {}", g.join(", "));
-        }
-        out!(
-            "{} events, {} cycles, {} collision queries; {:.0}x real time",
-            r.trace.len(),
-            r.cycles,
-            r.queries,
-            r.end_time_ns as f64 / 1e9 / wall.max(1e-9)
-        );
-        if let Some(p) = log {
-            if r.log_error.is_some() {
-                out!("log {}: not written (see the error above)", p.display());
+    } else {
+        // With a trace on stdout, the summary goes to stderr after it (a pipe gets the
+        // trace alone).
+        for line in summary(&r, &cell, wall, log) {
+            if trace.is_some() {
+                eprintln!("{line}");
             } else {
-                let counts: Vec<String> = r
-                    .log_counts
-                    .iter()
-                    .map(|(topic, n)| format!("{n} {topic}"))
-                    .collect();
-                out!("log {}: {}", p.display(), counts.join(", "));
+                out!("{line}");
             }
         }
     }
@@ -923,6 +857,98 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
         vworks_se::engine::Outcome::Interrupted => ExitCode::from(130),
         _ => ExitCode::FAILURE,
     })
+}
+
+/// The summary of a run, line by line: the outcome, a line per robot, the collisions and
+/// near misses with each robot's motion, warnings, errors, globals, counts and the log.
+fn summary(
+    r: &vworks_se::engine::RunResult,
+    cell: &vworks_cell::Cell,
+    wall: f64,
+    log: Option<&Path>,
+) -> Vec<String> {
+    let mut lines = Vec::new();
+    macro_rules! line {
+        ($($arg:tt)*) => { lines.push(format!($($arg)*)) };
+    }
+    // Names and messages from the workcell, escaped as log texts are.
+    use vworks_se::trace::escape_controls as esc;
+    line!(
+        "cell {}: {} at {}",
+        esc(&cell.name),
+        r.outcome.name(),
+        secs(r.end_time_ns)
+    );
+    line!(
+        "{:<10} {:>10} {:>10} {:>10} {:>8}  ended",
+        "robot",
+        "moving",
+        "waiting",
+        "idle",
+        "motions"
+    );
+    for s in &r.robots {
+        line!(
+            "{:<10} {:>10} {:>10} {:>10} {:>8}  {} at {}",
+            esc(&s.name),
+            secs(s.moving_ns),
+            secs(s.waiting_ns),
+            secs(s.idle_ns),
+            s.motions,
+            s.ended.name(),
+            secs(s.end_time_ns)
+        );
+    }
+    for c in &r.collisions {
+        line!(
+            "collision at {}: {} and {} (depth {:.1} mm)",
+            secs(c.time_ns),
+            esc(&c.a),
+            esc(&c.b),
+            c.depth * 1e3
+        );
+        for m in &c.motions {
+            line!("  {}", esc(&m.describe()));
+        }
+    }
+    // (The compile and link warnings, which open the list, were printed with their
+    // source lines.)
+    for w in r.warnings.iter().skip(cell.warnings.len()) {
+        line!("warning[{}]: {}", w.kind, esc(&w.message));
+        for m in &w.motions {
+            line!("  {}", esc(&m.describe()));
+        }
+    }
+    for e in &r.errors {
+        let at = e.file.as_ref().map_or(String::new(), |f| {
+            format!(" ({}:{}:{})", esc(f), e.line, e.col)
+        });
+        line!("error[{}]: {}{at}", e.kind, esc(&e.message));
+    }
+    if !r.globals.is_empty() {
+        let g: Vec<String> = r.globals.iter().map(|(k, v)| format!("{k}={v}")).collect();
+        line!("globals: {}", g.join(", "));
+    }
+    line!(
+        "{} events, {} cycles, {} collision queries; {:.0}x real time",
+        r.trace.len(),
+        r.cycles,
+        r.queries,
+        r.end_time_ns as f64 / 1e9 / wall.max(1e-9)
+    );
+    if let Some(p) = log {
+        if r.log_error.is_some() {
+            line!("log {}: not written (see the error above)", p.display());
+        } else {
+            let counts: Vec<String> = r
+                .log_counts
+                .iter()
+                .map(|(topic, n)| format!("{n} {topic}"))
+                .collect();
+            line!("log {}: {}", p.display(), counts.join(", "));
+        }
+    }
+    lines
 }
 
 fn plural(n: usize, word: &str) -> String {

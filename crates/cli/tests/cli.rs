@@ -295,6 +295,14 @@ fn run_until_and_trace() {
         }
     }
     assert!(people.contains(" duration=1.3 s "), "{people}");
+    // The summary is not dropped: it follows on stderr (a pipe gets the trace alone).
+    let err = text(&out.stderr);
+    assert!(err.starts_with("cell handoff: until at 2.000 s\n"), "{err}");
+    assert!(!people.contains("cell handoff"), "{people}");
+    // A trace and one JSON object cannot share stdout: asking for both is a usage error.
+    let both = vworks(&["run", &workcell("handoff"), "--trace", "--json"]);
+    assert_eq!(both.status.code(), Some(2));
+    assert!(text(&both.stderr).contains("cannot be used with '--json'"));
     let out = vworks(&["run", &workcell("handoff"), "--until", "2 parsecs"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(
@@ -652,6 +660,10 @@ fn log_events_match_the_run_trace_in_both_styles() {
     let seconds = vworks(&["log", "events", "--seconds", log]);
     assert_eq!(text(&seconds.stdout), text(&run_s.stdout));
     assert!(text(&seconds.stdout).starts_with("0 s left motion_start move_j duration="));
+    // `log info` counts in words: the crash's one near-miss warning is one /log message.
+    let info = text(&vworks(&["log", "info", log]).stdout);
+    assert!(info.contains("  /log              1 message\n"), "{info}");
+    assert!(info.contains("  /events           4 messages\n"), "{info}");
     let _ = std::fs::remove_dir_all(&d);
 }
 

@@ -141,8 +141,10 @@ impl LogLine {
     }
 }
 
-/// The statement at `pos` of robot `r`'s program as written: from its column to its `;` on
-/// that line, else the rest of the line; trimmed. Empty if the source is not in the cell.
+/// The statement at `pos` of robot `r`'s program as written: from its column to its `;`
+/// (KRL: to the end of its line or its comment), over as many lines as it takes (each line break and its indentation shown as one space),
+/// at most [`STATEMENT_LINES`] lines (then it ends with `…`); the rest of the line if no
+/// `;` ends it. Empty if the source is not in the cell.
 pub fn statement_at(cell: &Cell, r: usize, pos: SrcPos) -> String {
     let Some(robot) = cell.robots.get(r) else {
         return String::new();
@@ -151,16 +153,48 @@ pub fn statement_at(cell: &Cell, r: usize, pos: SrcPos) -> String {
     let Some((_, text)) = cell.sources.iter().find(|(p, _)| p == file) else {
         return String::new();
     };
-    let Some(line) = text.lines().nth((pos.line as usize).saturating_sub(1)) else {
+    let mut lines = text.lines().skip((pos.line as usize).saturating_sub(1));
+    let Some(first) = lines.next() else {
         return String::new();
     };
-    let rest: String = line
+    let first: String = first
         .chars()
         .skip((pos.col as usize).saturating_sub(1))
         .collect();
-    let stmt = match rest.find(';') {
-        Some(i) => &rest[..=i],
-        None => rest.as_str(),
-    };
-    stmt.trim().to_string()
+    // KRL ends a statement with its line (`;` starts a comment there).
+    let krl = Path::new(file).extension().is_some_and(|e| {
+        ["src", "sub", "dat"]
+            .iter()
+            .any(|k| e.eq_ignore_ascii_case(k))
+    });
+    if krl {
+        let code = first.split(';').next().unwrap_or_default();
+        return code.trim().to_string();
+    }
+    let mut out = String::new();
+    for (i, line) in std::iter::once(first.as_str()).chain(lines).enumerate() {
+        if i == STATEMENT_LINES {
+            out.push_str(" …");
+            break;
+        }
+        let line = line.trim();
+        if !out.is_empty() && !line.is_empty() {
+            out.push(' ');
+        }
+        if let Some(end) = line.find(';') {
+            out.push_str(&line[..=end]);
+            return out;
+        }
+        // A statement without `;` on its first line (a RAPID or KRL line, or one cut
+        // short) may go on; a WSL statement always ends with one.
+        out.push_str(line);
+    }
+    if !out.ends_with('…') && !out.contains(';') {
+        // No `;` within reach: the first line alone, as written.
+        return first.trim().to_string();
+    }
+    out
 }
+
+/// How many lines [`statement_at`] follows a statement over before it stops.
+pub const STATEMENT_LINES: usize = 8;

@@ -59,6 +59,12 @@ pub struct Contact {
     pub motions: Vec<crate::place::RobotMotion>,
 }
 
+/// A contact's depth from the signed gap between two bodies (m): how far they overlap, 0 for
+/// bodies just touching (never `-0`, which would print as `-0.0 mm`).
+pub(crate) fn depth_of(gap: f64) -> f64 {
+    if gap < 0.0 { -gap } else { 0.0 }
+}
+
 /// What a boundary check found.
 #[derive(Clone, Debug, PartialEq)]
 pub enum CollisionEvent {
@@ -659,7 +665,7 @@ impl Collider {
                                 time_ns: t,
                                 a: a.name.clone(),
                                 b: b.name.clone(),
-                                depth: -dist,
+                                depth: depth_of(dist),
                                 point,
                                 motions: Vec::new(),
                             },
@@ -851,6 +857,16 @@ mod tests {
     #![allow(clippy::unwrap_used)]
     use super::*;
     use parry3d::math::Vector;
+
+    /// Bodies just touching have depth 0, never -0 (it printed as `depth -0.0 mm`).
+    #[test]
+    fn depth_is_the_overlap_and_never_negative_zero() {
+        assert_eq!(depth_of(-0.002), 0.002);
+        let touching = depth_of(-0.0);
+        assert!(touching == 0.0 && touching.is_sign_positive());
+        assert!(depth_of(0.0).is_sign_positive());
+        assert_eq!(format!("{:.1}", depth_of(-0.0) * 1e3), "0.0");
+    }
 
     /// A small deterministic generator (no test depends on a random seed).
     struct Lcg(u64);

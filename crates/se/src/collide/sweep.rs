@@ -317,7 +317,7 @@ impl Collider {
                     time_ns: now,
                     a: self.bodies[first].name.clone(),
                     b: self.bodies[second].name.clone(),
-                    depth: -d,
+                    depth: depth_of(d),
                     point: p,
                     motions: Vec::new(),
                 });
