@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The side-by-side benchmarks of issue 8, in one run; writes BENCHMARKS.md.
+"""The side-by-side benchmarks against the performance targets, in one run; writes BENCHMARKS.md.
 
     .venv/bin/python bench/compare.py             # everything; rewrites BENCHMARKS.md
     .venv/bin/python bench/compare.py --profile   # also a perf profile of (b) and (c)
@@ -388,7 +388,7 @@ def main():
     lines = []
     w = lines.append
     w(BEGIN)
-    w("Written by `bench/compare.py` (issue 8), which runs every measurement below in one go")
+    w("Written by `bench/compare.py`, which runs every measurement below in one go")
     w(f"on this machine: {platform.machine()}, {os.cpu_count()} cores, {platform.system()} "
       f"{platform.release()}, Python {platform.python_version()}. The machine is a shared VM:")
     w("repeated runs differ by 10–20 % (docs/log.md). Criterion benches print the numbers")
