@@ -235,8 +235,8 @@ fn with_suggestion(mut e: clap::Error) -> clap::Error {
 }
 
 /// The workcell file that `command` was given as `path`: the path itself, or the
-/// `cell.toml` of a folder. A program file, or a folder without a `cell.toml`, is an
-/// error saying what to give instead.
+/// `cell.toml` of a folder. A program file, a sweep file, or a folder without a
+/// `cell.toml`, is an error saying what to give instead.
 fn cell_file(path: &Path, command: &str) -> Result<PathBuf, String> {
     if path.is_dir() {
         let file = path.join("cell.toml");
@@ -290,6 +290,7 @@ fn cell_file(path: &Path, command: &str) -> Result<PathBuf, String> {
             path.display()
         ));
     }
+    sweep::not_a_sweep_file(path, command)?;
     Ok(path.to_path_buf())
 }
 

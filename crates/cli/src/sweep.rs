@@ -245,10 +245,12 @@ impl Tally {
     }
 }
 
-pub(crate) fn sweep(a: Args) -> Result<ExitCode, String> {
+pub(crate) fn sweep(mut a: Args) -> Result<ExitCode, String> {
     if a.variables {
         return list_variables(&crate::cell_file(&a.file, "sweep --variables")?);
     }
+    // A folder: its sweep file, as `run` takes a cell's folder.
+    a.file = sweep_file(&a.file)?;
     // Everything is checked before the first variant runs.
     let sweep = Sweep::read(&a.file, &Disk).map_err(|e| e.to_string())?;
     let loader = Loader::new(&sweep.cell, &Disk).map_err(|e| e.to_string())?;
@@ -644,4 +646,198 @@ fn cell(v: &Value) -> String {
         Value::Text(s) => s.clone(),
         Value::Empty => "–".into(),
     }
+}
+
+/// What a TOML file given on the command line is, by its top-level keys: a sweep file
+/// (`cell = "…"` and `[[variable]]`s) and the workcell it names, a workcell (its robots'
+/// names), or something else (not readable, not TOML, neither: the command says why).
+pub(crate) enum Kind {
+    Sweep { cell: PathBuf },
+    Workcell { robots: Vec<String> },
+    Other,
+}
+
+/// The top-level keys of a sweep file (`vworks_sweep`'s format).
+const SWEEP_KEYS: [&str; 6] = ["cell", "combine", "seed", "until", "minimize", "variable"];
+/// The top-level keys of a workcell (`vworks_cell`'s format).
+const CELL_KEYS: [&str; 11] = [
+    "name",
+    "cycle",
+    "clearance",
+    "grip_distance",
+    "on_collision",
+    "robot",
+    "device",
+    "part",
+    "allow_collision",
+    "params",
+    "io",
+];
+
+pub(crate) fn kind_of(path: &Path) -> Kind {
+    if !path.is_file() {
+        return Kind::Other;
+    }
+    let Ok(Ok(file)) = crate::read(path).map(|t| t.parse::<toml::Table>()) else {
+        return Kind::Other;
+    };
+    match file.get("cell") {
+        Some(toml::Value::String(cell))
+            if file.contains_key("variable")
+                || file.keys().all(|k| SWEEP_KEYS.contains(&k.as_str())) =>
+        {
+            let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+            Kind::Sweep {
+                cell: dir.join(cell),
+            }
+        }
+        None if file.keys().any(|k| CELL_KEYS.contains(&k.as_str())) => Kind::Workcell {
+            robots: file
+                .get("robot")
+                .and_then(toml::Value::as_array)
+                .map(|rs| {
+                    rs.iter()
+                        .filter_map(|r| r.get("name")?.as_str().map(str::to_string))
+                        .collect()
+                })
+                .unwrap_or_default(),
+        },
+        _ => Kind::Other,
+    }
+}
+
+/// `Err` if `path`, given to `vworks COMMAND` as a workcell, is a sweep file: how to run
+/// it, and the workcell it names.
+pub(crate) fn not_a_sweep_file(path: &Path, command: &str) -> Result<(), String> {
+    let Kind::Sweep { cell } = kind_of(path) else {
+        return Ok(());
+    };
+    let missing = if cell.is_file() {
+        ""
+    } else {
+        " (not there: check its `cell`, relative to the sweep file)"
+    };
+    Err(format!(
+        "`{}` is a sweep file (the workcell to vary and its `[[variable]]`s), but `vworks {command}` takes a workcell: run the sweep with `vworks sweep {}`, or the workcell it names with `vworks {command} {}`{missing}",
+        path.display(),
+        path.display(),
+        cell.display(),
+    ))
+}
+
+/// The sweep file `vworks sweep` was given as `path`: the path itself, or the sweep file
+/// of a folder (its `sweep.toml`, else its one `.toml` with `[[variable]]`s). A workcell,
+/// or a folder without one sweep file, is an error saying what to give instead.
+fn sweep_file(path: &Path) -> Result<PathBuf, String> {
+    let file = if path.is_dir() {
+        let sweeps = sweep_files_in(path);
+        match sweeps.as_slice() {
+            [one] => one.clone(),
+            [] => return Err(no_sweep_file_in(path)),
+            many => {
+                let named: Vec<String> =
+                    many.iter().map(|p| format!("`{}`", p.display())).collect();
+                return Err(format!(
+                    "`{}` is a folder with {} sweep files and no sweep.toml: name the one to run: {}",
+                    path.display(),
+                    many.len(),
+                    named.join(", ")
+                ));
+            }
+        }
+    } else {
+        path.to_path_buf()
+    };
+    if let Kind::Workcell { robots } = kind_of(&file) {
+        let dir = file.parent().unwrap_or(Path::new(""));
+        let beside = match sweep_files_in(dir).as_slice() {
+            [one] => format!(
+                "; the sweep file beside it: `vworks sweep {}`",
+                one.display()
+            ),
+            _ => format!(". {}", how_to_write_a_sweep_file(&file, &robots)),
+        };
+        return Err(format!(
+            "`{}` is a workcell, but `vworks sweep` takes a sweep file: one that names a workcell and the values to vary{beside}",
+            file.display()
+        ));
+    }
+    Ok(file)
+}
+
+/// The sweep files of a folder: its `sweep.toml`, else every `.toml` that is a sweep
+/// file (sorted).
+fn sweep_files_in(dir: &Path) -> Vec<PathBuf> {
+    let default = dir.join("sweep.toml");
+    if default.is_file() {
+        return vec![default];
+    }
+    tomls_in(dir)
+        .into_iter()
+        .filter(|p| matches!(kind_of(p), Kind::Sweep { .. }))
+        .collect()
+}
+
+/// The `.toml` files of a folder, sorted.
+fn tomls_in(dir: &Path) -> Vec<PathBuf> {
+    let mut tomls: Vec<PathBuf> = std::fs::read_dir(if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    })
+    .map(|entries| {
+        entries
+            .filter_map(Result::ok)
+            .filter(|e| e.file_name().to_string_lossy().ends_with(".toml"))
+            .map(|e| dir.join(e.file_name()))
+            .collect()
+    })
+    .unwrap_or_default();
+    tomls.sort();
+    tomls
+}
+
+/// A folder without a sweep file: what is there, and a sweep file for its workcell.
+fn no_sweep_file_in(dir: &Path) -> String {
+    let what = format!(
+        "`{}` is a folder without a sweep file (a sweep.toml, or a .toml with `[[variable]]`s): `vworks sweep` takes one",
+        dir.display()
+    );
+    let tomls = tomls_in(dir);
+    let cell = tomls.iter().find_map(|p| match kind_of(p) {
+        Kind::Workcell { robots } => Some((p, robots)),
+        _ => None,
+    });
+    match cell {
+        Some((cell, robots)) => format!("{what}. {}", how_to_write_a_sweep_file(cell, &robots)),
+        None if tomls.is_empty() => {
+            format!("{what}; there is no .toml there (`vworks new NAME` creates a workcell folder)")
+        }
+        None => {
+            let named: Vec<String> = tomls.iter().map(|p| format!("`{}`", p.display())).collect();
+            format!(
+                "{what}; its .toml files are neither sweep files nor workcells: {}",
+                named.join(", ")
+            )
+        }
+    }
+}
+
+/// A minimal sweep file for the workcell `cell` (with these robots), to write beside it.
+fn how_to_write_a_sweep_file(cell: &Path, robots: &[String]) -> String {
+    let sweep = cell.with_file_name("sweep.toml");
+    let name = cell
+        .file_name()
+        .map_or_else(|| "cell.toml".into(), |n| n.to_string_lossy().into_owned());
+    let (path, values) = match robots.first() {
+        Some(r) => (format!("robot.{r}.base.xyz.0"), "[\"500mm\", \"600mm\"]"),
+        None => ("cycle".to_string(), "[\"4ms\", \"8ms\"]"),
+    };
+    format!(
+        "Write one for the workcell `{}`, e.g. {}:\n\n    cell = \"{name}\"\n\n    [[variable]]\n    path = \"{path}\"\n    values = {values}\n\nthen `vworks sweep {}`. `vworks sweep --variables {}` lists every value a sweep may vary; docs/sweep.md has the format",
+        cell.display(),
+        sweep.display(),
+        sweep.display(),
+        cell.display()
+    )
 }

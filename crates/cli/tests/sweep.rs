@@ -617,3 +617,44 @@ fn keep_logs_best_after_ctrl_c_keeps_only_the_best() {
     );
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// `vworks sweep FOLDER` said "it is a folder": it runs the folder's sweep file (its
+/// sweep.toml, else its one .toml with `[[variable]]`s) as `run` runs a cell's folder,
+/// writing the table beside it; a workcell given to `sweep` names the sweep file beside it.
+#[test]
+fn a_folder_is_swept_by_its_sweep_file() {
+    let sweep =
+        "cell = \"cell.toml\"\n[[variable]]\npath = \"params.wait\"\nvalues = [\"1s\", \"2s\"]\n";
+    let d = dir_with(
+        "folder",
+        &[
+            ("cell.toml", WAITING_CELL),
+            ("r1.wsl", WAITING_PROGRAM),
+            ("waits.toml", sweep),
+        ],
+    );
+    let out = vworks_in(&d, &["sweep", ".", "-q"]);
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(err.contains("wrote ./waits.csv and ./waits.html"), "{err}");
+    assert_eq!(
+        rows(&std::fs::read_to_string(d.join("waits.csv")).unwrap()).len(),
+        2
+    );
+    // The workcell given instead: the sweep file beside it.
+    let out = vworks_in(&d, &["sweep", "cell.toml"]);
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("`cell.toml` is a workcell, but `vworks sweep` takes a sweep file: one that names a workcell and the values to vary; the sweep file beside it: `vworks sweep waits.toml`"),
+        "{err}"
+    );
+    // A sweep.toml is the folder's sweep file, whatever else is there.
+    std::fs::write(d.join("sweep.toml"), sweep.replace("2s", "3s")).unwrap();
+    let out = vworks_in(d.parent().unwrap(), &["sweep", d.to_str().unwrap(), "-q"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let table = std::fs::read_to_string(d.join("sweep.csv")).unwrap();
+    assert!(table.starts_with("variant,params.wait [s],"), "{table}");
+    assert!(table.contains("\n1,3,completed,3,"), "{table}");
+    let _ = std::fs::remove_dir_all(&d);
+}
