@@ -658,3 +658,56 @@ fn a_folder_is_swept_by_its_sweep_file() {
     assert!(table.contains("\n1,3,completed,3,"), "{table}");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// A zone of `"fine"`, `"10mm"` showed `fine`, 0.01 under no unit, and one `"0.5cm"` (no
+/// unit vworks knows) turned the base's column into metres: a word or an invalid value is
+/// shown as written, the others in the unit they were written in, in the table and the best.
+#[test]
+fn a_word_or_an_invalid_value_keeps_the_column_in_its_unit() {
+    let d = dir_with(
+        "words",
+        &[
+            ("cell.toml", WAITING_CELL),
+            ("r1.wsl", WAITING_PROGRAM),
+            (
+                "s.toml",
+                "cell = \"cell.toml\"\n\
+                 [[variable]]\npath = \"robot.r1.default_zone\"\nvalues = [\"fine\", \"10mm\"]\n\
+                 [[variable]]\npath = \"robot.r1.base.xyz.0\"\nvalues = [\"650mm\", \"0.5cm\", \"700mm\"]\n",
+            ),
+        ],
+    );
+    let out = vworks_in(&d, &["sweep", "s.toml", "--best", "2", "-q"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let table = std::fs::read_to_string(d.join("s.csv")).unwrap();
+    let lines: Vec<&str> = table.lines().collect();
+    assert!(
+        lines[0]
+            .starts_with("variant,robot.r1.default_zone [mm],robot.r1.base.xyz.0 [mm],outcome,"),
+        "{table}"
+    );
+    let starts: Vec<String> = lines[1..]
+        .iter()
+        .map(|l| l.split(',').take(4).collect::<Vec<_>>().join(","))
+        .collect();
+    assert_eq!(
+        starts,
+        [
+            "0,fine,650,completed",
+            "1,fine,0.5cm,invalid",
+            "2,fine,700,completed",
+            "3,10,650,completed",
+            "4,10,0.5cm,invalid",
+            "5,10,700,completed",
+        ],
+        "{table}"
+    );
+    assert!(lines[2].contains("`0.5cm` is not a quantity"), "{table}");
+    assert_eq!(
+        text(&out.stdout),
+        "best by end_time (completed, no collision):\n  \
+         variant 0: end_time 1 s  (robot.r1.default_zone = fine, robot.r1.base.xyz.0 = 650mm)\n  \
+         variant 2: end_time 1 s  (robot.r1.default_zone = fine, robot.r1.base.xyz.0 = 700mm)\n"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}

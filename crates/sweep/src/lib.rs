@@ -133,6 +133,19 @@ pub struct Variable {
     pub unit: Option<Unit>,
 }
 
+impl Variable {
+    /// Every value shows as a number in the table file, in the variable's unit (not
+    /// `"fine"` nor `"5deg"` among lengths): a column an objective may be.
+    pub fn numeric(&self) -> bool {
+        match &self.values {
+            Values::List(v) => v
+                .iter()
+                .all(|x| table::in_unit(x, self.unit.as_ref()).number().is_some()),
+            Values::Range { .. } | Values::Random { .. } => true,
+        }
+    }
+}
+
 /// A variable's values: a list, or made when asked for (a range or random samples of
 /// millions of values take no memory).
 #[derive(Clone, Debug, PartialEq)]
@@ -442,7 +455,7 @@ impl Sweep {
         let variables: Vec<(String, bool)> = self
             .variables
             .iter()
-            .map(|v| (v.path.clone(), v.values.numeric()))
+            .map(|v| (v.path.clone(), v.numeric()))
             .collect();
         let numeric = table::numeric_columns(&variables, robots);
         let units = self.units();

@@ -95,31 +95,27 @@ pub struct Unit {
 }
 
 impl Unit {
-    /// The unit of these values (a variable's list, or a range's two ends): the first
-    /// unit written, if every value written with a unit has its dimension and every other
-    /// value is a plain number (SI, shown converted); else `None` (the values are shown
-    /// as SI numbers, or as text).
+    /// The unit of these values (a variable's list, or a range's two ends): of the
+    /// dimension that most of the values written with a unit have (ties: the first
+    /// written), the first unit written; `None` if no value has a unit (the values are
+    /// shown as they are). The other values do not change it: a plain number is SI (shown
+    /// converted), and a word (`"fine"`), a unit vworks does not know (`"0.5cm"`) or a
+    /// quantity of another dimension (`"5deg"` among lengths) is shown as written.
     pub fn of_values(values: &[toml::Value]) -> Option<Unit> {
-        let mut unit: Option<Unit> = None;
-        for v in values {
-            match v {
-                toml::Value::Integer(_) | toml::Value::Float(_) => {}
-                toml::Value::String(s) => match written(s) {
-                    Some((_, u)) => match &unit {
-                        None => unit = Some(u),
-                        Some(first) if first.dim == u.dim => {}
-                        Some(_) => return None,
-                    },
-                    None if matches!(
-                        vworks_cell::parse_quantity(s),
-                        Some(vworks_cell::Quantity::Number(_))
-                    ) => {}
-                    None => return None,
-                },
-                _ => return None,
-            }
-        }
-        unit
+        let units: Vec<Unit> = values
+            .iter()
+            .filter_map(|v| match v {
+                toml::Value::String(s) => written(s).map(|(_, u)| u),
+                _ => None,
+            })
+            .collect();
+        let count = |u: &Unit| units.iter().filter(|o| o.dim == u.dim).count();
+        // The most values; among as many, the first written (the first of its dimension).
+        units
+            .iter()
+            .enumerate()
+            .max_by_key(|(i, u)| (count(u), std::cmp::Reverse(*i)))
+            .map(|(_, u)| u.clone())
     }
 }
 
@@ -175,23 +171,39 @@ fn tidy(x: f64) -> f64 {
 }
 
 /// A variable's value as the table file shows it in `unit`: the number as written if it
-/// was written in that unit (`"500mm"`: 500), else its SI value converted (0.5: 500).
+/// was written in that unit (`"500mm"`: 500), else its SI value converted (0.5 or
+/// `"0.5m"`: 500); a value that is not a quantity of the unit's dimension (`"fine"`,
+/// `"0.5cm"`, `"5deg"` among lengths) as written, as text.
 pub fn in_unit(v: &toml::Value, unit: Option<&Unit>) -> Value {
     let Some(unit) = unit else {
         return shown(v);
     };
     if let toml::Value::String(s) = v
         && let Some((x, u)) = written(s)
-        && u.name == unit.name
     {
-        return Value::Num(x);
+        return if u.name == unit.name {
+            Value::Num(x)
+        } else if u.dim == unit.dim {
+            Value::Num(tidy(x * u.si / unit.si))
+        } else {
+            Value::Text(s.clone())
+        };
     }
-    match v {
-        toml::Value::String(s) if written(s).is_some_and(|(_, u)| u.dim != unit.dim) => shown(v),
-        _ => match shown(v).number() {
-            Some(x) => Value::Num(tidy(x / unit.si)),
-            None => shown(v),
+    use vworks_cell::Quantity;
+    let si = match v {
+        toml::Value::Integer(i) => Some(*i as f64),
+        toml::Value::Float(x) => Some(*x),
+        toml::Value::String(s) => match vworks_cell::parse_quantity(s) {
+            Some(Quantity::Number(x)) => Some(x),
+            Some(Quantity::WithUnit(x, d)) if d == unit.dim => Some(x),
+            _ => None,
         },
+        _ => None,
+    };
+    match (si, v) {
+        (Some(x), _) => Value::Num(tidy(x / unit.si)),
+        (None, toml::Value::String(s)) => Value::Text(s.clone()),
+        (None, other) => shown(other),
     }
 }
 

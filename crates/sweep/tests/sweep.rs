@@ -386,10 +386,10 @@ fn the_table_file_shows_each_variable_in_the_unit_it_was_written_in() {
         .iter()
         .map(|v| v.unit.as_ref().map(|u| u.name.clone()))
         .collect();
-    // Plain numbers: no unit; values of two dimensions: none either (SI, as before).
+    // Plain numbers: no unit; values of two dimensions: the first's (the other as written).
     assert_eq!(
         units,
-        [Some("mm"), Some("deg"), Some("mm/s"), None, None].map(|u| u.map(String::from))
+        [Some("mm"), Some("deg"), Some("mm/s"), None, Some("mm")].map(|u| u.map(String::from))
     );
     let robots = vec!["r1".to_string()];
     assert_eq!(
@@ -400,7 +400,7 @@ fn the_table_file_shows_each_variable_in_the_unit_it_was_written_in() {
             "robot.r2.base.rpy.2 [deg]",
             "params.speed [mm/s]",
             "cycle",
-            "clearance",
+            "clearance [mm]",
             "outcome",
             "end_time [s]",
             "cycle_time.r1 [s]",
@@ -427,5 +427,70 @@ fn the_table_file_shows_each_variable_in_the_unit_it_was_written_in() {
     assert_eq!(shown(2, 0), Value::Num(200.0));
     assert_eq!(shown(2, 1), Value::Num(300.0));
     assert_eq!(shown(3, 1), Value::Num(0.008));
-    assert_eq!(shown(4, 0), Value::Num(0.005));
+    assert_eq!(shown(4, 0), Value::Num(5.0));
+    assert_eq!(shown(4, 1), Value::Text("4ms".into()));
+}
+
+/// `["fine", "10mm", "20mm"]` showed `fine`, 0.01, 0.02 (no unit), and one value of an
+/// unknown unit (`"0.5cm"`) or of another dimension turned the whole column into SI
+/// numbers: a value that is not a quantity of the column's unit is shown as written, and
+/// the others keep the unit of most of them.
+#[test]
+fn a_value_that_is_not_a_quantity_does_not_change_the_others() {
+    let s = sweep_of(
+        "cell = \"c.toml\"\n\
+         [[variable]]\npath = \"robot.r1.default_zone\"\nvalues = [\"fine\", \"10mm\", \"20mm\", 0.03]\n\
+         [[variable]]\npath = \"robot.r2.base.xyz.0\"\nvalues = [\"500mm\", \"0.5cm\", \"0.6m\", true]\n\
+         [[variable]]\npath = \"robot.r2.base.xyz.1\"\nvalues = [\"5deg\", \"500mm\", \"600mm\"]\n\
+         [[variable]]\npath = \"params.mode\"\nvalues = [\"fast\", \"slow\"]\n",
+    )
+    .unwrap();
+    let shown = |k: usize| -> Vec<Value> {
+        s.variables[k]
+            .values
+            .to_vec()
+            .iter()
+            .map(|v| table::in_unit(v, s.variables[k].unit.as_ref()))
+            .collect()
+    };
+    let text = |t: &str| Value::Text(t.into());
+    assert_eq!(
+        shown(0),
+        [
+            text("fine"),
+            Value::Num(10.0),
+            Value::Num(20.0),
+            Value::Num(30.0)
+        ]
+    );
+    assert_eq!(
+        shown(1),
+        [
+            Value::Num(500.0),
+            text("0.5cm"),
+            Value::Num(600.0),
+            text("true")
+        ]
+    );
+    // Most are lengths: the column is in mm, whatever came first.
+    assert_eq!(
+        shown(2),
+        [text("5deg"), Value::Num(500.0), Value::Num(600.0)]
+    );
+    assert_eq!(shown(3), [text("fast"), text("slow")]);
+    let robots = vec!["r1".to_string()];
+    assert_eq!(
+        table::headers(&s.names(), &s.units(), &robots)[1..5],
+        [
+            "robot.r1.default_zone [mm]",
+            "robot.r2.base.xyz.0 [mm]",
+            "robot.r2.base.xyz.1 [mm]",
+            "params.mode",
+        ]
+    );
+    // A column with a word is no objective: not every value is a number.
+    let err = s
+        .check_objective("robot.r1.default_zone", &robots)
+        .unwrap_err();
+    assert!(err.contains("choose one of variant, end_time"), "{err}");
 }
