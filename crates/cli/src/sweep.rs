@@ -489,7 +489,8 @@ pub(crate) fn sweep(mut a: Args) -> Result<ExitCode, String> {
         tally.count("invalid"),
         if interrupted { " (interrupted)" } else { "" },
     );
-    print_best(&columns, &names, &units, &objective, &tally.best);
+    let none = no_best(&tally, &sweep, &a.file, interrupted);
+    print_best(&columns, &names, &units, &objective, &tally.best, &none);
     Ok(if failed {
         ExitCode::FAILURE
     } else if interrupted {
@@ -588,17 +589,81 @@ impl Pruner {
     }
 }
 
+/// What the summary says when no variant is among the best: what became of them, and
+/// what to do (`no variant completed: 4 stopped at \`until\` (1s); …`).
+fn no_best(tally: &Tally, sweep: &Sweep, file: &Path, interrupted: bool) -> String {
+    if tally.rows == 0 {
+        return "no variant finished: the sweep was interrupted before the first".into();
+    }
+    let collided_completed = tally.count("completed").saturating_sub(tally.feasible);
+    let until = sweep.until_ns.map_or_else(String::new, |ns| {
+        format!(" ({})", quantity(ns as f64 / 1e9, vworks_vm::Dim::TIME))
+    });
+    let mut what = Vec::new();
+    let mut todo = Vec::new();
+    for (n, said) in [
+        (collided_completed, "completed with a collision".to_string()),
+        (tally.count("collision"), "stopped at a collision".into()),
+        (tally.count("deadlock"), "deadlocked".into()),
+        (tally.count("error"), "ended with an error".into()),
+        (tally.count("until"), format!("stopped at `until`{until}")),
+        (
+            tally.count("timeout"),
+            "timed out (--variant-timeout)".into(),
+        ),
+        (tally.count("invalid"), "invalid".into()),
+    ] {
+        if n > 0 {
+            what.push(format!("{n} {said}"));
+        }
+    }
+    if tally.count("until") > 0 {
+        todo.push(format!(
+            "raise `until` in {} (or remove it) for them to complete",
+            file.display()
+        ));
+    }
+    if tally.count("timeout") > 0 {
+        todo.push("raise --variant-timeout".into());
+    }
+    if tally.collided > 0 {
+        todo.push(format!(
+            "`vworks run {} --set PATH=VALUE` runs one variant with its trace, to see where it collides",
+            sweep.cell.display()
+        ));
+    }
+    if tally.count("deadlock") + tally.count("error") + tally.count("invalid") > 0 {
+        todo.push("the rows' `error` says why the others did not complete".into());
+    }
+    format!(
+        "no variant completed{}: {}{}; the best are ranked among the variants that completed without a collision{}",
+        if tally.count("completed") > 0 {
+            " without a collision"
+        } else {
+            ""
+        },
+        what.join(", "),
+        if interrupted { " (interrupted)" } else { "" },
+        if todo.is_empty() {
+            String::new()
+        } else {
+            format!(": {}", todo.join("; "))
+        },
+    )
+}
+
 fn print_best(
     columns: &[String],
     names: &[String],
     units: &[Option<Unit>],
     objective: &str,
     best: &Best,
+    none: &str,
 ) {
     let column = |n: &str| columns.iter().position(|c| c == n);
     let best = best.rows();
     if best.is_empty() {
-        crate::out!("no variant completed without a collision");
+        crate::out!("{none}");
         return;
     }
     let k = column(objective).unwrap_or(0);

@@ -172,7 +172,10 @@ fn the_objective_is_checked_first_and_the_table_always_written() {
     .unwrap();
     let out = vworks_in(&d, &["sweep", "s.toml"]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
-    assert!(text(&out.stdout).contains("no variant completed without a collision"));
+    assert_eq!(
+        text(&out.stdout),
+        "no variant completed: 2 invalid; the best are ranked among the variants that completed without a collision: the rows' `error` says why the others did not complete\n"
+    );
     let table = std::fs::read_to_string(d.join("s.csv")).unwrap();
     let got = rows(&table);
     assert_eq!(got.len(), 2, "{table}");
@@ -708,6 +711,42 @@ fn a_word_or_an_invalid_value_keeps_the_column_in_its_unit() {
         "best by end_time (completed, no collision):\n  \
          variant 0: end_time 1 s  (robot.r1.default_zone = fine, robot.r1.base.xyz.0 = 650mm)\n  \
          variant 2: end_time 1 s  (robot.r1.default_zone = fine, robot.r1.base.xyz.0 = 700mm)\n"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// Every variant stopped at `until` said "no variant completed without a collision": now
+/// the summary says what became of them and what to do.
+#[test]
+fn no_best_says_what_became_of_the_variants() {
+    let d = dir_with(
+        "until",
+        &[
+            ("cell.toml", WAITING_CELL),
+            ("r1.wsl", WAITING_PROGRAM),
+            (
+                "s.toml",
+                "cell = \"cell.toml\"\nuntil = \"500ms\"\n[[variable]]\npath = \"params.wait\"\nvalues = [\"1s\", \"2s\", \"3s\", \"4s\"]\n",
+            ),
+        ],
+    );
+    let out = vworks_in(&d, &["sweep", "s.toml", "-q"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert_eq!(
+        text(&out.stdout),
+        "no variant completed: 4 stopped at `until` (500ms); the best are ranked among the variants that completed without a collision: raise `until` in s.toml (or remove it) for them to complete\n"
+    );
+    // Each outcome is said, with what to do about it.
+    std::fs::write(
+        d.join("s.toml"),
+        "cell = \"cell.toml\"\nuntil = \"1500ms\"\n[[variable]]\npath = \"params.wait\"\nvalues = [\"2s\", \"3s\", \"0.5cm\"]\n",
+    )
+    .unwrap();
+    let out = vworks_in(&d, &["sweep", "s.toml", "-q"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert_eq!(
+        text(&out.stdout),
+        "no variant completed: 2 stopped at `until` (1.5s), 1 invalid; the best are ranked among the variants that completed without a collision: raise `until` in s.toml (or remove it) for them to complete; the rows' `error` says why the others did not complete\n"
     );
     let _ = std::fs::remove_dir_all(&d);
 }
