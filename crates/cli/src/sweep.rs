@@ -7,7 +7,9 @@
 //! `--keep-logs DIR` it writes the variants' logs, or only some (`--keep-logs-variants
 //! 3,7,10-12`, `--keep-logs-best N`: a log leaves the folder as soon as its variant has
 //! dropped out of the best N, so the folder never holds many more than N). Every output
-//! goes through a temporary file (`vworks_model::output`). See `docs/sweep.md`.
+//! goes through a temporary file (`vworks_model::output`). It takes a folder holding a
+//! sweep file, and says what to do when given a workcell instead ([`Kind`]: `run` and
+//! `check` say so of a sweep file). See `docs/sweep.md`.
 
 use std::collections::BTreeSet;
 use std::io::IsTerminal;
@@ -27,8 +29,8 @@ use vworks_sweep::{Row, Sweep, Unit, per_second, run_streamed};
 /// What `vworks sweep` was asked.
 #[derive(clap::Args, Debug)]
 pub(crate) struct Args {
-    /// The sweep file (sweep.toml; see docs/sweep.md), or with --variables the workcell
-    /// (a cell.toml, or a folder holding one).
+    /// The sweep file (sweep.toml; see docs/sweep.md) or a folder holding one, or with
+    /// --variables the workcell (a cell.toml, or a folder holding one).
     pub(crate) file: PathBuf,
     /// Threads (default: one per core).
     #[arg(short, long, default_value_t = 0)]
