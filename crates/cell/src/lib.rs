@@ -27,6 +27,8 @@ use vworks_wslc::link::{CellSpec, Linked, RobotSpec, link};
 use vworks_wslc::{Diagnostic, Sources};
 
 mod io;
+mod paths;
+use paths::{program_files, read_hint, ros_package_paths, with_suggestion};
 pub mod params;
 pub mod variants;
 
@@ -551,44 +553,6 @@ pub fn same_link(a: &str, b: &str) -> bool {
     a == b || norm(a) == norm(b)
 }
 
-/// Where ROS keeps packages, searched for `package://` meshes after the workcell's
-/// `package_path`: each folder of `ROS_PACKAGE_PATH` (ROS 1), and `PREFIX/share` for each
-/// prefix of `AMENT_PREFIX_PATH` (ROS 2), in order.
-fn ros_package_paths() -> Vec<PathBuf> {
-    let split = |var: &str| -> Vec<PathBuf> {
-        std::env::var_os(var)
-            .map(|v| {
-                std::env::split_paths(&v)
-                    .filter(|p| !p.as_os_str().is_empty())
-                    .collect()
-            })
-            .unwrap_or_default()
-    };
-    let mut paths = split("ROS_PACKAGE_PATH");
-    paths.extend(
-        split("AMENT_PREFIX_PATH")
-            .into_iter()
-            .map(|p| p.join("share")),
-    );
-    paths
-}
-
-/// serde's "unknown field `cylce`, expected one of `name`, `cycle`, …" with the nearest
-/// valid key named: "…; did you mean `cycle`?".
-fn with_suggestion(msg: &str) -> String {
-    let Some(rest) = msg.strip_prefix("unknown field `") else {
-        return msg.to_string();
-    };
-    let Some((field, expected)) = rest.split_once('`') else {
-        return msg.to_string();
-    };
-    let valid = expected.split('`').skip(1).step_by(2);
-    match vworks_wslc::nearest(field, valid) {
-        Some(near) => format!("{msg}; did you mean `{near}`?"),
-        None => msg.to_string(),
-    }
-}
-
 /// The largest length a workcell may give (10 km): a size or a position beyond it is a
 /// typo (a unit missing), and would break the collision geometry's arithmetic.
 const MAX_LENGTH: f64 = 1e4;
@@ -596,76 +560,6 @@ const MAX_LENGTH: f64 = 1e4;
 /// How far a part may be from a robot's gripper for `grip` to take it when the workcell
 /// does not say (m): 5 mm, a gripper closing on a part that its fingers nearly touch.
 pub const DEFAULT_GRIP_DISTANCE: f64 = 0.005;
-
-/// The program files of robot `key` (`program`: one path, or a list of paths to files of
-/// one language), each joined to the workcell's folder `dir`.
-fn program_files(
-    cx: &Ctx<'_>,
-    key: &str,
-    program: &toml::Value,
-    dir: &Path,
-) -> Result<Vec<String>, CellError> {
-    let at = format!("{key}.program");
-    let how = "write one file (`program = \"r1.wsl\"`) or a list of files of one language (`program = [\"main.mod\", \"tools.mod\"]`)";
-    let names: Vec<&str> = match program {
-        toml::Value::String(s) => vec![s.as_str()],
-        toml::Value::Array(list) if !list.is_empty() => {
-            let mut names = Vec::with_capacity(list.len());
-            for (k, v) in list.iter().enumerate() {
-                let Some(s) = v.as_str() else {
-                    return Err(cx.bad(
-                        &format!("{at}[{k}]"),
-                        format!("`{v}` is not a file name; {how}"),
-                    ));
-                };
-                names.push(s);
-            }
-            names
-        }
-        toml::Value::Array(_) => {
-            return Err(cx.bad(&at, format!("lists no files; {how}")));
-        }
-        v => return Err(cx.bad(&at, format!("`{v}` is not a file name; {how}"))),
-    };
-    let paths: Vec<String> = names
-        .iter()
-        .map(|n| dir.join(n).display().to_string())
-        .collect();
-    if let Err((k, why)) = vworks_wslc::Language::of_files(&names) {
-        return Err(cx.bad(
-            &format!("{at}[{k}]"),
-            format!("{why} (give a robot of each language its own program)"),
-        ));
-    }
-    // The same file however it is written (`main.mod`, `./main.mod`).
-    let same: Vec<PathBuf> = names
-        .iter()
-        .map(|n| {
-            Path::new(n)
-                .components()
-                .filter(|c| !matches!(c, std::path::Component::CurDir))
-                .collect()
-        })
-        .collect();
-    if let Some(k) = (1..same.len()).find(|&k| same[..k].contains(&same[k])) {
-        return Err(cx.bad(
-            &format!("{at}[{k}]"),
-            format!("lists `{}` a second time; name each file once", names[k]),
-        ));
-    }
-    Ok(paths)
-}
-
-/// What to do about a file that cannot be read.
-fn read_hint(e: &std::io::Error) -> &'static str {
-    match e.kind() {
-        std::io::ErrorKind::NotFound => {
-            "; check the path: it is relative to the workcell file's folder"
-        }
-        std::io::ErrorKind::PermissionDenied => "; check the file's permissions",
-        _ => "",
-    }
-}
 
 /// Loads a workcell file: models, programs (compiled and linked), shapes.
 pub fn load(path: &Path) -> Result<Cell, CellError> {
