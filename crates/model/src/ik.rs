@@ -35,7 +35,8 @@ pub const MAX_AXES: usize = 12;
 pub enum IkError {
     /// The position is beyond the arm's reach.
     #[error(
-        "the pose (x {x:.4} m, y {y:.4} m, z {z:.4} m) is out of reach of {robot}: the wrist centre is {excess:.4} m beyond what the arm can reach; bring the target closer or move the robot's base"
+        "the pose (x {} m, y {} m, z {} m) is out of reach of {robot}: the wrist centre is {} what the arm can reach; bring the target closer or move the robot's base",
+        m4(*.x), m4(*.y), m4(*.z), beyond(*.excess)
     )]
     OutOfReach {
         /// Robot name.
@@ -51,7 +52,8 @@ pub enum IkError {
     },
     /// Solutions exist, but none within the joint limits.
     #[error(
-        "the pose (x {x:.4} m, y {y:.4} m, z {z:.4} m) is reachable by {robot} only outside its joint limits ({detail})"
+        "the pose (x {} m, y {} m, z {} m) is reachable by {robot} only outside its joint limits ({detail})",
+        m4(*.x), m4(*.y), m4(*.z)
     )]
     JointLimits {
         /// Robot name.
@@ -67,7 +69,8 @@ pub enum IkError {
     },
     /// The numeric solver did not converge (out of reach, a singularity, or the limits).
     #[error(
-        "no joint solution found for the pose (x {x:.4} m, y {y:.4} m, z {z:.4} m) of {robot}: the nearest reached is {error_m:.2e} m / {error_rad:.2e} rad away (out of reach, at a singularity or blocked by joint limits)"
+        "no joint solution found for the pose (x {} m, y {} m, z {} m) of {robot}: the nearest reached is {error_m:.2e} m / {error_rad:.2e} rad away (out of reach, at a singularity or blocked by joint limits)",
+        m4(*.x), m4(*.y), m4(*.z)
     )]
     NoConvergence {
         /// Robot name.
@@ -83,6 +86,20 @@ pub enum IkError {
         /// Remaining orientation error (rad).
         error_rad: f64,
     },
+}
+
+/// A length (m) in an error: 4 decimals, or scientific notation when huge.
+fn m4(x: f64) -> String {
+    crate::text::number(x, 4)
+}
+
+/// How far beyond the reach: in metres, or `far beyond` for a distance past any cell.
+fn beyond(excess: f64) -> String {
+    if excess.is_finite() && excess < 1e6 {
+        format!("{excess:.4} m beyond")
+    } else {
+        "far beyond".to_string()
+    }
 }
 
 impl IkError {

@@ -112,9 +112,9 @@ impl Joint {
     /// millimetres for a prismatic joint (`-165.0deg`, `250.0mm`).
     pub fn display(&self, v: f64) -> String {
         if self.kind == JointKind::Prismatic {
-            format!("{:.1}mm", v * 1e3)
+            format!("{}mm", crate::text::number(v * 1e3, 1))
         } else {
-            format!("{:.1}deg", v.to_degrees())
+            format!("{}deg", crate::text::number(v.to_degrees(), 1))
         }
     }
 }

@@ -30,6 +30,17 @@ pub fn escape_controls_owned(line: String) -> String {
     }
 }
 
+/// A number for a message with `decimals` places, as `{:.N}` writes it while it is of a
+/// size people write (below 10⁶ in magnitude); a larger one in scientific notation
+/// (`1.000e297`, not 298 digits), and an infinity as `inf`.
+pub fn number(x: f64, decimals: usize) -> String {
+    if !x.is_finite() || x.abs() < 1e6 {
+        format!("{x:.decimals$}")
+    } else {
+        format!("{x:.3e}")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -54,5 +65,13 @@ mod tests {
             escape_controls_owned(name.to_string()),
             escape_controls(name)
         );
+    }
+
+    #[test]
+    fn huge_numbers_are_written_in_scientific_notation() {
+        assert_eq!(number(0.12345, 4), "0.1235");
+        assert_eq!(number(-999_999.0, 1), "-999999.0");
+        assert_eq!(number(1e297, 4), "1.000e297");
+        assert_eq!(number(f64::INFINITY, 4), "inf");
     }
 }
