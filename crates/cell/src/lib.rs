@@ -28,7 +28,7 @@ use vworks_wslc::{Diagnostic, Sources};
 
 mod io;
 mod paths;
-use paths::{program_files, read_hint, ros_package_paths, with_suggestion};
+use paths::{program_files, read_hint, ros_package_paths};
 pub mod params;
 pub mod variants;
 
@@ -570,7 +570,29 @@ pub fn load(path: &Path) -> Result<Cell, CellError> {
 /// `files`: the disk, or memory ([`MemoryFiles`]).
 pub fn load_with(path: &Path, fs: &dyn Files) -> Result<Cell, CellError> {
     let (text, cf) = read_cell_file(path, fs)?;
-    load_parsed(path, &text, cf, fs, &Cache::default())
+    load_parsed(path, &text, cf, fs, &Cache::default(), None)
+}
+
+/// Loads a workcell as `vworks check` does, to find every problem it can: as [`load`],
+/// but a program that does not compile is replaced by an empty one (no code, no entry)
+/// and the loading goes on (the other robots' programs, every home, base and body), and
+/// a link that fails leaves [`Cell::linked`] empty. Returns the workcell (or its first
+/// problem, as [`load`] says it) and the programs' compile or link error, if any.
+pub fn load_checking(path: &Path) -> (Result<Cell, CellError>, Option<CellError>) {
+    let (text, cf) = match read_cell_file(path, &Disk) {
+        Ok(read) => read,
+        Err(e) => return (Err(e), None),
+    };
+    let mut programs = None;
+    let cell = load_parsed(
+        path,
+        &text,
+        cf,
+        &Disk,
+        &Cache::default(),
+        Some(&mut programs),
+    );
+    (cell, programs)
 }
 
 /// The workcell file's text and its parsed form (errors with line and column).
@@ -593,20 +615,48 @@ fn read_cell_file(path: &Path, fs: &dyn Files) -> Result<(String, CellFile), Cel
         file: &file,
         files: fs,
     };
-    let cf: CellFile = toml::from_str(&text).map_err(|e| {
-        let msg = with_suggestion(e.message());
-        let place = e.span().map(|s| {
-            let before = &text[..s.start.min(text.len())];
-            let line = before.matches('\n').count() + 1;
-            let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
-            format!("line {line}, column {col}")
-        });
-        cx.bad(
-            &place.unwrap_or_else(|| "file".into()),
-            format!("{msg}; the workcell format, key by key, is in docs/engine.md"),
-        )
-    })?;
+    let cf: CellFile = toml::from_str(&text).map_err(|e| paths::parse_error(&cx, &text, &e))?;
     Ok((text, cf))
+}
+
+/// Every unknown or misspelt key of the workcell file `path` whose text is `text`, each
+/// as the loader says it (`line 7, column 1`: "unknown field `modle`, …; did you mean
+/// `model`?"), in file order: the file parsed again with each such key's line commented
+/// out, as long as that leaves it valid TOML (a key whose value runs over several lines
+/// ends the search). Empty if the first problem of the file is not an unknown key.
+pub fn unknown_keys(path: &Path, text: &str) -> Vec<CellError> {
+    let file = path.display().to_string();
+    let cx = Ctx {
+        file: &file,
+        files: &Disk,
+    };
+    let mut text = text.to_string();
+    let mut found = Vec::new();
+    while found.len() < 100 {
+        let Err(e) = toml::from_str::<CellFile>(&text) else {
+            break;
+        };
+        let Some(start) = e.span().map(|s| s.start.min(text.len())) else {
+            break;
+        };
+        let Some(before) = text.get(..start) else {
+            break;
+        };
+        let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+        // Only a `key = value` line can go (not a table's header, not a key inside one).
+        let own_line = before[line_start..].trim().is_empty();
+        if !e.message().starts_with("unknown field") || !own_line {
+            break;
+        }
+        found.push((
+            before.matches('\n').count(),
+            paths::parse_error(&cx, &text, &e),
+        ));
+        text.insert(line_start, '#');
+    }
+    // (serde finds them in its own order.)
+    found.sort_by_key(|(line, _)| *line);
+    found.into_iter().map(|(_, e)| e).collect()
 }
 
 /// Loads a parsed workcell: `text` is the file's text (kept in [`Cell::sources`]);
@@ -617,6 +667,7 @@ fn load_parsed(
     cf: CellFile,
     fs: &dyn Files,
     cache: &Cache,
+    mut lenient: Option<&mut Option<CellError>>,
 ) -> Result<Cell, CellError> {
     let file = path.display().to_string();
     let cx = Ctx {
@@ -784,6 +835,7 @@ fn load_parsed(
             Some(s) => format!("{files_key}\u{0}{s:?}"),
             None => files_key,
         };
+        let mut stub = false;
         let module = match modules.iter().find(|(p, _)| *p == mkey) {
             Some((_, m)) => Arc::clone(m),
             None => {
@@ -839,20 +891,37 @@ fn load_parsed(
                     }
                     Err(d) => {
                         diagnostics.extend(d.iter().cloned());
-                        continue;
+                        let Some(out) = lenient.as_deref_mut() else {
+                            continue;
+                        };
+                        let rendered = vworks_wslc::render(&diagnostics, &render_sources, false);
+                        *out = Some(CellError::Program {
+                            diagnostics: diagnostics.clone(),
+                            rendered,
+                        });
+                        stub = true;
+                        Arc::new(Module {
+                            files: pnames.clone(),
+                            ..Module::default()
+                        })
                     }
                 }
             }
         };
-        let module = params::apply(
-            &cx,
-            &key,
-            &pname,
-            module,
-            &r.params,
-            &cf.params,
-            &mut param_copies,
-        )?;
+        // (A program that did not compile: its params are not known.)
+        let module = if stub {
+            module
+        } else {
+            params::apply(
+                &cx,
+                &key,
+                &pname,
+                module,
+                &r.params,
+                &cf.params,
+                &mut param_copies,
+            )?
+        };
         let home = match &r.home {
             None => vec![0.0; model.dof()],
             Some(v) => {
@@ -963,7 +1032,7 @@ fn load_parsed(
     if diagnostics.is_empty() {
         params::check_cell_params(&cx, &cf.params, &modules)?;
     }
-    if !diagnostics.is_empty() {
+    if !diagnostics.is_empty() && lenient.is_none() {
         let rendered = vworks_wslc::render(&diagnostics, &render_sources, false);
         return Err(CellError::Program {
             diagnostics,
@@ -998,10 +1067,30 @@ fn load_parsed(
             .collect(),
         parts: part_names,
     };
-    let linked = link(&spec).map_err(|e| CellError::Program {
-        rendered: vworks_wslc::render(&e.diagnostics, &render_sources, false),
-        diagnostics: e.diagnostics,
-    })?;
+    let no_links = || Linked {
+        globals: Vec::new(),
+        robots: Vec::new(),
+        syncs: Vec::new(),
+        warnings: Vec::new(),
+    };
+    // (Checking programs that did not compile: linking their stand-ins says nothing.)
+    let linked = match (diagnostics.is_empty()).then(|| link(&spec)) {
+        None => no_links(),
+        Some(Ok(linked)) => linked,
+        Some(Err(e)) => {
+            let e = CellError::Program {
+                rendered: vworks_wslc::render(&e.diagnostics, &render_sources, false),
+                diagnostics: e.diagnostics,
+            };
+            match lenient {
+                Some(out) => {
+                    *out = Some(e);
+                    no_links()
+                }
+                None => return Err(e),
+            }
+        }
+    };
     let mut allowed = Vec::new();
     // `allow_collision` at the top, or written after a table (and so inside it in TOML).
     let all_pairs: Vec<&Vec<String>> = cf

@@ -112,3 +112,18 @@ pub(crate) fn read_hint(e: &std::io::Error) -> &'static str {
         _ => "",
     }
 }
+
+/// A TOML or schema error of the workcell file's text, at its line and column.
+pub(crate) fn parse_error(cx: &Ctx<'_>, text: &str, e: &toml::de::Error) -> CellError {
+    let msg = with_suggestion(e.message());
+    let place = e.span().map(|s| {
+        let before = &text[..s.start.min(text.len())];
+        let line = before.matches('\n').count() + 1;
+        let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+        format!("line {line}, column {col}")
+    });
+    cx.bad(
+        &place.unwrap_or_else(|| "file".into()),
+        format!("{msg}; the workcell format, key by key, is in docs/engine.md"),
+    )
+}

@@ -118,7 +118,7 @@ impl<'f> Loader<'f> {
                 message: e.message().to_string(),
             })?;
         let cache = Cache::default();
-        let base = load_parsed(path, &text, cf, files, &cache)?;
+        let base = load_parsed(path, &text, cf, files, &cache, None)?;
         let variables = variables(&table, &base);
         Ok(Loader {
             path: path.to_path_buf(),
@@ -194,7 +194,7 @@ impl<'f> Loader<'f> {
                     e.message()
                 ),
             })?;
-        let mut cell = load_parsed(&self.path, &self.text, cf, self.files, &self.cache)?;
+        let mut cell = load_parsed(&self.path, &self.text, cf, self.files, &self.cache, None)?;
         cell.overrides = overrides
             .iter()
             .map(|o| (o.path.clone(), o.value.to_string()))
