@@ -1,22 +1,27 @@
 //! `vworks check CELL`: a whole workcell checked without running it.
 //!
-//! The workcell is loaded as `vworks run` loads it (`vworks_cell::load`: every key, the
-//! models, the homes within the joint limits, the programs compiled and linked), and then
-//! what a run would only find later but can be known exactly beforehand:
+//! The workcell is loaded as `vworks run` loads it, but with programs that do not compile
+//! left out (`vworks_cell::load_checking`: every key, the models, the homes within the
+//! joint limits, the programs compiled and linked), and then what a run would only find
+//! later but can be known exactly beforehand:
 //!
 //! - each `move_j`/`move_l`/`move_c` whose target is a constant (`pose(…)`, `joints(…)`,
 //!   a `const`, or an expression of constants the compiler folded): a `move_j` to joints
-//!   outside an axis's limits, and a pose target that no configuration of the arm reaches
-//!   within its limits (arms with an analytic solver: every solution is known), with the
-//!   robot's workcell tool (a program that changes its tool in a motion is not checked);
+//!   outside the axes' limits (every such axis named), and a pose target that no
+//!   configuration of the arm reaches within its limits (arms with an analytic solver:
+//!   every solution is known), with the motion's TCP: its own constant `tool` operand
+//!   (RAPID's `tool0`, a `PERS tooldata` never assigned), else the workcell's tool if no
+//!   motion of the program changes it (otherwise not checked);
 //! - the bodies at the start: every robot at its home against the other robots, devices
 //!   and parts, as the run's first collision check sees them (the same pairs skipped and
-//!   allowed): a collision at 0 s is an error, a near miss within the clearance a warning.
-//!   A robot touching a part its program grips is left to the run (the grip may come first).
+//!   allowed): a collision at 0 s is an error, a near miss within the clearance a warning,
+//!   one problem per two robots, devices or parts, at the key that placed them (a robot's
+//!   `base`, else its `home`, else its `[[robot]]` line). A robot touching a part its
+//!   program grips is left to the run (the grip may come first).
 //!
 //! Every problem names its file and line (the workcell key's line, the statement's line),
-//! what is wrong and what to do. The loader stops at the first workcell problem; the
-//! programs' diagnostics are all reported.
+//! what is wrong and what to do. The loader stops at the first workcell problem, except
+//! that every unknown key is reported; the programs' diagnostics are all reported.
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -92,6 +97,7 @@ pub(crate) fn check_cells(
     let mut failed = false;
     let mut out = Vec::new();
     for f in files {
+        programs_without_cell(f)?;
         let path = crate::cell_file(f, "check")?;
         let r = check_cell(&path, color);
         let errors = r.problems.iter().filter(|p| p.error).count()
@@ -158,6 +164,64 @@ pub(crate) fn check_cells(
     })
 }
 
+/// A folder holding programs but no workcell: the programs to check one by one, or
+/// `vworks new`.
+fn programs_without_cell(dir: &Path) -> Result<(), String> {
+    if !dir.is_dir() || dir.join("cell.toml").is_file() {
+        return Ok(());
+    }
+    let mut names: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map(|entries| entries.filter_map(Result::ok).map(|e| e.path()).collect())
+        .unwrap_or_default();
+    names.sort();
+    if names
+        .iter()
+        .any(|p| p.extension().is_some_and(|e| e == "toml"))
+    {
+        return Ok(());
+    }
+    let programs: Vec<String> = names
+        .iter()
+        .filter(|p| p.is_file() && is_program(p))
+        .map(|p| format!("`vworks check {}`", crate::display(p)))
+        .collect();
+    if programs.is_empty() {
+        return Ok(());
+    }
+    Err(format!(
+        "`{}` is a folder without a cell.toml, but it holds {}: check each on its own ({}), or write a cell.toml naming the robots and their programs (`vworks new NAME` creates a workcell folder to start from)",
+        crate::display(dir),
+        crate::plural(programs.len(), "program"),
+        programs.join(", ")
+    ))
+}
+
+/// The robots of the workcell text and their program files (as the loader joins them to
+/// the workcell's folder `dir`), in file order, as far as the text parses.
+fn robots_of(text: &str, dir: &Path) -> Vec<(String, Vec<String>)> {
+    let Ok(t) = text.parse::<toml::Table>() else {
+        return Vec::new();
+    };
+    let robots = t.get("robot").and_then(|r| r.as_array());
+    robots
+        .into_iter()
+        .flatten()
+        .map(|r| {
+            let name = r.get("name").and_then(|n| n.as_str()).unwrap_or_default();
+            let files = match r.get("program") {
+                Some(toml::Value::String(p)) => vec![p.as_str()],
+                Some(toml::Value::Array(list)) => list.iter().filter_map(|p| p.as_str()).collect(),
+                _ => Vec::new(),
+            };
+            let files = files
+                .iter()
+                .map(|p| dir.join(p).display().to_string())
+                .collect();
+            (name.to_string(), files)
+        })
+        .collect()
+}
+
 /// Checks the workcell file `path`.
 fn check_cell(path: &Path, color: bool) -> Report {
     let file = path.display().to_string();
@@ -166,6 +230,8 @@ fn check_cell(path: &Path, color: bool) -> Report {
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
+    let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let robots = robots_of(&text, &dir);
     let mut report = Report {
         name: stem,
         programs: 0,
@@ -174,26 +240,25 @@ fn check_cell(path: &Path, color: bool) -> Report {
         diagnostics: Vec::new(),
         sources: vec![(file.clone(), text.clone())],
     };
-    let cell = match vworks_cell::load(path) {
+    // Programs that do not compile or link are reported, and the workcell is checked on.
+    let (loaded, programs) = vworks_cell::load_checking(path);
+    if let Some(e) = programs {
+        workcell_error(e, path, &text, &robots, &mut report);
+    }
+    let cell = match loaded {
         Ok(cell) => cell,
         Err(e) => {
             // What the file says, as far as it parses: the name and the programs.
-            if let Ok(t) = text.parse::<toml::Table>() {
-                if let Some(n) = t.get("name").and_then(|n| n.as_str()) {
-                    report.name = n.to_string();
-                }
-                let mut programs: Vec<String> = t
-                    .get("robot")
-                    .and_then(|r| r.as_array())
-                    .into_iter()
-                    .flatten()
-                    .filter_map(|r| r.get("program").map(|p| p.to_string()))
-                    .collect();
-                programs.sort();
-                programs.dedup();
-                report.programs = programs.len();
+            if let Ok(t) = text.parse::<toml::Table>()
+                && let Some(n) = t.get("name").and_then(|n| n.as_str())
+            {
+                report.name = n.to_string();
             }
-            workcell_error(e, &file, &text, &mut report);
+            let mut programs: Vec<&Vec<String>> = robots.iter().map(|(_, f)| f).collect();
+            programs.sort();
+            programs.dedup();
+            report.programs = programs.len();
+            workcell_error(e, path, &text, &robots, &mut report);
             return report;
         }
     };
@@ -202,23 +267,36 @@ fn check_cell(path: &Path, color: bool) -> Report {
     programs.sort();
     programs.dedup();
     report.programs = programs.len();
-    report.rendered = cell.render_warnings(color);
-    report.diagnostics = cell
-        .warnings
-        .iter()
-        .map(|d| (false, diagnostic_json(d)))
-        .collect();
-    report.sources = cell.sources.clone();
+    report.rendered.push_str(&cell.render_warnings(color));
+    report.diagnostics.extend(
+        cell.warnings
+            .iter()
+            .map(|d| (false, diagnostic_json(d, &robots))),
+    );
+    for source in &cell.sources {
+        if !report.sources.iter().any(|(f, _)| *f == source.0) {
+            report.sources.push(source.clone());
+        }
+    }
     targets(&cell, &mut report.problems);
     at_the_start(&cell, &text, &mut report.problems);
     report
 }
 
-fn diagnostic_json(d: &vworks_wslc::Diagnostic) -> serde_json::Value {
+/// A diagnostic as a JSON issue; its robot, if one robot's program has its file.
+fn diagnostic_json(
+    d: &vworks_wslc::Diagnostic,
+    robots: &[(String, Vec<String>)],
+) -> serde_json::Value {
+    let mut owners = robots.iter().filter(|(_, f)| f.contains(&d.at.file));
+    let robot = match (owners.next(), owners.next()) {
+        (Some((r, _)), None) => Some(r.as_str()),
+        _ => None,
+    };
     let mut v = issue_json(
         d.code.as_str(),
         &d.message,
-        None,
+        robot,
         Some(&d.at.file),
         d.at.line,
         d.at.col,
@@ -227,8 +305,48 @@ fn diagnostic_json(d: &vworks_wslc::Diagnostic) -> serde_json::Value {
     v
 }
 
+/// The robot a workcell key is in: `robot[1] \`r2\`.home[0]` names it; a place (`line 7,
+/// column 1`) is in the robot whose `[[robot]]` table holds that line.
+fn robot_of_key(key: &str, text: &str, robots: &[(String, Vec<String>)]) -> Option<String> {
+    if let Some(rest) = key.strip_prefix("robot[") {
+        let i: usize = rest.split(']').next()?.trim().parse().ok()?;
+        return robots.get(i).map(|(n, _)| n.clone());
+    }
+    let line: usize = key.strip_prefix("line ")?.split(',').next()?.parse().ok()?;
+    let before: Vec<(usize, String)> = headers(text)
+        .into_iter()
+        .take_while(|(at, _)| *at <= line)
+        .collect();
+    let (_, last) = before.last()?;
+    if last != "[[robot]]" && !last.starts_with("[robot.") {
+        return None;
+    }
+    let nth = before.iter().filter(|(_, h)| h == "[[robot]]").count();
+    robots.get(nth.checked_sub(1)?).map(|(n, _)| n.clone())
+}
+
+/// The table headers of a TOML text (`[[robot]]`, `[robot.params]`), without spaces or
+/// comments, with their 1-based lines.
+fn headers(text: &str) -> Vec<(usize, String)> {
+    text.lines()
+        .enumerate()
+        .filter_map(|(i, l)| {
+            let l = l.split('#').next().unwrap_or_default().trim();
+            l.starts_with('[')
+                .then(|| (i + 1, l.chars().filter(|c| !c.is_whitespace()).collect()))
+        })
+        .collect()
+}
+
 /// A workcell that does not load: the loader's error, placed at its key's line.
-fn workcell_error(e: CellError, file: &str, text: &str, report: &mut Report) {
+fn workcell_error(
+    e: CellError,
+    path: &Path,
+    text: &str,
+    robots: &[(String, Vec<String>)],
+    report: &mut Report,
+) {
+    let file = path.display().to_string();
     let mut at = |key: Option<&str>, message: String| {
         let (line, col, width) = key
             .and_then(|k| locate(text, k))
@@ -236,8 +354,8 @@ fn workcell_error(e: CellError, file: &str, text: &str, report: &mut Report) {
         report.problems.push(Problem {
             error: true,
             kind: "workcell",
-            robot: None,
-            file: file.to_string(),
+            robot: key.and_then(|k| robot_of_key(k, text, robots)),
+            file: file.clone(),
             line,
             col,
             width,
@@ -252,8 +370,22 @@ fn workcell_error(e: CellError, file: &str, text: &str, report: &mut Report) {
             report.rendered = rendered;
             report.diagnostics = diagnostics
                 .iter()
-                .map(|d| (d.is_error(), diagnostic_json(d)))
+                .map(|d| (d.is_error(), diagnostic_json(d, robots)))
                 .collect();
+        }
+        // An unknown key: every one of the file (the loader stops at the first).
+        CellError::Invalid { key, message, .. }
+            if key.starts_with("line ") && message.starts_with("unknown field") =>
+        {
+            let all = vworks_cell::unknown_keys(path, text);
+            if all.is_empty() {
+                at(Some(&key), message);
+            }
+            for e in all {
+                if let CellError::Invalid { key, message, .. } = e {
+                    at(Some(&key), message);
+                }
+            }
         }
         // A TOML syntax error's key is its place, which the location line shows.
         CellError::Invalid { key, message, .. } if key.starts_with("line ") => {
@@ -284,8 +416,8 @@ fn robot_key(text: &str, name: &str, field: &str) -> Option<String> {
 fn targets(cell: &Cell, problems: &mut Vec<Problem>) {
     for r in &cell.robots {
         let m = &r.module;
-        // A motion may change the tool (`tool` operand): the TCP of later motions is then
-        // only known at run time.
+        // A motion with a `tool` operand (every RAPID motion) sets the TCP from there on:
+        // a motion without one then has a TCP only the run knows.
         let tool_changes = m.code.iter().any(|i| {
             matches!(i, Instr::MoveJ(f) | Instr::MoveL(f) | Instr::MoveC(f) if f.has(MoveFlags::TOOL))
         });
@@ -301,6 +433,19 @@ fn targets(cell: &Cell, problems: &mut Vec<Problem>) {
                 };
                 let Some(target) = constant_target(m, proc, pc, f) else {
                     continue;
+                };
+                // The motion's TCP: its own `tool` if a constant gives it, else the
+                // workcell's if no motion of the program changes it.
+                let tool = if f.has(MoveFlags::TOOL) {
+                    let above = u32::from(f.has(MoveFlags::DURATION));
+                    match constant_operand(m, proc, pc, above, 6) {
+                        Some(ConstValue::Pose(t)) => {
+                            Some(Iso::from_xyz_rpy([t[0], t[1], t[2]], [t[3], t[4], t[5]]))
+                        }
+                        _ => None,
+                    }
+                } else {
+                    (!tool_changes).then_some(r.tool)
                 };
                 let pos = m.pos_of(pc as u32);
                 let mut problem = |kind: &'static str, message: String| {
@@ -329,27 +474,43 @@ fn targets(cell: &Cell, problems: &mut Vec<Problem>) {
                 };
                 match target {
                     ConstValue::Joints(q) if joint_move => {
-                        for (i, v) in q.iter().enumerate().take(n) {
-                            let j = r.model.axis(i);
-                            if *v < j.lower - 1e-9 || *v > j.upper + 1e-9 {
-                                problem(
-                                    "limits",
+                        // Every axis outside its limits, in one problem.
+                        let outside: Vec<String> = q
+                            .iter()
+                            .enumerate()
+                            .take(n)
+                            .filter_map(|(i, v)| {
+                                let j = r.model.axis(i);
+                                (!(j.lower - 1e-9..=j.upper + 1e-9).contains(v)).then(|| {
                                     format!(
-                                        "joint limit exceeded: axis {} `{}` would go to {}, outside its range {} to {}; choose a target within the range",
+                                        "axis {} `{}` would go to {}, outside its range {} to {}",
                                         i + 1,
                                         j.name,
                                         j.display(*v),
                                         j.display(j.lower),
                                         j.display(j.upper)
-                                    ),
-                                );
-                                break;
-                            }
+                                    )
+                                })
+                            })
+                            .collect();
+                        if !outside.is_empty() {
+                            let (what, ranges) = match outside.len() {
+                                1 => ("joint limit exceeded", "the range"),
+                                _ => ("joint limits exceeded", "the ranges"),
+                            };
+                            problem(
+                                "limits",
+                                format!(
+                                    "{what}: {}; choose a target within {ranges}",
+                                    outside.join("; ")
+                                ),
+                            );
                         }
                     }
-                    ConstValue::Pose(p) if !tool_changes => {
+                    ConstValue::Pose(p) if tool.is_some() => {
+                        let tool = tool.unwrap_or(r.tool);
                         let tcp = Iso::from_xyz_rpy([p[0], p[1], p[2]], [p[3], p[4], p[5]]);
-                        let flange = tcp.mul(&r.tool.inverse());
+                        let flange = tcp.mul(&tool.inverse());
                         let mut out = [[0.0; 6]; 8];
                         if let Some(Err(e)) = r.model.ik_analytic_all(&flange, &r.home, &mut out) {
                             problem(
@@ -368,7 +529,6 @@ fn targets(cell: &Cell, problems: &mut Vec<Problem>) {
 /// The target of the motion at `pc` if a constant pushed it (`PushConst` of a pose or
 /// joints, the operands above it pushed by straight-line code: no jump lands between).
 fn constant_target(m: &Module, proc: &ProcInfo, pc: usize, f: MoveFlags) -> Option<ConstValue> {
-    let start = proc.code_start as usize;
     let effect = m.code[pc].stack_effect(m, proc)?;
     let width = if f.has(MoveFlags::TARGET_JOINTS) {
         vworks_vm::MAX_AXES as u32
@@ -381,7 +541,22 @@ fn constant_target(m: &Module, proc: &ProcInfo, pc: usize, f: MoveFlags) -> Opti
         _ => 0,
     };
     // Slots above the target's top: the speed, zone, tool … operands.
-    let mut above = effect.pops.checked_sub(width + via)?;
+    let above = effect.pops.checked_sub(width + via)?;
+    constant_operand(m, proc, pc, above, width)
+}
+
+/// The operand of `width` slots of the instruction at `pc`, `above` slots below the top
+/// of the stack, if it is a constant: a pose or joints pushed by `PushConst`, or a module
+/// variable no instruction of the program writes (a RAPID `PERS tooldata`'s frame) read by
+/// `LoadVarN` — the slots above it pushed by straight-line code (no jump lands between).
+fn constant_operand(
+    m: &Module,
+    proc: &ProcInfo,
+    pc: usize,
+    mut above: u32,
+    width: u32,
+) -> Option<ConstValue> {
+    let start = proc.code_start as usize;
     let lands = |at: usize| {
         m.code
             .get(start..start + proc.code_len as usize)
@@ -401,15 +576,31 @@ fn constant_target(m: &Module, proc: &ProcInfo, pc: usize, f: MoveFlags) -> Opti
         }
         let e = ins.stack_effect(m, proc)?;
         if above < e.pushes {
-            // This instruction pushed the target's top slot: a constant of the target's
+            // This instruction pushed the operand's top slot: a constant of the operand's
             // width, with nothing of it below, or something only the run knows.
-            return match ins {
+            let value = match ins {
                 Instr::PushConst(c) if above == 0 && e.pushes == width => {
-                    let value = m.consts.get(c as usize)?.value.clone();
-                    matches!(value, ConstValue::Pose(_) | ConstValue::Joints(_)).then_some(value)
+                    m.consts.get(c as usize)?.value.clone()
                 }
-                _ => None,
+                Instr::LoadVarN(slot, n) if above == 0 && u32::from(n) == width => {
+                    let var = m.vars.iter().find(|v| v.slot == slot)?;
+                    let slots = slot..slot + width;
+                    let written = m.code.iter().any(|i| match *i {
+                        Instr::StoreVar(s) => slots.contains(&s),
+                        Instr::StoreVarN(s, n) => s < slots.end && slots.start < s + u32::from(n),
+                        Instr::StoreVarJoint(s) => {
+                            s < slots.end && slots.start < s + vworks_vm::MAX_AXES as u32
+                        }
+                        _ => false,
+                    });
+                    if written {
+                        return None;
+                    }
+                    var.init.clone()
+                }
+                _ => return None,
             };
+            return matches!(value, ConstValue::Pose(_) | ConstValue::Joints(_)).then_some(value);
         }
         above = above - e.pushes + e.pops;
     }
@@ -439,23 +630,7 @@ fn at_the_start(cell: &Cell, text: &str, problems: &mut Vec<Problem>) {
     let mut collider = Collider::new(cell);
     let moving = vec![false; vms.len()];
     let file = cell.file.display().to_string();
-    // The workcell key a body's place is written at: a robot's home, a device's pose.
-    let key_of = |body: &str| -> Option<String> {
-        let owner = |name: &str| {
-            body == name
-                || body
-                    .strip_prefix(name)
-                    .is_some_and(|rest| rest.starts_with('.'))
-        };
-        if let Some(i) = cell.robots.iter().position(|r| owner(&r.name)) {
-            return Some(format!("robot[{i}].home"));
-        }
-        if let Some(i) = cell.devices.iter().position(|d| d.name == body) {
-            return Some(format!("device[{i}].pose"));
-        }
-        let i = cell.parts.iter().position(|p| p.name == body)?;
-        Some(format!("part[{i}].pose"))
-    };
+    let table = text.parse::<toml::Table>().unwrap_or_default();
     // A robot touching a part its program grips: the grip may come before the first check.
     let grips = |a: &str, b: &str| {
         let Some(p) = cell.parts.iter().find(|p| p.name == b) else {
@@ -469,61 +644,219 @@ fn at_the_start(cell: &Cell, text: &str, problems: &mut Vec<Problem>) {
                     .any(|s| r.module.str(s.part) == p.name)
         })
     };
-    let place = |a: &str, b: &str| {
-        let key = key_of(a)
-            .and_then(|k| locate(text, &k).map(|r| (k, r)))
-            .or_else(|| key_of(b).and_then(|k| locate(text, &k).map(|r| (k, r))));
-        key.map_or((0, 0, 1), |(_, r)| line_col(text, r))
-    };
-    let esc = |s: &str| vworks_se::trace::escape_controls(s).into_owned();
+    // The touching (or near) pairs of bodies, by the pair of robots, devices and parts
+    // they belong to, in the order first found: (owners, collision, [(a, b, depth or gap)]).
+    type Pairs = Vec<(String, String, f64)>;
+    let mut groups: Vec<((Owner, Owner), bool, Pairs)> = Vec::new();
     for event in collider.check(cell, &vms, 0, &moving) {
-        match event {
-            CollisionEvent::Start(c) => {
-                if grips(&c.a, &c.b) || grips(&c.b, &c.a) {
-                    continue;
-                }
-                let (line, col, width) = place(&c.a, &c.b);
-                let (a, b) = (esc(&c.a), esc(&c.b));
-                let then = if cell.stop_on_collision {
-                    "the run would stop with a collision at 0 s"
-                } else {
-                    "the run would report a collision at 0 s"
-                };
-                problems.push(Problem {
-                    error: true,
-                    kind: "collision",
-                    robot: None,
-                    file: file.clone(),
-                    line,
-                    col,
-                    width,
-                    message: format!(
-                        "`{a}` and `{b}` overlap at the start (depth {:.1} mm): {then}; change the robot's home or the body's pose, or allow the pair (`allow_collision = [[\"{a}\", \"{b}\"]]`)",
-                        c.depth * 1e3
-                    ),
-                });
+        let (a, b, x, collision) = match event {
+            CollisionEvent::Start(c) if !(grips(&c.a, &c.b) || grips(&c.b, &c.a)) => {
+                (c.a, c.b, c.depth, true)
             }
-            CollisionEvent::NearMiss(a, b, d) => {
-                let (line, col, width) = place(&a, &b);
-                problems.push(Problem {
-                    error: false,
-                    kind: "near_miss",
-                    robot: None,
-                    file: file.clone(),
-                    line,
-                    col,
-                    width,
-                    message: format!(
-                        "`{}` and `{}` are {:.1} mm apart at the start, within the cell's clearance of {:.1} mm",
-                        esc(&a),
-                        esc(&b),
-                        d * 1e3,
-                        cell.clearance * 1e3
-                    ),
-                });
-            }
-            CollisionEvent::End(..) => {}
+            CollisionEvent::NearMiss(a, b, d) => (a, b, d, false),
+            _ => continue,
+        };
+        let (Some(oa), Some(ob)) = (Owner::of(cell, &a), Owner::of(cell, &b)) else {
+            continue;
+        };
+        let key = if oa <= ob { (oa, ob) } else { (ob, oa) };
+        let (a, b) = if oa <= ob { (a, b) } else { (b, a) };
+        match groups
+            .iter_mut()
+            .find(|(k, c, _)| *k == key && *c == collision)
+        {
+            Some((_, _, pairs)) => pairs.push((a, b, x)),
+            None => groups.push((key, collision, vec![(a, b, x)])),
         }
+    }
+    // (Bodies that overlap are not also said to come near.)
+    let touching: Vec<(Owner, Owner)> = groups.iter().filter(|g| g.1).map(|g| g.0).collect();
+    groups.retain(|(k, collision, _)| *collision || !touching.contains(k));
+    let esc = |s: &str| vworks_se::trace::escape_controls(s).into_owned();
+    for ((oa, ob), collision, mut pairs) in groups {
+        // The deepest first; the nearest first for near misses.
+        pairs.sort_by(|x, y| {
+            let order = if collision {
+                y.2.total_cmp(&x.2)
+            } else {
+                x.2.total_cmp(&y.2)
+            };
+            order.then_with(|| (&x.0, &x.1).cmp(&(&y.0, &y.1)))
+        });
+        let how = if collision { "by" } else { "apart:" };
+        let named = |(a, b, x): &(String, String, f64)| {
+            format!("`{}` and `{}` {how} {:.1} mm", esc(a), esc(b), x * 1e3)
+        };
+        let mut listed: Vec<String> = pairs.iter().take(3).map(named).collect();
+        if pairs.len() > 3 {
+            let more = pairs.len() - 3;
+            listed.push(format!(
+                "and {more} more {}",
+                if more == 1 { "pair" } else { "pairs" }
+            ));
+        }
+        let listed = listed.join(", ");
+        // Pointed at what most likely placed them wrong (see `Owner::blame`).
+        let blamed = Owner::blame(oa, ob, &table);
+        let (line, col, width) = blamed.place(&table, text);
+        let robot = [blamed, oa, ob].into_iter().find_map(|o| match o {
+            Owner::Robot(i) => Some(cell.robots[i].name.clone()),
+            _ => None,
+        });
+        let (wa, wb) = (oa.words(cell), ob.words(cell));
+        let message = if collision {
+            let then = if cell.stop_on_collision {
+                "the run would stop with a collision at 0 s"
+            } else {
+                "the run would report a collision at 0 s"
+            };
+            let allow = match pairs.as_slice() {
+                [(a, b, _)] => format!("[[\"{}\", \"{}\"]]", esc(a), esc(b)),
+                _ => format!("[[\"{}\", \"{}\"]]", esc(oa.name(cell)), esc(ob.name(cell))),
+            };
+            format!(
+                "{wa} and {wb} overlap at the start ({listed}): {then}; place them apart (change {}, or {}), or allow the pair (`allow_collision = {allow}`)",
+                oa.keys(cell),
+                ob.keys(cell)
+            )
+        } else {
+            format!(
+                "{wa} and {wb} come within the cell's clearance of {:.1} mm at the start ({listed})",
+                cell.clearance * 1e3
+            )
+        };
+        problems.push(Problem {
+            error: collision,
+            kind: if collision { "collision" } else { "near_miss" },
+            robot,
+            file: file.clone(),
+            line,
+            col,
+            width,
+            message,
+        });
+    }
+}
+
+/// What a body at the start belongs to: a robot, a device or a part (by index).
+#[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Debug)]
+enum Owner {
+    Robot(usize),
+    Device(usize),
+    Part(usize),
+}
+
+impl Owner {
+    /// The owner of the body `name` (`r1.link_2`, `table`).
+    fn of(cell: &Cell, body: &str) -> Option<Owner> {
+        let of_robot = |name: &str| {
+            body == name
+                || body
+                    .strip_prefix(name)
+                    .is_some_and(|rest| rest.starts_with('.'))
+        };
+        if let Some(i) = cell.robots.iter().position(|r| of_robot(&r.name)) {
+            return Some(Owner::Robot(i));
+        }
+        if let Some(i) = cell.devices.iter().position(|d| d.name == body) {
+            return Some(Owner::Device(i));
+        }
+        cell.parts
+            .iter()
+            .position(|p| p.name == body)
+            .map(Owner::Part)
+    }
+
+    fn name(self, cell: &Cell) -> &str {
+        match self {
+            Owner::Robot(i) => &cell.robots[i].name,
+            Owner::Device(i) => &cell.devices[i].name,
+            Owner::Part(i) => &cell.parts[i].name,
+        }
+    }
+
+    /// `robot \`r1\``, `device \`table\``.
+    fn words(self, cell: &Cell) -> String {
+        let what = match self {
+            Owner::Robot(_) => "robot",
+            Owner::Device(_) => "device",
+            Owner::Part(_) => "part",
+        };
+        format!(
+            "{what} `{}`",
+            vworks_se::trace::escape_controls(self.name(cell))
+        )
+    }
+
+    /// The keys that place it: `` `r1`'s `base` or `home` ``, `` `table`'s `pose` ``.
+    fn keys(self, cell: &Cell) -> String {
+        let name = vworks_se::trace::escape_controls(self.name(cell)).into_owned();
+        match self {
+            Owner::Robot(_) => format!("`{name}`'s `base` or `home`"),
+            _ => format!("`{name}`'s `pose`"),
+        }
+    }
+
+    /// Its table in the workcell file (`robot`, 1) and that table.
+    fn table(self, table: &toml::Table) -> (&'static str, usize, Option<&toml::Value>) {
+        let (list, i) = match self {
+            Owner::Robot(i) => ("robot", i),
+            Owner::Device(i) => ("device", i),
+            Owner::Part(i) => ("part", i),
+        };
+        let t = table
+            .get(list)
+            .and_then(|l| l.as_array())
+            .and_then(|l| l.get(i));
+        (list, i, t)
+    }
+
+    /// Of two owners of touching bodies, the one whose placing most likely put them
+    /// there: a robot with a `base` (robots stand at the origin unless moved), the later
+    /// of two such robots, else a robot; of a device and a part, the part.
+    fn blame(a: Owner, b: Owner, table: &toml::Table) -> Owner {
+        let based = |o: Owner| {
+            matches!(o, Owner::Robot(_))
+                && o.table(table).2.is_some_and(|t| t.get("base").is_some())
+        };
+        match (a, b) {
+            (Owner::Robot(_), Owner::Robot(_)) if based(a) && !based(b) => a,
+            (_, Owner::Robot(_)) => b,
+            (Owner::Robot(_), _) => a,
+            _ => b,
+        }
+    }
+
+    /// Where the workcell file places it: a robot's `base` if written, else its `home`;
+    /// a device's or part's `pose`; else its table's header (`[[robot]]`).
+    fn place(self, table: &toml::Table, text: &str) -> (u32, u32, usize) {
+        let (list, i, t) = self.table(table);
+        let keys: &[&str] = match self {
+            Owner::Robot(_) => &["base", "home"],
+            _ => &["pose"],
+        };
+        let written = keys
+            .iter()
+            .find(|k| t.is_some_and(|t| t.get(**k).is_some()));
+        if let Some(range) = written.and_then(|k| locate(text, &format!("{list}[{i}].{k}"))) {
+            return line_col(text, range);
+        }
+        // The table's header: the (i+1)-th `[[robot]]`.
+        let header = format!("[[{list}]]");
+        if let Some((line, _)) = headers(text)
+            .into_iter()
+            .filter(|(_, h)| *h == header)
+            .nth(i)
+        {
+            let src = text.lines().nth(line - 1).unwrap_or_default();
+            let col = src.chars().take_while(|c| c.is_whitespace()).count();
+            return (
+                line as u32,
+                col as u32 + 1,
+                src.trim().chars().count().max(1),
+            );
+        }
+        locate(text, list).map_or((0, 0, 1), |r| line_col(text, r))
     }
 }
 

@@ -848,3 +848,38 @@ fn the_report_line_counts_in_words() {
     assert!(err.contains("(1 robot, "), "{err}");
     assert!(err.contains(" events, 0 collisions)"), "{err}");
 }
+
+/// `check --json` names the robot of a workcell problem in a robot's table and of a
+/// diagnostic in a robot's program; one cell prints an object, several an array.
+#[test]
+fn check_json_names_the_robot_and_takes_several_cells() {
+    let d = temp_dir("check-json-robot");
+    std::fs::write(
+        d.join("cell.toml"),
+        "name = \"c\"\n[[robot]]\nname = \"r1\"\nmodel = \"irb120\"\nprogram = \"r1.wsl\"\nhome = [\"0deg\", \"-130deg\", \"0deg\", \"0deg\", \"30deg\", \"0deg\"]\n",
+    )
+    .unwrap();
+    std::fs::write(d.join("r1.wsl"), "proc main() {\n    delay 2;\n}\n").unwrap();
+    let out = vworks(&["check", d.to_str().unwrap(), "--json"]);
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let errors = v["errors"].as_array().unwrap();
+    let kinds: Vec<(&str, &str)> = errors
+        .iter()
+        .map(|e| {
+            (
+                e["kind"].as_str().unwrap(),
+                e["robot"].as_str().unwrap_or("null"),
+            )
+        })
+        .collect();
+    assert_eq!(kinds, [("E0021", "r1"), ("workcell", "r1")], "{v}");
+    let both = vworks(&[
+        "check",
+        d.to_str().unwrap(),
+        d.join("cell.toml").to_str().unwrap(),
+        "--json",
+    ]);
+    let v: serde_json::Value = serde_json::from_slice(&both.stdout).unwrap();
+    assert_eq!(v.as_array().map(Vec::len), Some(2), "{v}");
+}
