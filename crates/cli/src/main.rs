@@ -447,7 +447,7 @@ const NEW_CELL: &[(&str, &str)] = &[
     (
         "cell.toml",
         r#"# A workcell: its robots, devices and parts. See docs/engine.md for every key.
-name = "{name}"
+name = {name_toml}
 cycle = "4ms"          # collision checks at every 4 ms boundary (and between them)
 clearance = "5mm"      # closer than this is a near-miss warning
 
@@ -515,11 +515,24 @@ const NEW_ARMS: &[(&str, &str, &str)] = &[
 
 fn new_cell(dir: &Path, model: &str) -> Result<ExitCode, String> {
     let arms: Vec<&str> = NEW_ARMS.iter().map(|(m, _, _)| *m).collect();
-    let Some((model, home, extra)) = NEW_ARMS.iter().find(|(m, _, _)| *m == model) else {
-        let what = if vworks_model::builtin::names().contains(&model) {
+    // (`IRB120` is the irb120.)
+    let lower = model.to_lowercase();
+    let Some((model, home, extra)) = NEW_ARMS.iter().find(|(m, _, _)| *m == lower) else {
+        let what = if vworks_model::builtin::names().contains(&lower.as_str()) {
             format!("`{model}` is not an arm (a new cell's program moves a tool over a table)")
         } else {
-            format!("`{model}` is not a built-in model")
+            // The arm it begins (`kr6`), else the nearest in spelling.
+            let mut begun = arms
+                .iter()
+                .filter(|a| !lower.is_empty() && a.starts_with(&lower));
+            let near = match (begun.next(), begun.next()) {
+                (Some(a), None) => Some(*a),
+                _ => vworks_wslc::nearest(&lower, arms.iter().copied()),
+            };
+            let hint = near
+                .map(|n| format!(" (did you mean {n}?)"))
+                .unwrap_or_default();
+            format!("`{model}` is not a built-in model{hint}")
         };
         return Err(format!(
             "--model {}: {what}; choose one of the arms {} (a URDF robot: write its `urdf` in cell.toml after `vworks new`)",
@@ -548,6 +561,11 @@ fn new_cell(dir: &Path, model: &str) -> Result<ExitCode, String> {
     for (file, text) in NEW_CELL {
         let path = dir.join(file);
         let text = text
+            // The name as a TOML string (quotes and backslashes escaped).
+            .replace(
+                "{name_toml}",
+                &toml::Value::String(name.clone()).to_string(),
+            )
             .replace("{name}", &name)
             .replace("{model}", model)
             .replace("{pad}", &" ".repeat(12usize.saturating_sub(model.len())))

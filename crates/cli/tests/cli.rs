@@ -849,6 +849,36 @@ fn the_report_line_counts_in_words() {
     assert!(err.contains(" events, 0 collisions)"), "{err}");
 }
 
+/// `vworks new` writes the name as a TOML string: a name with a quote or a backslash
+/// makes a cell that loads and runs; `--model` takes any case.
+#[test]
+fn new_escapes_the_name_and_takes_the_model_in_any_case() {
+    let d = temp_dir("new-names");
+    for (name, model) in [("a\"b", "irb120"), ("x\\y", "IRB120"), ("k", "Kr6R900")] {
+        let cell = d.join(name);
+        let out = vworks(&["new", cell.to_str().unwrap(), "--model", model]);
+        assert_eq!(out.status.code(), Some(0), "{name}: {}", text(&out.stderr));
+        let toml = std::fs::read_to_string(cell.join("cell.toml")).unwrap();
+        assert!(
+            toml.contains(&format!("model = \"{}\"", model.to_lowercase())),
+            "{toml}"
+        );
+        let out = vworks(&["run", cell.to_str().unwrap(), "--json"]);
+        assert_eq!(out.status.code(), Some(0), "{name}: {}", text(&out.stderr));
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(v["outcome"], "completed", "{name}: {v}");
+        assert_eq!(v["cell"], name, "{v}");
+    }
+    // A model it does not know: the nearest arm suggested.
+    let out = vworks(&["new", d.join("n").to_str().unwrap(), "--model", "kr6"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        text(&out.stderr).contains("`kr6` is not a built-in model (did you mean kr6r900?)"),
+        "{}",
+        text(&out.stderr)
+    );
+}
+
 /// `check --json` names the robot of a workcell problem in a robot's table and of a
 /// diagnostic in a robot's program; one cell prints an object, several an array.
 #[test]
