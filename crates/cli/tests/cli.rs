@@ -229,7 +229,6 @@ fn run_json_has_the_contracts_fields() {
         "moving_ns",
         "waiting_ns",
         "idle_ns",
-        "handler_ns",
         "motions",
         "end_time_ns",
     ] {

@@ -120,9 +120,7 @@ impl RunResult {
             "end_time_ns": self.end_time_ns,
             "robots": self.robots.iter().map(|s| json!({
                 "name": s.name, "moving_ns": s.moving_ns, "waiting_ns": s.waiting_ns, "idle_ns": s.idle_ns,
-                // The contract (spec/engine.md) lists `handler_ns`; handlers take no
-                // simulated time, so it is 0 by definition (docs/engine.md).
-                "handler_ns": 0, "motions": s.motions, "end_time_ns": s.end_time_ns, "ended": s.ended.name(),
+                "motions": s.motions, "end_time_ns": s.end_time_ns, "ended": s.ended.name(),
             })).collect::<Vec<_>>(),
             "collisions": self.collisions.iter().map(|c| json!({
                 "time_ns": c.time_ns, "a": c.a, "b": c.b, "depth_m": c.depth, "point_m": c.point,

@@ -87,8 +87,24 @@ fn two_runs_give_identical_traces() {
     }
 }
 
-/// The cell file with its [[robot]] tables in reverse order, next to the original.
-fn reversed_copy(name: &str) -> PathBuf {
+/// The disk, but for one file served from memory: the reversed cell file, at a path beside
+/// the original (its programs found as from there), never written to the repository.
+struct Overlay {
+    path: PathBuf,
+    text: String,
+}
+
+impl vworks_cell::Files for Overlay {
+    fn read(&self, path: &Path) -> std::io::Result<Vec<u8>> {
+        if path == self.path {
+            return Ok(self.text.clone().into_bytes());
+        }
+        vworks_cell::Files::read(&vworks_cell::Disk, path)
+    }
+}
+
+/// The cell file with its [[robot]] tables in reverse order, as if next to the original.
+fn reversed_copy(name: &str) -> Overlay {
     let dir = root().join("workcells").join(name);
     let text = std::fs::read_to_string(dir.join("cell.toml")).unwrap();
     let mut head = String::new();
@@ -111,9 +127,10 @@ fn reversed_copy(name: &str) -> PathBuf {
         target.push('\n');
     }
     robots.reverse();
-    let out = dir.join(format!(".reversed-{}.toml", std::process::id()));
-    std::fs::write(&out, format!("{head}{}{tail}", robots.concat())).unwrap();
-    out
+    Overlay {
+        path: dir.join("reversed.toml"),
+        text: format!("{head}{}{tail}", robots.concat()),
+    }
 }
 
 #[test]
@@ -121,10 +138,9 @@ fn robot_order_does_not_change_any_event_time() {
     for (name, _) in EXAMPLES {
         let c = cell(name);
         let a = Simulation::new(Arc::clone(&c)).run(None);
-        let path = reversed_copy(name);
-        let rc = load(Path::new(&path));
-        let _ = std::fs::remove_file(&path);
-        let rc = Arc::new(rc.unwrap());
+        let reversed = reversed_copy(name);
+        assert!(!reversed.path.exists(), "{}", reversed.path.display());
+        let rc = Arc::new(vworks_cell::load_with(&reversed.path, &reversed).unwrap());
         assert_eq!(
             rc.robots.first().map(|r| &r.name),
             c.robots.last().map(|r| &r.name)

@@ -1,5 +1,5 @@
 //! The RAPID front-end over a corpus of modules (`tests/rapid/corpus/`, and the folder
-//! `VWORKS_RAPID_CORPUS` names, if set): every file either compiles to a module that
+//! `VWORKS_RAPID_CORPUS` names, else the repository's other RAPID files): every file either compiles to a module that
 //! round-trips through `.wslb`, or fails with diagnostics that each have a code and a
 //! line — never a panic, never an internal error (E0900). Both are counted.
 
@@ -77,19 +77,47 @@ fn the_bundled_corpus_compiles_or_names_what_vworks_does_not_run() {
 
 /// `VWORKS_RAPID_CORPUS=DIR cargo test -p vworks-wslc --test rapid_corpus -- --nocapture`
 /// runs the same checks over the modules of `DIR` and prints the counts and the codes of
-/// each file that does not compile.
+/// each file that does not compile. Without it, the checks run over the repository's other
+/// RAPID files, whose outcomes are known: the example workcell's two tasks and the
+/// compiler's `ok` fixtures compile; each `err` fixture fails with the code its name starts
+/// with (but one that needs the workcell's I/O wiring to fail).
 #[test]
-fn an_external_corpus_if_given() {
-    let Some(dir) = std::env::var_os("VWORKS_RAPID_CORPUS") else {
+fn an_external_corpus_if_given_else_the_repositorys_other_rapid_files() {
+    if let Some(dir) = std::env::var_os("VWORKS_RAPID_CORPUS") {
+        let (ok, failed) = run_corpus(Path::new(&dir));
+        eprintln!(
+            "external corpus: {} compile, {} fail",
+            ok.len(),
+            failed.len()
+        );
+        for (name, codes) in &failed {
+            eprintln!("  {name}: {}", codes.join(", "));
+        }
         return;
-    };
-    let (ok, failed) = run_corpus(Path::new(&dir));
-    eprintln!(
-        "external corpus: {} compile, {} fail",
-        ok.len(),
-        failed.len()
+    }
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let (ok, failed) = run_corpus(&root.join("../../workcells/rapid_handoff"));
+    assert_eq!(
+        (ok, failed),
+        (vec!["r1.mod".to_string(), "r2.mod".to_string()], vec![])
     );
+    let (ok, failed) = run_corpus(&root.join("test_data/ok"));
+    assert_eq!(ok, vec!["rapid_flow.mod", "rapid_motions.mod"]);
+    assert!(failed.is_empty(), "{failed:?}");
+    // A fixture with a `.io` file beside it fails only against that wiring of the workcell
+    // (E0302: a signal the cell does not give): on its own it compiles.
+    let err = root.join("test_data/err");
+    let (ok, failed) = run_corpus(&err);
+    for name in &ok {
+        assert!(
+            err.join(name).with_extension("io").exists(),
+            "{name} compiled"
+        );
+    }
+    assert_eq!(ok, vec!["E0302_rapid_signal.mod"]);
+    assert_eq!(failed.len(), 7, "{failed:?}");
     for (name, codes) in &failed {
-        eprintln!("  {name}: {}", codes.join(", "));
+        let code = &name[..5];
+        assert!(codes.iter().any(|c| c == code), "{name}: {codes:?}");
     }
 }
