@@ -26,14 +26,12 @@
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::Arc;
 
 use vworks_cell::{Cell, CellError};
 use vworks_model::math::Iso;
 use vworks_se::collide::{Collider, CollisionEvent};
 use vworks_se::result::issue_json;
 use vworks_vm::bytecode::{MoveFlags, ProcInfo};
-use vworks_vm::machine::{Vm, VmConfig};
 use vworks_vm::{ConstValue, Instr, Module};
 
 /// True for a program file (by its extension): WSL, RAPID, or bytecode.
@@ -610,23 +608,7 @@ fn constant_operand(
 /// The bodies at the start (every robot at its home): collisions and near misses, as the
 /// run's first collision check finds them.
 fn at_the_start(cell: &Cell, text: &str, problems: &mut Vec<Problem>) {
-    let vms: Vec<Vm> = cell
-        .robots
-        .iter()
-        .enumerate()
-        .map(|(i, r)| {
-            let cfg = VmConfig {
-                cycle_ns: cell.cycle_ns,
-                default_speed: r.default_speed,
-                default_zone: r.default_zone,
-                tool: r.tool,
-                start_joints: r.home.clone(),
-                robot: i as u32,
-                ..VmConfig::default()
-            };
-            Vm::new(Arc::clone(&r.module), Arc::clone(&r.model), cfg, r.entry)
-        })
-        .collect();
+    let vms = vworks_se::engine::robot_vms(cell);
     let mut collider = Collider::new(cell);
     let moving = vec![false; vms.len()];
     let file = cell.file.display().to_string();

@@ -617,12 +617,7 @@ fn report_to(log: &Path, out: &Path) -> Result<(vworks_report::Written, ExitCode
 /// A program's `log` line as a plain run prints it: `[11.156 s] r1: done`.
 fn log_line(l: &vworks_se::trace::LogLine) -> String {
     use vworks_se::trace::escape_controls as esc;
-    format!(
-        "[{:.3} s] {}: {}",
-        l.time_ns as f64 / 1e9,
-        esc(&l.robot),
-        esc(&l.text)
-    )
+    format!("[{}] {}: {}", secs(l.time_ns), esc(&l.robot), esc(&l.text))
 }
 
 /// Runs the simulation to its end (or `until`). With `progress` (the run's start), a bar on
@@ -751,6 +746,15 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
         }
         Err(message)
     };
+    // A folder runs its cell.toml; a program or a sweep file is an error saying what to give.
+    let file = match cell_file(path, "run") {
+        Ok(f) => f,
+        Err(e) => {
+            let issue = json_issue("usage", &e, None, Some(&display(path)), 0, 0);
+            return cannot_start(vec![issue], e);
+        }
+    };
+    let path = file.as_path();
     let until = match until.map(parse_time).transpose() {
         Ok(u) => u,
         Err(e) => return cannot_start(vec![json_issue("usage", &e, None, None, 0, 0)], e),
@@ -1037,17 +1041,7 @@ fn run(cmd: Command, color: bool) -> Result<ExitCode, String> {
             quiet,
             set,
         } => run_cell(
-            &match cell_file(&cell, "run") {
-                Ok(c) => c,
-                Err(m) => {
-                    if json {
-                        let issue = json_issue("usage", &m, None, Some(&display(&cell)), 0, 0);
-                        let v = serde_json::json!({"outcome": "error", "errors": [issue]});
-                        out!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
-                    }
-                    return Err(m);
-                }
-            },
+            &cell,
             RunOptions {
                 set: &set,
                 until: until.as_deref(),

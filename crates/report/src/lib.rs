@@ -24,7 +24,7 @@ use std::fmt::Write as _;
 
 use vworks_se::mcaplog::{LogContents, LoggedEvent};
 use vworks_se::stats::{Ending, Fold, RobotStats};
-use vworks_se::trace::{Data, Kind, RobotMotion, Times};
+use vworks_se::trace::{Data, Kind, RobotMotion, Times, contact_text};
 
 pub use vworks_se::stats::Activity;
 
@@ -190,21 +190,16 @@ impl Report {
                     },
                 ) => {
                     open_collisions.insert((a.clone(), b.clone()), collisions.len());
-                    // Depth and point, as the details text shows them (without the motions,
-                    // which have a column).
-                    let details = Data::Collision {
-                        a: String::new(),
-                        b: String::new(),
-                        contact: *contact,
-                        motions: Vec::new(),
-                    }
-                    .text();
+                    // Depth and point (the motions have a column of their own).
+                    let details = contact
+                        .as_ref()
+                        .map_or(String::new(), |(depth, point)| contact_text(*depth, point));
                     collisions.push(Collision {
                         start_ns: e.time_ns,
                         end_ns: None,
                         a: a.clone(),
                         b: b.clone(),
-                        details: details.trim().to_string(),
+                        details,
                         motions: motions.clone(),
                     });
                 }

@@ -30,12 +30,24 @@ pub struct RobotMotion {
     pub line: u32,
     /// Its column (0 if none).
     pub col: u32,
-    /// The statement's text as written (`move_l above speed 250mm/s;`), from its column
-    /// to its `;` on that line (the rest of the line, for a statement over several lines).
+    /// The statement's text as written (`move_l above speed 250mm/s;`): see
+    /// [`statement_at`].
     pub statement: String,
 }
 
 impl RobotMotion {
+    /// A robot that has not moved yet (no motion to name).
+    pub fn not_moved(robot: String) -> RobotMotion {
+        RobotMotion {
+            robot,
+            moving: false,
+            file: None,
+            line: 0,
+            col: 0,
+            statement: String::new(),
+        }
+    }
+
     /// What the robot was doing, for people: `r1 moving: r1.wsl:7:9 move_l above speed
     /// 250mm/s;`, `r1 standing after: …`, `r1 standing (not moved yet)`.
     pub fn describe(&self) -> String {
@@ -96,6 +108,14 @@ impl RobotMotion {
         })
     }
 
+    /// Sets `object`'s `motions` to the list, if it is not empty (a JSON object of a
+    /// collision or a near miss).
+    pub(crate) fn put_list(object: &mut Json, motions: &[RobotMotion]) {
+        if !motions.is_empty() {
+            object["motions"] = motions.iter().map(RobotMotion::to_json).collect();
+        }
+    }
+
     /// The list of a `motions` field (absent, in a log written before they were: empty).
     pub(crate) fn list_from_json(v: Option<&Json>) -> Option<Vec<RobotMotion>> {
         match v {
@@ -141,10 +161,10 @@ impl LogLine {
     }
 }
 
-/// The statement at `pos` of robot `r`'s program as written: from its column to its `;`
-/// (KRL: to the end of its line or its comment), over as many lines as it takes (each line break and its indentation shown as one space),
-/// at most [`STATEMENT_LINES`] lines (then it ends with `…`); the rest of the line if no
-/// `;` ends it. Empty if the source is not in the cell.
+/// The statement at `pos` of robot `r`'s program as written: from its column to its `;`,
+/// over as many lines as it takes (each line trimmed, joined by one space), at most
+/// [`STATEMENT_LINES`] lines (then it ends with ` …`); the first line alone if the file
+/// ends before a `;`. Empty if the source is not in the cell.
 pub fn statement_at(cell: &Cell, r: usize, pos: SrcPos) -> String {
     let Some(robot) = cell.robots.get(r) else {
         return String::new();
@@ -153,47 +173,33 @@ pub fn statement_at(cell: &Cell, r: usize, pos: SrcPos) -> String {
     let Some((_, text)) = cell.sources.iter().find(|(p, _)| p == file) else {
         return String::new();
     };
-    let mut lines = text.lines().skip((pos.line as usize).saturating_sub(1));
-    let Some(first) = lines.next() else {
-        return String::new();
+    let line_start: usize = text
+        .split_inclusive('\n')
+        .take((pos.line as usize).saturating_sub(1))
+        .map(str::len)
+        .sum();
+    let line = &text[line_start..];
+    let rest = line
+        .char_indices()
+        .nth((pos.col as usize).saturating_sub(1))
+        .map_or("", |(i, _)| &line[i..]);
+    let window_end = rest
+        .match_indices('\n')
+        .nth(STATEMENT_LINES - 1)
+        .map_or(rest.len(), |(i, _)| i);
+    let window = &rest[..window_end];
+    let joined = |s: &str| {
+        s.lines()
+            .map(str::trim)
+            .filter(|l| !l.is_empty())
+            .collect::<Vec<_>>()
+            .join(" ")
     };
-    let first: String = first
-        .chars()
-        .skip((pos.col as usize).saturating_sub(1))
-        .collect();
-    // KRL ends a statement with its line (`;` starts a comment there).
-    let krl = Path::new(file).extension().is_some_and(|e| {
-        ["src", "sub", "dat"]
-            .iter()
-            .any(|k| e.eq_ignore_ascii_case(k))
-    });
-    if krl {
-        let code = first.split(';').next().unwrap_or_default();
-        return code.trim().to_string();
+    match window.find(';') {
+        Some(end) => joined(&window[..=end]),
+        None if window_end < rest.len() => joined(window) + " …",
+        None => rest.lines().next().unwrap_or_default().trim().to_string(),
     }
-    let mut out = String::new();
-    for (i, line) in std::iter::once(first.as_str()).chain(lines).enumerate() {
-        if i == STATEMENT_LINES {
-            out.push_str(" …");
-            break;
-        }
-        let line = line.trim();
-        if !out.is_empty() && !line.is_empty() {
-            out.push(' ');
-        }
-        if let Some(end) = line.find(';') {
-            out.push_str(&line[..=end]);
-            return out;
-        }
-        // A statement without `;` on its first line (a RAPID or KRL line, or one cut
-        // short) may go on; a WSL statement always ends with one.
-        out.push_str(line);
-    }
-    if !out.ends_with('…') && !out.contains(';') {
-        // No `;` within reach: the first line alone, as written.
-        return first.trim().to_string();
-    }
-    out
 }
 
 /// How many lines [`statement_at`] follows a statement over before it stops.

@@ -90,9 +90,7 @@ impl Issue {
         if let Some(d) = self.distance_m {
             v["distance_m"] = d.into();
         }
-        if !self.motions.is_empty() {
-            v["motions"] = self.motions.iter().map(RobotMotion::to_json).collect();
-        }
+        RobotMotion::put_list(&mut v, &self.motions);
         v
     }
 }

@@ -131,31 +131,12 @@ fn written(text: &str) -> Option<(f64, Unit)> {
         Some(rest) => (-1.0, rest.trim_start()),
         None => (1.0, t),
     };
-    // The number: digits, a fraction, an exponent (the lexer's grammar); then the unit.
-    let b = body.as_bytes();
-    let mut end = 0;
-    while end < b.len() && b[end].is_ascii_digit() {
-        end += 1;
-    }
-    if end + 1 < b.len() && b[end] == b'.' && b[end + 1].is_ascii_digit() {
-        end += 1;
-        while end < b.len() && b[end].is_ascii_digit() {
-            end += 1;
-        }
-    }
-    if end < b.len() && matches!(b[end], b'e' | b'E') {
-        let digits = match b.get(end + 1) {
-            Some(b'+' | b'-') => end + 2,
-            _ => end + 1,
-        };
-        if b.get(digits).is_some_and(u8::is_ascii_digit) {
-            end = digits;
-            while end < b.len() && b[end].is_ascii_digit() {
-                end += 1;
-            }
-        }
-    }
-    let number: f64 = body[..end].parse().ok()?;
+    // The number as written is the longest start of it that reads as one (`450`, `2.5`,
+    // `1e3`); the unit follows. (`parse_quantity` has checked that the text is a quantity.)
+    let (end, number) = (1..=body.len())
+        .rev()
+        .filter(|&i| body.is_char_boundary(i))
+        .find_map(|i| body[..i].parse::<f64>().ok().map(|x| (i, x)))?;
     let name = body[end..].trim().to_string();
     let si = match parse_quantity(&format!("1{name}"))? {
         Quantity::WithUnit(x, _) => x,

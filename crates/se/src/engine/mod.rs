@@ -148,6 +148,28 @@ pub struct Simulation {
 /// robots in well under a second.
 pub const INSTANT_LIMIT: u64 = 1_000_000;
 
+/// A VM per robot of `cell`, in the workcell's order, each at its home with the cell's
+/// cycle and the robot's defaults and tool (none has run yet): what a simulation starts
+/// from, and what `vworks check` looks at the cell's start with.
+pub fn robot_vms(cell: &Cell) -> Vec<Vm> {
+    cell.robots
+        .iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let cfg = VmConfig {
+                cycle_ns: cell.cycle_ns,
+                default_speed: r.default_speed,
+                default_zone: r.default_zone,
+                tool: r.tool,
+                start_joints: r.home.clone(),
+                robot: i as u32,
+                ..VmConfig::default()
+            };
+            Vm::new(Arc::clone(&r.module), Arc::clone(&r.model), cfg, r.entry)
+        })
+        .collect()
+}
+
 impl Simulation {
     /// A simulation of `cell` at time 0, every VM created (none has run yet).
     pub fn new(cell: Arc<Cell>) -> Simulation {
@@ -168,23 +190,7 @@ impl Simulation {
                 to_module[r][*cg as usize] = Some(mg as u32);
             }
         }
-        let vms: Vec<Vm> = cell
-            .robots
-            .iter()
-            .enumerate()
-            .map(|(i, r)| {
-                let cfg = VmConfig {
-                    cycle_ns: cell.cycle_ns,
-                    default_speed: r.default_speed,
-                    default_zone: r.default_zone,
-                    tool: r.tool,
-                    start_joints: r.home.clone(),
-                    robot: i as u32,
-                    ..VmConfig::default()
-                };
-                Vm::new(Arc::clone(&r.module), Arc::clone(&r.model), cfg, r.entry)
-            })
-            .collect();
+        let vms = robot_vms(&cell);
         let signal_to = (0..n)
             .map(|r| {
                 let m = &cell.robots[r].module;
@@ -548,14 +554,7 @@ impl Simulation {
                         col: pos.col,
                         statement: crate::place::statement_at(&self.cell, r, pos),
                     },
-                    None => RobotMotion {
-                        robot,
-                        moving: false,
-                        file: None,
-                        line: 0,
-                        col: 0,
-                        statement: String::new(),
-                    },
+                    None => RobotMotion::not_moved(robot),
                 }
             })
             .collect()

@@ -424,16 +424,20 @@ impl McapLog {
             _ => None,
         };
         if let Some(level) = level {
-            let message = match &ev.data {
-                Data::Text { text } => text.clone(),
+            let message: std::borrow::Cow<'_, str> = match &ev.data {
+                Data::Text { text } => text.into(),
+                Data::Issue {
+                    message, motions, ..
+                } if motions.is_empty() => message.into(),
                 // A near miss names each robot's motion, a line each.
                 Data::Issue {
                     message, motions, ..
                 } => std::iter::once(message.clone())
                     .chain(motions.iter().map(|m| m.describe()))
                     .collect::<Vec<_>>()
-                    .join("\n"),
-                _ => ev.details.clone(),
+                    .join("\n")
+                    .into(),
+                _ => ev.details.as_str().into(),
             };
             let v = serde_json::json!({"timestamp": scene::ts(e.time), "level": level, "message": message, "name": ev.robot.as_deref().unwrap_or("cell"), "file": ev.file.as_deref().unwrap_or_default(), "line": ev.line});
             self.write(LOG, e.time, &v)?;

@@ -61,6 +61,18 @@ pub fn seconds(ns: i64) -> String {
     format!("{sign}{whole}.{} s", digits.trim_end_matches('0'))
 }
 
+/// Where a collision started, as its trace details show it: `depth=0.4mm point=(0.5200,
+/// 0.1000, 0.4000)` (the point in m).
+pub fn contact_text(depth_m: f64, point_m: &[f64; 3]) -> String {
+    format!(
+        "depth={} point=({:.4}, {:.4}, {:.4})",
+        fmt_quantity(depth_m, Dim::LENGTH),
+        point_m[0],
+        point_m[1],
+        point_m[2]
+    )
+}
+
 /// What an event is: its kind, as trace lines and the log name it ([`Kind::name`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 #[non_exhaustive]
@@ -532,23 +544,15 @@ impl Event {
     /// value stays in display units, as recorded).
     pub fn details_as(&self, times: Times) -> String {
         match (&self.data, times) {
-            (_, Times::Nanoseconds)
-            | (
-                Data::None
-                | Data::Set { .. }
-                | Data::MotionEnd { .. }
-                | Data::WaitEnd { .. }
-                | Data::Signal { .. }
-                | Data::Part { .. }
-                | Data::Text { .. }
-                | Data::Procedure { .. }
-                | Data::Remote { .. }
-                | Data::Global { .. }
-                | Data::Collision { .. }
-                | Data::Issue { .. },
-                _,
-            ) => self.details.clone(),
-            (data, times) => data.text_as(times),
+            (
+                Data::Motion { .. }
+                | Data::Delay { .. }
+                | Data::WaitCondition { .. }
+                | Data::WaitSignal { .. }
+                | Data::WaitSync { .. },
+                Times::Seconds,
+            ) => self.data.text_as(times),
+            _ => self.details.clone(),
         }
     }
 
@@ -671,11 +675,8 @@ impl Data {
                 motions,
             } => match contact {
                 Some((depth, p)) => format!(
-                    "{a} {b} depth={} point=({:.4}, {:.4}, {:.4}){}",
-                    fmt_quantity(*depth, Dim::LENGTH),
-                    p[0],
-                    p[1],
-                    p[2],
+                    "{a} {b} {}{}",
+                    contact_text(*depth, p),
                     RobotMotion::trace_suffix(motions)
                 ),
                 None => format!("{a} {b}"),
@@ -742,9 +743,7 @@ impl Data {
                     }
                     None => json!({"a": a, "b": b}),
                 };
-                if !motions.is_empty() {
-                    o["motions"] = motions.iter().map(RobotMotion::to_json).collect();
-                }
+                RobotMotion::put_list(&mut o, motions);
                 o
             }
             Data::Issue {
@@ -754,9 +753,7 @@ impl Data {
                 motions,
             } => {
                 let mut o = json!({"kind": kind, "message": message, "distance_m": distance_m});
-                if !motions.is_empty() {
-                    o["motions"] = motions.iter().map(RobotMotion::to_json).collect();
-                }
+                RobotMotion::put_list(&mut o, motions);
                 o
             }
         }
@@ -889,18 +886,19 @@ impl TraceEvent {
 
     /// The details as trace lines show them (empty when there are none).
     pub fn details(&self, cell: &Cell) -> String {
-        self.details_of(cell, &self.data(cell))
+        self.details_of(cell, &self.data(cell), Times::Nanoseconds)
     }
 
-    /// The details text from the event's typed `data`: the text of [`Data`], except that a
-    /// set's value is shown in display units (`250mm`), which needs the global's type.
-    fn details_of(&self, cell: &Cell, data: &Data) -> String {
+    /// The details text from the event's typed `data`: the text of [`Data`] with times as
+    /// `times` says, except that a set's value is shown in display units (`250mm`), which
+    /// needs the global's type.
+    fn details_of(&self, cell: &Cell, data: &Data, times: Times) -> String {
         match (&self.detail, data) {
             (Detail::Set { global, new, .. }, Data::Set { global: name, .. }) => {
                 let ty = cell.linked.globals[*global as usize].ty;
                 format!("{name}={}", format_value(*new, ty))
             }
-            _ => data.text(),
+            _ => data.text_as(times),
         }
     }
 
@@ -964,7 +962,7 @@ impl TraceEvent {
                 .and_then(|r| cell.robots.get(r))
                 .map(|r| r.name.clone()),
             kind: self.kind,
-            details: self.details_of(cell, &data),
+            details: self.details_of(cell, &data, Times::Nanoseconds),
             data,
             file: self.file(cell).map(str::to_string),
             line,
@@ -984,10 +982,7 @@ impl TraceEvent {
             .robot
             .and_then(|r| cell.robots.get(r))
             .map_or("-", |r| r.name.as_str());
-        let mut details = match times {
-            Times::Nanoseconds => self.details(cell),
-            _ => self.resolve(cell).details_as(times),
-        };
+        let mut details = self.details_of(cell, &self.data(cell), times);
         if details.is_empty() {
             details.push('-');
         }
