@@ -9,42 +9,46 @@
 #![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)] // tests fail by panicking
 
 mod common;
-use common::{case_names, parse, root, run};
+use std::path::Path;
 
-#[test]
-fn every_bad_input_gets_an_answer_a_person_can_act_on() {
-    let dir = root().join("tests/errors");
-    let names = case_names(&dir);
-    assert!(names.len() >= 30, "{} cases", names.len());
-    for name in &names {
-        let case = parse(&std::fs::read_to_string(dir.join(format!("{name}.case"))).unwrap());
-        let (code, stdout, stderr) = run(name, &case);
-        let mut got = format!("exit {code}\n--- stderr\n{stderr}");
-        if !stdout.is_empty() {
-            got.push_str("--- stdout\n");
-            got.push_str(&stdout);
-        }
-        expect_test::expect_file![dir.join(format!("{name}.out"))].assert_eq(&got);
-        // What a machine can check of "file, place, what, what to do".
-        assert_ne!(code, 0, "{name}: a mistake must not exit 0");
-        // A runtime error is the run's outcome: the summary on stdout reports it.
+use common::{parse, run, test_every_case};
+
+fn main() {
+    test_every_case(
+        "tests/errors",
+        30,
+        every_bad_input_gets_an_answer_a_person_can_act_on,
+    )
+}
+
+fn every_bad_input_gets_an_answer_a_person_can_act_on(dir: &Path, name: &str) {
+    let case = parse(&std::fs::read_to_string(dir.join(format!("{name}.case"))).unwrap());
+    let (code, stdout, stderr) = run(name, &case);
+    let mut got = format!("exit {code}\n--- stderr\n{stderr}");
+    if !stdout.is_empty() {
+        got.push_str("--- stdout\n");
+        got.push_str(&stdout);
+    }
+    expect_test::expect_file![dir.join(format!("{name}.out"))].assert_eq(&got);
+    // What a machine can check of "file, place, what, what to do".
+    assert_ne!(code, 0, "{name}: a mistake must not exit 0");
+    // A runtime error is the run's outcome: the summary on stdout reports it.
+    assert!(
+        stderr.contains("error") || stdout.contains("error["),
+        "{name}: no error line in:\n{stderr}{stdout}"
+    );
+    assert!(!stderr.contains("panicked"), "{name}: panicked:\n{stderr}");
+    // (An argument clap rejects is named by clap: no file to name.)
+    let about_an_argument =
+        stderr.contains("For more information, try '--help'.") || stderr.starts_with("error: --");
+    let named = case.args.iter().filter(|a| a.contains('.'));
+    let files = case.files.iter().map(|(f, _)| f);
+    if case.args.iter().any(|a| a.contains('.')) && !about_an_argument {
         assert!(
-            stderr.contains("error") || stdout.contains("error["),
-            "{name}: no error line in:\n{stderr}{stdout}"
+            named
+                .chain(files)
+                .any(|f| stderr.contains(f.as_str()) || stdout.contains(f.as_str())),
+            "{name}: the message names no file:\n{stderr}"
         );
-        assert!(!stderr.contains("panicked"), "{name}: panicked:\n{stderr}");
-        // (An argument clap rejects is named by clap: no file to name.)
-        let about_an_argument = stderr.contains("For more information, try '--help'.")
-            || stderr.starts_with("error: --");
-        let named = case.args.iter().filter(|a| a.contains('.'));
-        let files = case.files.iter().map(|(f, _)| f);
-        if case.args.iter().any(|a| a.contains('.')) && !about_an_argument {
-            assert!(
-                named
-                    .chain(files)
-                    .any(|f| stderr.contains(f.as_str()) || stdout.contains(f.as_str())),
-                "{name}: the message names no file:\n{stderr}"
-            );
-        }
     }
 }

@@ -15,7 +15,7 @@ mod common;
 use std::path::Path;
 use std::sync::Arc;
 
-use common::{case_names, parse, root};
+use common::{parse, test_every_case};
 use expect_test::expect_file;
 use vworks_cell::MemoryFiles;
 use vworks_se::engine::Simulation;
@@ -66,71 +66,66 @@ fn without_position(line: &str) -> String {
     out
 }
 
-#[test]
-fn rapid_modules_run_as_their_wsl_twins() {
-    let dir = root().join("tests/rapid");
-    let names = case_names(&dir);
-    assert!(
-        names.len() >= 10,
-        "{} equivalence cases; the issue asks for 10",
-        names.len()
-    );
-    for name in &names {
-        let text = std::fs::read_to_string(dir.join(format!("{name}.case"))).unwrap();
-        let case = parse(&text);
-        let mods: Vec<&str> = case
-            .files
-            .iter()
-            .filter_map(|(p, _)| p.strip_suffix(".mod"))
-            .collect();
-        assert!(!mods.is_empty(), "{name}: no RAPID module");
-        for m in &mods {
-            assert!(
-                case.files.iter().any(|(p, _)| *p == format!("{m}.wsl")),
-                "{name}: {m}.mod has no WSL twin {m}.wsl"
-            );
-        }
-        let (rapid, outcome_r) = run(name, &case.files, |t| t.to_string());
-        let (wsl, outcome_w) = run(name, &case.files, |t| {
-            let mut t = t.to_string();
-            for m in &mods {
-                t = t.replace(&format!("\"{m}.mod\""), &format!("\"{m}.wsl\""));
-            }
-            t
-        });
+fn main() {
+    // The issue that brought RAPID asked for at least 10 equivalence cases.
+    test_every_case("tests/rapid", 10, rapid_modules_run_as_their_wsl_twins)
+}
+
+fn rapid_modules_run_as_their_wsl_twins(dir: &Path, name: &str) {
+    let text = std::fs::read_to_string(dir.join(format!("{name}.case"))).unwrap();
+    let case = parse(&text);
+    let mods: Vec<&str> = case
+        .files
+        .iter()
+        .filter_map(|(p, _)| p.strip_suffix(".mod"))
+        .collect();
+    assert!(!mods.is_empty(), "{name}: no RAPID module");
+    for m in &mods {
         assert!(
-            rapid.len() > 2,
-            "{name}: the RAPID run has {} events",
-            rapid.len()
+            case.files.iter().any(|(p, _)| *p == format!("{m}.wsl")),
+            "{name}: {m}.mod has no WSL twin {m}.wsl"
         );
-        let r: Vec<String> = rapid.iter().map(|l| without_position(l)).collect();
-        let w: Vec<String> = wsl.iter().map(|l| without_position(l)).collect();
-        if r != w {
-            let first = r
-                .iter()
-                .zip(&w)
-                .position(|(a, b)| a != b)
-                .unwrap_or(r.len().min(w.len()));
-            panic!(
-                "{name}: RAPID and WSL differ at event {first}:\n  RAPID: {}\n  WSL:   {}\n({} and {} events)",
-                r.get(first).map_or("(none)", String::as_str),
-                w.get(first).map_or("(none)", String::as_str),
-                r.len(),
-                w.len()
-            );
-        }
-        assert_eq!(outcome_r, outcome_w, "{name}: outcomes differ");
-        let trace = format!("outcome {outcome_r}\n{}\n", rapid.join("\n"));
-        for want in text.lines().filter_map(|l| l.strip_prefix("# expect: ")) {
-            assert!(
-                trace.contains(want),
-                "{name}: expected `{want}` in the RAPID trace:\n{trace}"
-            );
-        }
-        assert!(
-            rapid.iter().all(|l| !l.contains(".wsl:")),
-            "{name}: an event of the RAPID run names a WSL file"
-        );
-        expect_file![dir.join(format!("{name}.trace"))].assert_eq(&trace);
     }
+    let (rapid, outcome_r) = run(name, &case.files, |t| t.to_string());
+    let (wsl, outcome_w) = run(name, &case.files, |t| {
+        let mut t = t.to_string();
+        for m in &mods {
+            t = t.replace(&format!("\"{m}.mod\""), &format!("\"{m}.wsl\""));
+        }
+        t
+    });
+    assert!(
+        rapid.len() > 2,
+        "{name}: the RAPID run has {} events",
+        rapid.len()
+    );
+    let r: Vec<String> = rapid.iter().map(|l| without_position(l)).collect();
+    let w: Vec<String> = wsl.iter().map(|l| without_position(l)).collect();
+    if r != w {
+        let first = r
+            .iter()
+            .zip(&w)
+            .position(|(a, b)| a != b)
+            .unwrap_or(r.len().min(w.len()));
+        panic!(
+            "{name}: RAPID and WSL differ at event {first}:\n  RAPID: {}\n  WSL:   {}\n({} and {} events)",
+            r.get(first).map_or("(none)", String::as_str),
+            w.get(first).map_or("(none)", String::as_str),
+            r.len(),
+            w.len()
+        );
+    }
+    assert_eq!(outcome_r, outcome_w, "{name}: outcomes differ");
+    let trace = format!("outcome {outcome_r}\n{}\n", rapid.join("\n"));
+    for want in text.lines().filter_map(|l| l.strip_prefix("# expect: ")) {
+        assert!(
+            trace.contains(want),
+            "{name}: expected `{want}` in the RAPID trace:\n{trace}"
+        );
+    }
+    assert!(
+        rapid.iter().all(|l| !l.contains(".wsl:")),
+        "{name}: an event of the RAPID run names a WSL file"
+    );
+    expect_file![dir.join(format!("{name}.trace"))].assert_eq(&trace);
 }

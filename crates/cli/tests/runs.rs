@@ -13,7 +13,17 @@
 #![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)] // tests fail by panicking
 
 mod common;
-use common::{case_names, parse, root, run};
+use std::path::Path;
+
+use common::{parse, run, test_every_case};
+
+fn main() {
+    test_every_case(
+        "tests/runs",
+        10,
+        runs_give_the_times_and_outcomes_the_language_reference_promises,
+    )
+}
 
 /// `1234x real time` → `Nx real time`: the only thing in an output that depends on the
 /// machine.
@@ -33,45 +43,39 @@ fn mask_speed(text: &str) -> String {
         + if text.ends_with('\n') { "\n" } else { "" }
 }
 
-#[test]
-fn runs_give_the_times_and_outcomes_the_language_reference_promises() {
-    let dir = root().join("tests/runs");
-    let names = case_names(&dir);
-    assert!(names.len() >= 10, "{} cases", names.len());
-    for name in &names {
-        let text = std::fs::read_to_string(dir.join(format!("{name}.case"))).unwrap();
-        let case = parse(&text);
-        let (code, stdout, stderr) = run(name, &case);
-        let (stdout, stderr) = (mask_speed(&stdout), mask_speed(&stderr));
-        let mut got = format!("exit {code}\n");
-        if !stderr.is_empty() {
-            got.push_str("--- stderr\n");
-            got.push_str(&stderr);
-        }
-        if !stdout.is_empty() {
-            got.push_str("--- stdout\n");
-            got.push_str(&stdout);
-        }
-        assert!(!stderr.contains("panicked"), "{name}: panicked:\n{stderr}");
-        let expects: Vec<&str> = text
-            .lines()
-            .take_while(|l| !l.starts_with("$ vworks"))
-            .filter_map(|l| l.strip_prefix("# expect: "))
-            .collect();
-        assert!(!expects.is_empty(), "{name}: no `# expect:` line");
-        for e in expects {
-            assert!(
-                got.contains(e),
-                "{name}: expected (by hand) `{e}` in:\n{got}"
-            );
-        }
-        let header = text.lines().take_while(|l| !l.starts_with("$ vworks"));
-        for e in header.filter_map(|l| l.strip_prefix("# expect-not: ")) {
-            assert!(
-                !got.contains(e),
-                "{name}: expected (by hand) no `{e}` in:\n{got}"
-            );
-        }
-        expect_test::expect_file![dir.join(format!("{name}.out"))].assert_eq(&got);
+fn runs_give_the_times_and_outcomes_the_language_reference_promises(dir: &Path, name: &str) {
+    let text = std::fs::read_to_string(dir.join(format!("{name}.case"))).unwrap();
+    let case = parse(&text);
+    let (code, stdout, stderr) = run(name, &case);
+    let (stdout, stderr) = (mask_speed(&stdout), mask_speed(&stderr));
+    let mut got = format!("exit {code}\n");
+    if !stderr.is_empty() {
+        got.push_str("--- stderr\n");
+        got.push_str(&stderr);
     }
+    if !stdout.is_empty() {
+        got.push_str("--- stdout\n");
+        got.push_str(&stdout);
+    }
+    assert!(!stderr.contains("panicked"), "{name}: panicked:\n{stderr}");
+    let expects: Vec<&str> = text
+        .lines()
+        .take_while(|l| !l.starts_with("$ vworks"))
+        .filter_map(|l| l.strip_prefix("# expect: "))
+        .collect();
+    assert!(!expects.is_empty(), "{name}: no `# expect:` line");
+    for e in expects {
+        assert!(
+            got.contains(e),
+            "{name}: expected (by hand) `{e}` in:\n{got}"
+        );
+    }
+    let header = text.lines().take_while(|l| !l.starts_with("$ vworks"));
+    for e in header.filter_map(|l| l.strip_prefix("# expect-not: ")) {
+        assert!(
+            !got.contains(e),
+            "{name}: expected (by hand) no `{e}` in:\n{got}"
+        );
+    }
+    expect_test::expect_file![dir.join(format!("{name}.out"))].assert_eq(&got);
 }

@@ -88,32 +88,96 @@ fn rel(p: &Path) -> String {
     )
 }
 
-#[test]
-fn ok_programs_compile_to_the_expected_bytecode() {
-    let all = programs("ok");
-    assert!(all.len() >= 8, "the ok/ corpus is too small");
-    for p in all {
-        let src = read(&p);
-        let name = rel(&p);
-        let out = compile(&name, &src).unwrap_or_else(|e| {
-            let mut s = Sources::new();
-            s.add(&name, &src);
-            panic!(
-                "{name} should compile:\n{}",
-                render(&e.diagnostics, &s, false)
-            )
-        });
-        assert!(
-            out.warnings.is_empty(),
-            "{name} has warnings: {:?}",
-            out.warnings
-        );
-        let listing = disassemble(&out.module, &[src.as_str()]);
-        expect_file![p.with_extension("disasm")].assert_eq(&listing);
-        // The binary form round-trips exactly.
-        let back = Module::decode(&out.module.encode()).unwrap_or_else(|e| panic!("{name}: {e}"));
-        assert_eq!(back, out.module, "{name}: encode/decode changed the module");
+/// One test per fixture (named `ok/NAME.wsl`, `err/NAME.wsl`, `link/NAME`), so a failing
+/// fixture names itself, as ruff's fixture tests do; and the tests that hold over all of
+/// them: the folders are not emptied, and every diagnostic code has a fixture.
+fn main() {
+    use libtest_mimic::{Arguments, Failed, Trial};
+    let args = Arguments::from_args();
+    let ok = programs("ok");
+    let err = programs("err");
+    let link = link_case_dirs();
+    let mut trials = Vec::new();
+    for p in ok.clone() {
+        trials.push(Trial::test(rel(&p), move || {
+            ok_program_compiles_to_the_expected_bytecode(&p);
+            Ok(())
+        }));
     }
+    for p in err.clone() {
+        trials.push(Trial::test(rel(&p), move || {
+            bad_program_gives_the_expected_diagnostics(&p);
+            Ok(())
+        }));
+    }
+    for case in link.clone() {
+        trials.push(Trial::test(rel(&case), move || {
+            link_case_gives_the_expected_diagnostics(&case);
+            Ok(())
+        }));
+    }
+    let ok_count = ok.len();
+    trials.push(Trial::test(
+        "the ok corpus holds at least 8 programs",
+        move || {
+            if ok_count >= 8 {
+                Ok(())
+            } else {
+                Err(Failed::from(format!("ok/ holds {ok_count} programs")))
+            }
+        },
+    ));
+    trials.push(Trial::test(
+        "every diagnostic code has a fixture",
+        move || {
+            let mut covered = BTreeSet::new();
+            for p in &err {
+                covered.extend(diagnostics_of(p).1);
+            }
+            for case in &link {
+                covered.extend(
+                    link_diagnostics(case)
+                        .0
+                        .iter()
+                        .map(|d| d.code.as_str().to_string()),
+                );
+            }
+            let missing: Vec<&str> = Code::ALL
+                .iter()
+                .map(|c| c.as_str())
+                .filter(|c| *c != "E0900" && !covered.contains(*c))
+                .collect();
+            if missing.is_empty() {
+                Ok(())
+            } else {
+                Err(Failed::from(format!("no golden test gives {missing:?}")))
+            }
+        },
+    ));
+    libtest_mimic::run(&args, trials).exit()
+}
+
+fn ok_program_compiles_to_the_expected_bytecode(p: &Path) {
+    let src = read(p);
+    let name = rel(p);
+    let out = compile(&name, &src).unwrap_or_else(|e| {
+        let mut s = Sources::new();
+        s.add(&name, &src);
+        panic!(
+            "{name} should compile:\n{}",
+            render(&e.diagnostics, &s, false)
+        )
+    });
+    assert!(
+        out.warnings.is_empty(),
+        "{name} has warnings: {:?}",
+        out.warnings
+    );
+    let listing = disassemble(&out.module, &[src.as_str()]);
+    expect_file![p.with_extension("disasm")].assert_eq(&listing);
+    // The binary form round-trips exactly.
+    let back = Module::decode(&out.module.encode()).unwrap_or_else(|e| panic!("{name}: {e}"));
+    assert_eq!(back, out.module, "{name}: encode/decode changed the module");
 }
 
 fn code_of_header(src: &str, name: &str) -> String {
@@ -134,47 +198,53 @@ fn code_of_header(src: &str, name: &str) -> String {
     code
 }
 
-#[test]
-fn bad_programs_give_the_expected_diagnostics() {
-    let mut covered = BTreeSet::new();
-    for p in programs("err") {
-        let src = read(&p);
-        let name = rel(&p);
-        let want = code_of_header(&src, &name);
-        let diags = match compile(&name, &src) {
-            Ok(out) => out.warnings,
-            Err(e) => e.diagnostics,
-        };
-        assert!(!diags.is_empty(), "{name} should give diagnostics");
-        let codes: BTreeSet<&str> = diags.iter().map(|d| d.code.as_str()).collect();
-        assert!(
-            codes.contains(want.as_str()),
-            "{name} is about {want} but gave {codes:?}"
-        );
-        covered.extend(codes.iter().map(|c| c.to_string()));
-        let mut s = Sources::new();
-        s.add(&name, &src);
-        expect_file![p.with_extension("stderr")].assert_eq(&render(&diags, &s, false));
-    }
-    covered.extend(link_cases());
-    let missing: Vec<&str> = Code::ALL
-        .iter()
-        .map(|c| c.as_str())
-        .filter(|c| *c != "E0900" && !covered.contains(*c))
-        .collect();
-    assert!(missing.is_empty(), "no golden test gives {missing:?}");
+/// A bad program's diagnostics (its warnings if it compiles) and their codes.
+fn diagnostics_of(p: &Path) -> (Vec<vworks_wslc::Diagnostic>, BTreeSet<String>) {
+    let src = read(p);
+    let name = rel(p);
+    let diags = match compile(&name, &src) {
+        Ok(out) => out.warnings,
+        Err(e) => e.diagnostics,
+    };
+    let codes = diags.iter().map(|d| d.code.as_str().to_string()).collect();
+    (diags, codes)
 }
 
-/// Runs every link case; returns the codes they gave.
-fn link_cases() -> BTreeSet<String> {
-    let mut covered = BTreeSet::new();
+fn bad_program_gives_the_expected_diagnostics(p: &Path) {
+    let src = read(p);
+    let name = rel(p);
+    let want = code_of_header(&src, &name);
+    let (diags, codes) = diagnostics_of(p);
+    assert!(!diags.is_empty(), "{name} should give diagnostics");
+    assert!(
+        codes.contains(&want),
+        "{name} is about {want} but gave {codes:?}"
+    );
+    let mut s = Sources::new();
+    s.add(&name, &src);
+    expect_file![p.with_extension("stderr")].assert_eq(&render(&diags, &s, false));
+}
+
+/// The link cases' folders, sorted.
+fn link_case_dirs() -> Vec<PathBuf> {
     let mut cases: Vec<PathBuf> = std::fs::read_dir(dir("link"))
         .unwrap_or_else(|e| panic!("link: {e}"))
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.is_dir())
         .collect();
     cases.sort();
-    for case in cases {
+    cases
+}
+
+fn link_case_gives_the_expected_diagnostics(case: &Path) {
+    let (diags, sources) = link_diagnostics(case);
+    expect_file![case.join("expected.txt")].assert_eq(&render(&diags, &sources, false));
+}
+
+/// Compiles a link case's modules and links its cell: the diagnostics and the sources
+/// they point into.
+fn link_diagnostics(case: &Path) -> (Vec<vworks_wslc::Diagnostic>, Sources) {
+    {
         let cell_txt = read(&case.join("cell.txt"));
         let case_name = case
             .file_name()
@@ -244,8 +314,6 @@ fn link_cases() -> BTreeSet<String> {
             Ok(l) => l.warnings,
             Err(e) => e.diagnostics,
         };
-        covered.extend(diags.iter().map(|d| d.code.as_str().to_string()));
-        expect_file![case.join("expected.txt")].assert_eq(&render(&diags, &sources, false));
+        (diags, sources)
     }
-    covered
 }

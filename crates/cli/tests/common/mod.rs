@@ -27,6 +27,37 @@ pub fn case_names(dir: &Path) -> Vec<String> {
     names
 }
 
+/// Runs one test per `NAME.case` in the repository's `folder` (the test is named `NAME`,
+/// so a failing case names itself, as ruff's fixture tests do), with libtest-mimic: the
+/// usual test arguments work (`cargo test --test runs -- log-lines`, `--list`). A test
+/// `the folder holds at least MIN cases` guards against an emptied or moved folder.
+/// `check(dir, name)` fails by panicking.
+pub fn test_every_case(folder: &'static str, min: usize, check: fn(&Path, &str)) -> ! {
+    use libtest_mimic::{Arguments, Failed, Trial};
+    let args = Arguments::from_args();
+    let dir = root().join(folder);
+    let names = case_names(&dir);
+    let count = names.len();
+    let mut trials = vec![Trial::test(
+        format!("the folder holds at least {min} cases"),
+        move || {
+            if count >= min {
+                Ok(())
+            } else {
+                Err(Failed::from(format!("{folder} holds {count} cases")))
+            }
+        },
+    )];
+    for name in names {
+        let dir = dir.clone();
+        trials.push(Trial::test(name.clone(), move || {
+            check(&dir, &name);
+            Ok(())
+        }));
+    }
+    libtest_mimic::run(&args, trials).exit()
+}
+
 /// A command (`$ vworks …`) and its files (`--- NAME` then the text).
 pub struct Case {
     /// The arguments after `vworks`.
