@@ -197,10 +197,18 @@ fn robots_taking_turns_at_one_instant_do_not_race() {
     assert!(r.warnings.is_empty(), "{:?}", r.warnings);
 }
 
+/// The contract's workcell example (../shared/spec/engine.md), copied verbatim into
+/// `tests/data/contract-cell.toml` so the test below runs on any checkout.
+fn contract_cell() -> String {
+    let copy = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/contract-cell.toml");
+    std::fs::read_to_string(copy).unwrap()
+}
+
 #[test]
-fn the_contracts_workcell_example_loads_as_written() {
+fn the_copy_of_the_contracts_workcell_example_is_the_contracts() {
     let spec = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/spec/engine.md");
     let Ok(text) = std::fs::read_to_string(&spec) else {
+        // Outside the project's checkout layout the contract is not at hand; CI has it.
         assert!(
             std::env::var_os("CI").is_none(),
             "CI must have ../shared/spec/engine.md"
@@ -212,6 +220,17 @@ fn the_contracts_workcell_example_loads_as_written() {
         .nth(1)
         .and_then(|s| s.split("```").next())
         .unwrap();
+    assert_eq!(
+        toml,
+        contract_cell(),
+        "the contract's workcell example changed: update tests/data/contract-cell.toml"
+    );
+}
+
+#[test]
+fn the_contracts_workcell_example_loads_as_written() {
+    let toml = contract_cell();
+    let toml = toml.as_str();
     let path = write_cell(
         "spec",
         &[
