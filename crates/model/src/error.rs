@@ -28,6 +28,8 @@ pub enum ModelError {
     /// The URDF is well-formed but describes something vworks cannot use.
     #[error("{file}: {element}: {message}; {help}")]
     Invalid {
+        /// What is wrong, as a kind a program can match (the message says it in words).
+        problem: UrdfProblem,
         /// The file.
         file: String,
         /// The element, e.g. "joint `joint_3`".
@@ -57,4 +59,53 @@ pub enum ModelError {
         /// The names there are.
         known: String,
     },
+}
+
+/// What is wrong with a well-formed URDF that vworks cannot use ([`ModelError::Invalid`]):
+/// the kind, for programs and tests to match; the error's message says it in words.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[non_exhaustive]
+pub enum UrdfProblem {
+    /// Elements nest deeper than [`crate::urdf::MAX_NESTING`].
+    TooDeep,
+    /// A joint type vworks does not simulate (`floating`, `planar`, `spherical`).
+    UnsupportedJointType,
+    /// A joint type URDF does not have.
+    UnknownJointType,
+    /// A joint without a `type`.
+    MissingJointType,
+    /// Two links of one name.
+    DuplicateLink,
+    /// A robot without links.
+    NoLinks,
+    /// A joint's parent or child link does not exist.
+    MissingLink,
+    /// A link with two parent joints.
+    TwoParents,
+    /// A number that is not finite (an `<origin>`).
+    NotFinite,
+    /// A moving joint's axis of zero length (or not finite).
+    ZeroAxis,
+    /// More than one link without a parent.
+    SeveralRoots,
+    /// Joints that close a loop.
+    Cycle,
+    /// The tool link asked for is not a link of the robot.
+    UnknownToolLink,
+    /// The tree branches, no `tool0`, and no tool link named.
+    AmbiguousToolLink,
+    /// Joint limits that are not a finite range (`lower > upper`, not finite).
+    BadJointRange,
+    /// A moving joint's velocity limit that is not positive and finite.
+    BadVelocityLimit,
+    /// An acceleration, deceleration or jerk limit that is not positive and finite.
+    BadDynamicLimit,
+    /// A shape's size that is not positive and finite.
+    BadSize,
+    /// A mesh with no volume, so no convex hull.
+    DegenerateMesh,
+    /// More than 12 axes on the chain to the tool.
+    TooManyAxes,
+    /// A `<mimic>` joint on the chain to the tool.
+    MimicOnToolChain,
 }

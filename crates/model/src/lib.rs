@@ -30,7 +30,7 @@ pub mod output;
 pub mod text;
 pub mod urdf;
 
-pub use error::ModelError;
+pub use error::{ModelError, UrdfProblem};
 pub use ik::IkError;
 pub use math::Iso;
 pub use model::{JointKind, RobotModel};

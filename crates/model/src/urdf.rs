@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use parry3d::math::Vector;
 use parry3d::shape::SharedShape;
 
-use crate::error::ModelError;
+use crate::error::{ModelError, UrdfProblem};
 use crate::files::{Disk, Files};
 use crate::math::{Iso, V3, norm};
 use crate::mesh;
@@ -69,12 +69,14 @@ pub fn load_str_with(
     opts: &LoadOptions,
     files: &dyn Files,
 ) -> Result<RobotModel, ModelError> {
-    let invalid = |element: String, message: String, help: &str| ModelError::Invalid {
-        file: file.to_string(),
-        element,
-        message,
-        help: help.to_string(),
-    };
+    let invalid =
+        |problem: UrdfProblem, element: String, message: String, help: &str| ModelError::Invalid {
+            problem,
+            file: file.to_string(),
+            element,
+            message,
+            help: help.to_string(),
+        };
     // urdf-rs walks the element tree recursively: nesting is bounded before it sees it.
     check_nesting(text, file)?;
     // Joint elements read from the text itself (comments and references left out).
@@ -94,6 +96,7 @@ pub fn load_str_with(
     for (i, l) in robot.links.iter().enumerate() {
         if by_name.insert(l.name.as_str(), i).is_some() {
             return Err(invalid(
+                UrdfProblem::DuplicateLink,
                 format!("link `{}`", l.name),
                 "is declared twice".into(),
                 "give every link a unique name",
@@ -102,6 +105,7 @@ pub fn load_str_with(
     }
     if robot.links.is_empty() {
         return Err(invalid(
+            UrdfProblem::NoLinks,
             "robot".into(),
             "has no links".into(),
             "a URDF needs at least one <link>",
@@ -115,6 +119,7 @@ pub fn load_str_with(
         let find = |name: &str, role: &str| {
             by_name.get(name).copied().ok_or_else(|| {
                 invalid(
+                    UrdfProblem::MissingLink,
                     el(),
                     format!("its {role} link `{name}` does not exist"),
                     "name a <link> of this file",
@@ -125,6 +130,7 @@ pub fn load_str_with(
         let c = find(&j.child.link, "child")?;
         if let Some(other) = parent_of[c] {
             return Err(invalid(
+                UrdfProblem::TwoParents,
                 el(),
                 format!(
                     "link `{}` already has the parent joint `{}`",
@@ -137,6 +143,7 @@ pub fn load_str_with(
         let o = &j.origin;
         if o.xyz.0.iter().chain(o.rpy.0.iter()).any(|x| !x.is_finite()) {
             return Err(invalid(
+                UrdfProblem::NotFinite,
                 el(),
                 "its <origin> has a value that is not a finite number".into(),
                 "write numbers for xyz and rpy (no nan or inf)",
@@ -146,6 +153,7 @@ pub fn load_str_with(
         let moves = j.joint_type != urdf_rs::JointType::Fixed;
         if moves && (a.iter().any(|x| !x.is_finite()) || norm(a) < 1e-12) {
             return Err(invalid(
+                UrdfProblem::ZeroAxis,
                 el(),
                 format!("its <axis xyz> is {:?}", a),
                 "give a non-zero direction, e.g. <axis xyz=\"0 0 1\"/>",
@@ -163,6 +171,7 @@ pub fn load_str_with(
             .map(|r| robot.links[*r].name.as_str())
             .collect();
         return Err(invalid(
+            UrdfProblem::SeveralRoots,
             format!("link `{}`", names[1]),
             format!("the tree has {} roots ({})", roots.len(), names.join(", ")),
             "connect every link to one base link with a joint",
@@ -170,6 +179,7 @@ pub fn load_str_with(
     }
     let Some(&root) = roots.first() else {
         return Err(invalid(
+            UrdfProblem::Cycle,
             "robot".into(),
             "every link has a parent, so the joints form a cycle".into(),
             "remove the joint that closes the loop",
@@ -195,6 +205,7 @@ pub fn load_str_with(
             .find(|i| !order.contains(i))
             .unwrap_or(0);
         return Err(invalid(
+            UrdfProblem::Cycle,
             format!("link `{}`", robot.links[stray].name),
             "is part of a cycle of joints, not reachable from the base".into(),
             "a URDF is a tree: remove the joint that closes the loop",
@@ -207,6 +218,7 @@ pub fn load_str_with(
     let tool_old = match &opts.tool_link {
         Some(name) => *by_name.get(name.as_str()).ok_or_else(|| {
             invalid(
+                UrdfProblem::UnknownToolLink,
                 format!("tool link `{name}`"),
                 "is not a link of this robot".into(),
                 "name one of its links as the tool",
@@ -226,6 +238,7 @@ pub fn load_str_with(
                             .map(|i| robot.links[i].name.as_str())
                             .collect();
                         return Err(invalid(
+                            UrdfProblem::AmbiguousToolLink,
                             format!("link `{}`", robot.links[l].name),
                             "the tree branches here, so the tool link is ambiguous".into(),
                             &format!(
@@ -254,6 +267,7 @@ pub fn load_str_with(
             urdf_rs::JointType::Fixed => JointKind::Fixed,
             _ => {
                 return Err(invalid(
+                    UrdfProblem::UnsupportedJointType,
                     el(),
                     "has a type vworks does not support".into(),
                     "use revolute, continuous, prismatic or fixed",
@@ -274,6 +288,7 @@ pub fn load_str_with(
             _ => {
                 if !lim.lower.is_finite() || !lim.upper.is_finite() || lim.lower > lim.upper {
                     return Err(invalid(
+                        UrdfProblem::BadJointRange,
                         el(),
                         format!(
                             "its limits lower={} upper={} are not a finite range",
@@ -288,6 +303,7 @@ pub fn load_str_with(
         let (max_velocity, max_accel, max_jerk) = if kind.is_movable() {
             if !(lim.velocity.is_finite() && lim.velocity > 0.0) {
                 return Err(invalid(
+                    UrdfProblem::BadVelocityLimit,
                     el(),
                     format!("its velocity limit is {}", lim.velocity),
                     "a moving joint needs <limit velocity=\"…\"/> greater than 0",
@@ -297,6 +313,7 @@ pub fn load_str_with(
             let given = |name: &str, value: Option<f64>| -> Result<Option<f64>, ModelError> {
                 match value {
                     Some(v) if !(v.is_finite() && v > 0.0) => Err(invalid(
+                        UrdfProblem::BadDynamicLimit,
                         el(),
                         format!("its {name} limit is {v}"),
                         &format!("write <limit {name}=\"…\"/> greater than 0, or leave it out"),
@@ -343,6 +360,7 @@ pub fn load_str_with(
             let o = &c.origin;
             if o.xyz.0.iter().chain(o.rpy.0.iter()).any(|x| !x.is_finite()) {
                 return Err(invalid(
+                    UrdfProblem::NotFinite,
                     el,
                     "its <origin> has a value that is not a finite number".into(),
                     "write numbers for xyz and rpy",
@@ -375,6 +393,7 @@ pub fn load_str_with(
         .collect();
     if axes.len() > 12 {
         return Err(invalid(
+            UrdfProblem::TooManyAxes,
             format!("link `{}`", links[tool_link].name),
             format!("the chain to the tool has {} axes", axes.len()),
             "vworks robots have at most 12 axes; split the cell into several robots",
@@ -393,6 +412,7 @@ pub fn load_str_with(
             .any(|rj| rj.name == *name && rj.mimic.is_some())
         {
             return Err(invalid(
+                UrdfProblem::MimicOnToolChain,
                 format!("joint `{name}`"),
                 "mimics another joint, and is on the chain to the tool: vworks would move it as an axis of its own".into(),
                 "give it its own axis (remove <mimic>), or choose a tool link whose chain does not pass through it",
@@ -466,6 +486,7 @@ fn check_nesting(text: &str, file: &str) -> Result<(), ModelError> {
                     .collect();
                 let line = 1 + text[..start].bytes().filter(|&c| c == b'\n').count();
                 return Err(ModelError::Invalid {
+                    problem: UrdfProblem::TooDeep,
                     file: file.to_string(),
                     element: format!("element `<{name}>` at line {line}"),
                     message: format!(
@@ -524,6 +545,7 @@ fn check_joint_types(elements: &[JointElement<'_>], file: &str) -> Result<(), Mo
             Some("revolute" | "continuous" | "prismatic" | "fixed") => {}
             Some(t @ ("floating" | "planar" | "spherical")) => {
                 return Err(ModelError::Invalid {
+                    problem: UrdfProblem::UnsupportedJointType,
                     file: file.into(),
                     element: format!("joint `{name}`"),
                     message: format!("type `{t}` is not supported"),
@@ -533,6 +555,7 @@ fn check_joint_types(elements: &[JointElement<'_>], file: &str) -> Result<(), Mo
             }
             Some(t) => {
                 return Err(ModelError::Invalid {
+                    problem: UrdfProblem::UnknownJointType,
                     file: file.into(),
                     element: format!("joint `{name}`"),
                     message: format!("unknown joint type `{t}`"),
@@ -541,6 +564,7 @@ fn check_joint_types(elements: &[JointElement<'_>], file: &str) -> Result<(), Mo
             }
             None => {
                 return Err(ModelError::Invalid {
+                    problem: UrdfProblem::MissingJointType,
                     file: file.into(),
                     element: format!("joint `{name}`"),
                     message: "has no type".into(),
@@ -646,6 +670,7 @@ fn geometry(
     files: &dyn Files,
 ) -> Result<Geometry, ModelError> {
     let bad = |what: &str| ModelError::Invalid {
+        problem: UrdfProblem::BadSize,
         file: file.into(),
         element: el.into(),
         message: format!("its {what} must be positive, finite numbers"),
@@ -767,6 +792,7 @@ pub fn build_shape(
                 .map(|p| Vector::new(p[0], p[1], p[2]))
                 .collect();
             SharedShape::convex_hull(&pts).ok_or_else(|| ModelError::Invalid {
+                problem: UrdfProblem::DegenerateMesh,
                 file: file.into(),
                 element: el.into(),
                 message: "the mesh is flat or degenerate, so it has no convex hull".into(),

@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use vworks_model::urdf::{LoadOptions, load_file};
-use vworks_model::{ModelError, builtin};
+use vworks_model::{ModelError, UrdfProblem, builtin};
 
 fn dir() -> PathBuf {
     let d = std::env::temp_dir().join(format!("vworks-model-bad-{}", std::process::id()));
@@ -35,16 +35,35 @@ fn load(file: &str, text: &str) -> Result<vworks_model::RobotModel, ModelError> 
     load_file(&p, &LoadOptions::default())
 }
 
+/// The kind of error a case must give.
+#[derive(Debug, PartialEq)]
+enum Want {
+    Read,
+    Parse,
+    Invalid(UrdfProblem),
+    Mesh,
+}
+
 fn expect_error(
     case: &str,
+    want: Want,
     r: Result<vworks_model::RobotModel, ModelError>,
     file: &str,
     needles: &[&str],
 ) {
     let e = match r {
         Ok(_) => panic!("{case}: should fail"),
-        Err(e) => e.to_string(),
+        Err(e) => e,
     };
+    let got = match &e {
+        ModelError::Read { .. } => Some(Want::Read),
+        ModelError::Parse { .. } => Some(Want::Parse),
+        ModelError::Invalid { problem, .. } => Some(Want::Invalid(*problem)),
+        ModelError::Mesh { .. } => Some(Want::Mesh),
+        _ => None,
+    };
+    assert_eq!(got, Some(want), "{case}: {e}");
+    let e = e.to_string();
     assert!(
         e.contains(file),
         "{case}: the message must name the file {file}: {e}"
@@ -59,6 +78,7 @@ fn missing_file() {
     let p = dir().join("nowhere.urdf");
     expect_error(
         "missing file",
+        Want::Read,
         load_file(&p, &LoadOptions::default()),
         "nowhere.urdf",
         &["cannot read"],
@@ -69,6 +89,7 @@ fn missing_file() {
 fn bad_xml() {
     expect_error(
         "bad xml",
+        Want::Parse,
         load("badxml.urdf", "<robot name=\"x\"><link name=\"a\"></robot"),
         "badxml.urdf",
         &["not a valid URDF"],
@@ -80,6 +101,7 @@ fn unknown_joint_type() {
     let t = robot(&(link("a") + &link("b") + &joint("j_weird", "banana", "a", "b", "")));
     expect_error(
         "unknown type",
+        Want::Invalid(UrdfProblem::UnknownJointType),
         load("type.urdf", &t),
         "type.urdf",
         &["joint `j_weird`", "unknown joint type `banana`", "revolute"],
@@ -87,6 +109,7 @@ fn unknown_joint_type() {
     let t = robot(&(link("a") + &link("b") + &joint("j_float", "floating", "a", "b", "")));
     expect_error(
         "floating",
+        Want::Invalid(UrdfProblem::UnsupportedJointType),
         load("float.urdf", &t),
         "float.urdf",
         &["joint `j_float`", "not supported"],
@@ -103,7 +126,13 @@ fn cycle_in_the_tree() {
             + &joint("ab", "revolute", "a", "b", "")
             + &joint("ba", "revolute", "b", "a", "")),
     );
-    expect_error("cycle", load("cycle.urdf", &t), "cycle.urdf", &["cycle"]);
+    expect_error(
+        "cycle",
+        Want::Invalid(UrdfProblem::Cycle),
+        load("cycle.urdf", &t),
+        "cycle.urdf",
+        &["cycle"],
+    );
     // Without any root at all.
     let t = robot(
         &(link("a")
@@ -113,6 +142,7 @@ fn cycle_in_the_tree() {
     );
     expect_error(
         "cycle, no root",
+        Want::Invalid(UrdfProblem::Cycle),
         load("cycle2.urdf", &t),
         "cycle2.urdf",
         &["cycle"],
@@ -127,6 +157,7 @@ fn cycle_in_the_tree() {
     );
     expect_error(
         "two parents",
+        Want::Invalid(UrdfProblem::TwoParents),
         load("parents.urdf", &t),
         "parents.urdf",
         &["joint `bc`", "already has the parent joint `ac`"],
@@ -138,6 +169,7 @@ fn two_roots() {
     let t = robot(&(link("a") + &link("b") + &link("c") + &joint("ab", "revolute", "a", "b", "")));
     expect_error(
         "two roots",
+        Want::Invalid(UrdfProblem::SeveralRoots),
         load("roots.urdf", &t),
         "roots.urdf",
         &["2 roots", "a, c"],
@@ -149,6 +181,7 @@ fn missing_mesh() {
     let body = r#"<link name="a"><collision><geometry><mesh filename="package://arm/meshes/a.stl"/></geometry></collision></link>"#;
     expect_error(
         "missing mesh",
+        Want::Mesh,
         load("mesh.urdf", &robot(body)),
         "mesh.urdf",
         &[
@@ -164,6 +197,7 @@ fn missing_mesh() {
     let body = r#"<link name="a"><collision><geometry><mesh filename="junk.stl"/></geometry></collision></link>"#;
     expect_error(
         "junk mesh",
+        Want::Mesh,
         load("junk.urdf", &robot(body)),
         "junk.urdf",
         &["junk.stl", "not an STL"],
@@ -186,6 +220,7 @@ fn meshes_that_are_devices_or_too_large_are_refused_unread() {
     std::os::unix::fs::symlink("/dev/urandom", &random).unwrap();
     expect_error(
         "mesh linked to /dev/urandom",
+        Want::Mesh,
         load("random.urdf", &robot(&mesh("random.stl"))),
         "random.urdf",
         &[
@@ -200,6 +235,7 @@ fn meshes_that_are_devices_or_too_large_are_refused_unread() {
         .unwrap();
     expect_error(
         "mesh over the limit",
+        Want::Mesh,
         load("big.urdf", &robot(&mesh("big.stl"))),
         "big.urdf",
         &["big.stl", "larger than 256 MiB"],
@@ -219,6 +255,7 @@ fn nan_or_inf_in_an_origin() {
     let j = joint("j2", "revolute", "a", "b", "").replace(r#"xyz="0 0 0.1""#, r#"xyz="0 nan 0.1""#);
     expect_error(
         "nan",
+        Want::Invalid(UrdfProblem::NotFinite),
         load("nan.urdf", &robot(&(link("a") + &link("b") + &j))),
         "nan.urdf",
         &["joint `j2`", "<origin>", "finite"],
@@ -226,6 +263,7 @@ fn nan_or_inf_in_an_origin() {
     let j = joint("j3", "revolute", "a", "b", "").replace(r#"rpy="0 0 0""#, r#"rpy="0 inf 0""#);
     expect_error(
         "inf",
+        Want::Invalid(UrdfProblem::NotFinite),
         load("inf.urdf", &robot(&(link("a") + &link("b") + &j))),
         "inf.urdf",
         &["joint `j3`", "<origin>", "finite"],
@@ -238,6 +276,7 @@ fn zero_axis() {
         .replace(r#"<axis xyz="0 0 1"/>"#, r#"<axis xyz="0 0 0"/>"#);
     expect_error(
         "zero axis",
+        Want::Invalid(UrdfProblem::ZeroAxis),
         load("axis.urdf", &robot(&(link("a") + &link("b") + &j))),
         "axis.urdf",
         &["joint `j4`", "<axis xyz>", "non-zero"],
@@ -249,6 +288,7 @@ fn more_mistakes() {
     let j = joint("j5", "revolute", "a", "nowhere", "");
     expect_error(
         "missing child",
+        Want::Invalid(UrdfProblem::MissingLink),
         load("child.urdf", &robot(&(link("a") + &j))),
         "child.urdf",
         &["joint `j5`", "child link `nowhere`"],
@@ -256,6 +296,7 @@ fn more_mistakes() {
     let j = joint("j6", "revolute", "a", "b", "").replace(r#"velocity="1""#, r#"velocity="0""#);
     expect_error(
         "no velocity",
+        Want::Invalid(UrdfProblem::BadVelocityLimit),
         load("vel.urdf", &robot(&(link("a") + &link("b") + &j))),
         "vel.urdf",
         &["joint `j6`", "velocity"],
@@ -264,6 +305,7 @@ fn more_mistakes() {
         .replace(r#"lower="-1" upper="1""#, r#"lower="1" upper="-1""#);
     expect_error(
         "inverted limits",
+        Want::Invalid(UrdfProblem::BadJointRange),
         load("lim.urdf", &robot(&(link("a") + &link("b") + &j))),
         "lim.urdf",
         &["joint `j7`", "lower"],
@@ -275,6 +317,7 @@ fn more_mistakes() {
         + &joint("ac", "revolute", "a", "c", "");
     expect_error(
         "branching",
+        Want::Invalid(UrdfProblem::AmbiguousToolLink),
         load("branch.urdf", &robot(&body)),
         "branch.urdf",
         &["branches", "name the tool link", "b, c"],
@@ -282,6 +325,7 @@ fn more_mistakes() {
     let body = r#"<link name="a"><collision><geometry><box size="0.1 -0.2 0.1"/></geometry></collision></link>"#;
     expect_error(
         "negative box",
+        Want::Invalid(UrdfProblem::BadSize),
         load("box.urdf", &robot(body)),
         "box.urdf",
         &["link `a` collision 1", "box size"],
@@ -327,6 +371,7 @@ fn a_type_after_a_non_ascii_character_is_an_error_not_a_panic() {
     ));
     expect_error(
         "non-ascii quote",
+        Want::Invalid(UrdfProblem::MissingJointType),
         load("quote.urdf", &text),
         "quote.urdf",
         &["joint `j`"],
@@ -358,6 +403,7 @@ fn tool0_is_the_tool_when_the_tree_branches() {
     let body = body.replace("tool0", "flange");
     expect_error(
         "branching without tool0",
+        Want::Invalid(UrdfProblem::AmbiguousToolLink),
         load("notool0.urdf", &robot(&body)),
         "notool0.urdf",
         &["the tree branches", "tool_link", "tool0"],
@@ -393,24 +439,28 @@ fn dynamic_limits_are_read_whatever_the_version() {
     assert_eq!(m.axis(0).max_jerk, None);
     expect_error(
         "zero acceleration",
+        Want::Invalid(UrdfProblem::BadDynamicLimit),
         load("zero.urdf", &limits(r#"acceleration="0""#)),
         "zero.urdf",
         &["joint `j`", "acceleration limit is 0"],
     );
     expect_error(
         "negative jerk",
+        Want::Invalid(UrdfProblem::BadDynamicLimit),
         load("jerk.urdf", &limits(r#"jerk="-5""#)),
         "jerk.urdf",
         &["joint `j`", "jerk limit is -5", "greater than 0"],
     );
     expect_error(
         "infinite jerk",
+        Want::Invalid(UrdfProblem::BadDynamicLimit),
         load("inf.urdf", &limits(r#"jerk="inf""#)),
         "inf.urdf",
         &["joint `j`", "jerk limit is inf"],
     );
     expect_error(
         "not a number",
+        Want::Invalid(UrdfProblem::BadDynamicLimit),
         load("nan.urdf", &limits(r#"deceleration="fast""#)),
         "nan.urdf",
         &["joint `j`", "deceleration limit is NaN"],
@@ -432,6 +482,7 @@ fn a_mimic_joint_on_the_tool_chain_is_an_error() {
     .concat();
     expect_error(
         "mimic on the chain",
+        Want::Invalid(UrdfProblem::MimicOnToolChain),
         load("mimic.urdf", &robot(&body)),
         "mimic.urdf",
         &["joint `j2`", "mimics another joint"],
@@ -447,6 +498,7 @@ fn deeply_nested_elements_are_an_error_not_a_stack_overflow() {
     let t = robot(&(link("a") + &"<x>".repeat(n) + &"</x>".repeat(n)));
     expect_error(
         "nesting",
+        Want::Invalid(UrdfProblem::TooDeep),
         load("deep.urdf", &t),
         "deep.urdf",
         &["element `<x>` at line 1", "64"],
@@ -466,6 +518,7 @@ fn deeply_nested_elements_are_an_error_not_a_stack_overflow() {
     let t = robot(&(link("a") + &"<x>".repeat(inner + 1) + &"</x>".repeat(inner + 1)));
     expect_error(
         "one too deep",
+        Want::Invalid(UrdfProblem::TooDeep),
         load("too_deep.urdf", &t),
         "too_deep.urdf",
         &["65 deep", "64"],
