@@ -860,14 +860,9 @@ fn load_parsed(
                             .iter()
                             .map(|(p, t)| (p.as_str(), t.as_str()))
                             .collect();
-                        let result = match language {
-                            vworks_wslc::Language::Rapid => {
-                                vworks_wslc::rapid::compile_files(&files, signals)
-                            }
-                            vworks_wslc::Language::Wsl => vworks_wslc::compile_files(&files),
-                        }
-                        .map(|out| (Arc::new(out.module), out.warnings))
-                        .map_err(|e| e.diagnostics);
+                        let result = vworks_wslc::compile_program(language, &files, signals)
+                            .map(|out| (Arc::new(out.module), out.warnings))
+                            .map_err(|e| e.diagnostics);
                         cache.keep_program(
                             &mkey,
                             Compiled {

@@ -38,7 +38,7 @@ use vworks_vm::{ConstValue, Instr, Module};
 pub(crate) fn is_program(path: &Path) -> bool {
     let text = path.to_string_lossy();
     let ext = path.extension().map(|e| e.to_string_lossy().to_lowercase());
-    matches!(ext.as_deref(), Some("wsl" | "wslb")) || vworks_wslc::rapid::is_rapid_path(&text)
+    ext.as_deref() == Some("wslb") || vworks_wslc::Language::of_source_file(&text).is_some()
 }
 
 /// True for what `check` takes as a workcell: a `.toml` file, or a folder.

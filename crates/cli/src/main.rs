@@ -27,7 +27,7 @@ use view::view;
 use vworks_se::result::issue_json as json_issue;
 use vworks_vm::Module;
 use vworks_vm::bytecode::disassemble;
-use vworks_wslc::{Language, Sources, compile_files_as, render};
+use vworks_wslc::{Language, Sources, render};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -344,7 +344,7 @@ fn compile_program(
         .iter()
         .map(|(p, t)| (p.as_str(), t.as_str()))
         .collect();
-    match compile_files_as(language, &files) {
+    match vworks_wslc::compile_program(language, &files, None) {
         Ok(out) => {
             eprint!("{}", render(&out.warnings, &sources, color));
             Ok((Some(out.module), 0, out.warnings.len()))

@@ -148,18 +148,12 @@ impl Module {
 /// The language named `language` (`"wsl"` or `"rapid"`, any case), else by the
 /// extensions of `paths` (all of one language), else WSL.
 fn language_of(language: Option<&str>, paths: &[&str]) -> PyResult<vworks_wslc::Language> {
-    Ok(match language.map(str::to_ascii_lowercase).as_deref() {
+    match language {
         None => {
-            vworks_wslc::Language::of_files(paths).map_err(|(_, why)| PyValueError::new_err(why))?
+            vworks_wslc::Language::of_files(paths).map_err(|(_, why)| PyValueError::new_err(why))
         }
-        Some("wsl") => vworks_wslc::Language::Wsl,
-        Some("rapid") => vworks_wslc::Language::Rapid,
-        Some(other) => {
-            return Err(PyValueError::new_err(format!(
-                "unknown language {other:?}: use \"wsl\" or \"rapid\""
-            )));
-        }
-    })
+        Some(name) => vworks_wslc::Language::from_name(name).map_err(PyValueError::new_err),
+    }
 }
 
 /// Compiles `source`, WSL or ABB RAPID; `path` names the file in diagnostics. The
@@ -175,10 +169,7 @@ pub(crate) fn compile(
     language: Option<&str>,
 ) -> PyResult<Module> {
     let lang = language_of(language, path.as_slice())?;
-    let path = path.unwrap_or(match lang {
-        vworks_wslc::Language::Rapid => "x.mod",
-        vworks_wslc::Language::Wsl => "x.wsl",
-    });
+    let path = path.unwrap_or(lang.default_path());
     compile_program(py, lang, &[(path.to_string(), source.to_string())])
 }
 
@@ -217,7 +208,7 @@ fn compile_program(
         .iter()
         .map(|(p, t)| (p.as_str(), t.as_str()))
         .collect();
-    match vworks_wslc::compile_files_as(lang, &refs) {
+    match vworks_wslc::compile_program(lang, &refs, None) {
         Ok(c) => Ok(Module {
             warnings: c.warnings.iter().map(|d| diagnostic(d, &sources)).collect(),
             module: c.module,

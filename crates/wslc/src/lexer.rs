@@ -216,6 +216,27 @@ pub struct Token {
     pub span: Span,
 }
 
+impl crate::frontend::Lexeme for Token {
+    fn span_mut(&mut self) -> &mut Span {
+        &mut self.span
+    }
+    fn span(&self) -> Span {
+        self.span
+    }
+    fn is_eof(&self) -> bool {
+        self.kind == TokKind::Eof
+    }
+    fn is_error(&self) -> bool {
+        self.kind == TokKind::Error
+    }
+    fn eof(at: Span) -> Self {
+        Token {
+            kind: TokKind::Eof,
+            span: at,
+        }
+    }
+}
+
 /// The units a literal may carry: spelling, SI factor, dimension.
 pub const UNITS: &[(&str, f64, Dim)] = &[
     ("mm", 1e-3, Dim::LENGTH),

@@ -20,16 +20,20 @@
 //! ```
 
 pub mod diag;
+mod frontend;
+mod language;
 pub mod lexer;
 pub mod link;
 mod lower;
 pub mod parser;
-mod program;
 pub mod rapid;
 pub mod syntax;
 pub mod units;
 
+use frontend::program::ProgramText;
+
 pub use diag::{Code, Diagnostic, Severity, Sources, render};
+pub use language::Language;
 
 /// Every built-in function as (name, signature, result), in the order of
 /// docs/language.md's table: for editors, completions and documentation tools.
@@ -124,90 +128,41 @@ pub fn compile(path: &str, source: &str) -> Result<Compiled, CompileError> {
 /// file with the library files it uses. Each file is lexed and parsed on its own;
 /// positions and diagnostics name their own file.
 pub fn compile_files(files: &[(&str, &str)]) -> Result<Compiled, CompileError> {
-    let program = program::ProgramText::new(files);
+    let program = ProgramText::new(files);
     let mut diags = Vec::new();
     let mut ast = syntax::SourceModule { items: Vec::new() };
-    for (_, start, text) in program.files() {
-        let toks = program::ProgramText::lex(start, text, &mut diags, lexer::lex, |t| &mut t.span);
-        ast.items
-            .extend(parser::parse(program.text(), toks, &mut diags).items);
+    for (_, file) in program.parse_each(&mut diags, lexer::lex, parser::parse) {
+        ast.items.extend(file.items);
     }
     let syntax_ok = !diags.iter().any(Diagnostic::is_error);
     finish(&program, syntax_ok.then_some(&ast), diags)
 }
 
-/// The language of a program file, from its extension: RAPID for `.mod`, `.modx`, `.sys`,
-/// `.sysx` and `.prg`, WSL for anything else.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Language {
-    /// WSL, vworks's own language.
-    Wsl,
-    /// ABB RAPID.
-    Rapid,
-}
-
-impl Language {
-    /// The language of a file by its extension.
-    pub fn of_path(path: &str) -> Language {
-        if rapid::is_rapid_path(path) {
-            Language::Rapid
-        } else {
-            Language::Wsl
-        }
-    }
-
-    /// The language of a program of several files: the first file's, which every other
-    /// must share; else the index of the first file in another language and a message
-    /// naming both. (WSL for no files.)
-    pub fn of_files(paths: &[&str]) -> Result<Language, (usize, String)> {
-        let Some(first) = paths.first() else {
-            return Ok(Language::Wsl);
-        };
-        let language = Language::of_path(first);
-        match paths.iter().position(|p| Language::of_path(p) != language) {
-            None => Ok(language),
-            Some(k) => Err((
-                k,
-                format!(
-                    "`{}` is {} but `{first}` is {}: one program's files are all in one language",
-                    paths[k],
-                    Language::of_path(paths[k]).name(),
-                    language.name()
-                ),
-            )),
-        }
-    }
-
-    /// Its name as messages give it: `WSL` or `RAPID`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Language::Wsl => "WSL",
-            Language::Rapid => "RAPID",
-        }
-    }
-}
-
 /// Compiles a program in the given language.
 pub fn compile_as(language: Language, path: &str, source: &str) -> Result<Compiled, CompileError> {
-    compile_files_as(language, &[(path, source)])
+    compile_program(language, &[(path, source)], None)
 }
 
-/// Compiles a program of several files ((path, text), in order) in `language`: a RAPID
-/// task's modules ([`rapid::compile_files`]) or a WSL program's files ([`compile_files`]).
-pub fn compile_files_as(
+/// Compiles a program of several files ((path, text), in order) in `language`: the one
+/// entry point that picks the front-end. A RAPID task's modules go to
+/// [`rapid::compile_files`] with the robot's I/O signals `io` (`None`: any signal by
+/// name); a WSL program's files to [`compile_files`] (WSL has no I/O signals: `io` is not
+/// read).
+pub fn compile_program(
     language: Language,
     files: &[(&str, &str)],
+    io: Option<&[rapid::IoSignal]>,
 ) -> Result<Compiled, CompileError> {
     match language {
         Language::Wsl => compile_files(files),
-        Language::Rapid => rapid::compile_files(files, None),
+        Language::Rapid => rapid::compile_files(files, io),
     }
 }
 
 /// Checks and generates code for a syntax tree (if the front-end produced one), verifies
 /// the module, and resolves and sorts the diagnostics.
 pub(crate) fn finish(
-    program: &program::ProgramText,
+    program: &ProgramText,
     ast: Option<&syntax::SourceModule>,
     mut diags: Vec<Diagnostic>,
 ) -> Result<Compiled, CompileError> {

@@ -10,6 +10,7 @@
 //! `* / mod`; unary `-`; postfix call, `.field`, `[index]`.
 
 use crate::diag::{Code, Diagnostic};
+use crate::frontend::{Limits, PResult, Parser, Reported};
 use crate::lexer::{Kw, Punct, TokKind, Token};
 use crate::syntax::*;
 
@@ -21,29 +22,11 @@ const MAX_ERRORS: usize = 100;
 
 /// Parses a token stream (from [`crate::lexer::lex`]).
 pub fn parse(src: &str, toks: Vec<Token>, diags: &mut Vec<Diagnostic>) -> SourceModule {
-    let mut p = Parser {
-        src,
-        toks,
-        pos: 0,
-        diags,
-        depth: 0,
-        errors: 0,
+    let limits = Limits {
+        max_depth: MAX_DEPTH,
+        max_errors: MAX_ERRORS,
     };
-    p.module()
-}
-
-/// A parse failure that has been reported; the caller recovers.
-struct Reported;
-
-type PResult<T> = Result<T, Reported>;
-
-struct Parser<'s, 'd> {
-    src: &'s str,
-    toks: Vec<Token>,
-    pos: usize,
-    diags: &'d mut Vec<Diagnostic>,
-    depth: u32,
-    errors: usize,
+    Parser::new(src, toks, diags, limits).module()
 }
 
 fn describe(t: &TokKind, text: &str) -> String {
@@ -58,38 +41,9 @@ fn describe(t: &TokKind, text: &str) -> String {
     }
 }
 
-impl Parser<'_, '_> {
-    fn tok(&self) -> &Token {
-        let i = self.pos.min(self.toks.len() - 1);
-        &self.toks[i]
-    }
-
+impl Parser<'_, '_, Token> {
     fn kind(&self) -> &TokKind {
         &self.tok().kind
-    }
-
-    fn span(&self) -> Span {
-        self.tok().span
-    }
-
-    fn prev_span(&self) -> Span {
-        if self.pos == 0 {
-            Span::default()
-        } else {
-            self.toks[(self.pos - 1).min(self.toks.len() - 1)].span
-        }
-    }
-
-    fn text(&self, s: Span) -> &str {
-        self.src.get(s.range()).unwrap_or("")
-    }
-
-    fn bump(&mut self) -> Token {
-        let t = self.tok().clone();
-        if self.pos < self.toks.len() - 1 {
-            self.pos += 1;
-        }
-        t
     }
 
     fn at_p(&self, p: Punct) -> bool {
@@ -105,21 +59,11 @@ impl Parser<'_, '_> {
     }
 
     fn eat_p(&mut self, p: Punct) -> bool {
-        if self.at_p(p) {
-            self.bump();
-            true
-        } else {
-            false
-        }
+        self.eat_if(|s| s.at_p(p))
     }
 
     fn eat_kw(&mut self, k: Kw) -> bool {
-        if self.at_kw(k) {
-            self.bump();
-            true
-        } else {
-            false
-        }
+        self.eat_if(|s| s.at_kw(k))
     }
 
     /// E0005 for a motion option given a second time (token `t`).
@@ -130,16 +74,6 @@ impl Parser<'_, '_> {
             t.span,
         );
         self.report(d)
-    }
-
-    fn report(&mut self, d: Diagnostic) -> Reported {
-        // A lexer error already explains an error token; do not pile on.
-        let on_error_token = self.kind() == &TokKind::Error;
-        if self.errors < MAX_ERRORS && !on_error_token {
-            self.diags.push(d);
-        }
-        self.errors += 1;
-        Reported
     }
 
     fn unexpected(&mut self, expected: &str) -> Reported {
@@ -160,8 +94,7 @@ impl Parser<'_, '_> {
         }
         if p == Punct::Semi {
             // Point just after the previous token: that is where the `;` is missing.
-            let prev = self.prev_span();
-            let at = Span::new(prev.end as usize, prev.end as usize);
+            let at = self.after_prev();
             let t = self.tok().clone();
             let found = describe(&t.kind, self.text(t.span));
             let d = Diagnostic::error(
@@ -199,7 +132,7 @@ impl Parser<'_, '_> {
 
     /// One level deeper; an error (and no level) past [`MAX_DEPTH`].
     fn enter(&mut self) -> PResult<()> {
-        if self.depth >= MAX_DEPTH {
+        if !self.deeper() {
             let d = Diagnostic::error(
                 Code::E0006,
                 format!("nested more than {MAX_DEPTH} levels deep"),
@@ -209,12 +142,7 @@ impl Parser<'_, '_> {
             .with_help("split the expression or the blocks into procedures or variables: `var part = a + b; …`");
             return Err(self.report(d));
         }
-        self.depth += 1;
         Ok(())
-    }
-
-    fn leave(&mut self) {
-        self.depth -= 1;
     }
 
     /// Skips to the end of the current statement: past `;`, or before `}` / the end.
@@ -270,11 +198,11 @@ impl Parser<'_, '_> {
     fn module(&mut self) -> SourceModule {
         let mut items = Vec::new();
         while self.kind() != &TokKind::Eof {
-            let start = self.pos;
+            let start = self.mark();
             match self.item() {
                 Ok(i) => items.push(i),
                 Err(Reported) => {
-                    if self.pos == start {
+                    if self.mark() == start {
                         self.bump();
                     }
                     self.sync_item();
@@ -405,12 +333,12 @@ impl Parser<'_, '_> {
                 self.leave();
                 return Err(self.report(d));
             }
-            let start = self.pos;
+            let start = self.mark();
             let sspan = self.span();
             match self.stmt() {
                 Ok(s) => stmts.push(s),
                 Err(Reported) => {
-                    if self.pos == start {
+                    if self.mark() == start {
                         self.bump();
                     }
                     self.sync_stmt();
@@ -766,10 +694,10 @@ impl Parser<'_, '_> {
 
     fn expr_stmt(&mut self) -> PResult<StmtKind> {
         // `pulse g for t;` — `pulse` is special only there, so it stays usable as a name.
-        let kind_at = |k: usize| self.toks.get(self.pos + k).map(|t| &t.kind);
+        let kind_at = |k: usize| &self.peek(k).kind;
         if self.at_ident("pulse")
-            && kind_at(1) == Some(&TokKind::Ident)
-            && kind_at(2) == Some(&TokKind::Kw(Kw::For))
+            && kind_at(1) == &TokKind::Ident
+            && kind_at(2) == &TokKind::Kw(Kw::For)
         {
             self.bump();
             let name = self.bump();
@@ -784,11 +712,9 @@ impl Parser<'_, '_> {
         }
         // `sync s with r1, r2 [timeout t];` — `sync` and `with` are special only there.
         if self.at_ident("sync")
-            && kind_at(1) == Some(&TokKind::Ident)
-            && self
-                .toks
-                .get(self.pos + 2)
-                .is_some_and(|t| t.kind == TokKind::Ident && self.text(t.span) == "with")
+            && kind_at(1) == &TokKind::Ident
+            && kind_at(2) == &TokKind::Ident
+            && self.text(self.peek(2).span) == "with"
         {
             self.bump();
             let name = self.ident("a sync point's name")?;

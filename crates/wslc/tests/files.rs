@@ -3,7 +3,7 @@
 //! name the file and the line in it.
 
 use vworks_vm::Module;
-use vworks_wslc::{Language, compile_files, compile_files_as, rapid};
+use vworks_wslc::{Language, compile_files, compile_program, rapid};
 
 const MAIN: &str =
     "MODULE MainMod\n  PERS num nParts := 0;\n  PROC main()\n    Pick;\n  ENDPROC\nENDMODULE\n";
@@ -114,9 +114,10 @@ fn a_wsl_program_and_its_library_file() {
     let pick = m.proc("pick").unwrap_or_else(|| panic!("no pick"));
     assert_eq!((m.file_of(pick.pos), pick.pos.line), ("lib.wsl", 2));
     // An unterminated comment in one file does not swallow the next.
-    let e = compile_files_as(
+    let e = compile_program(
         Language::Wsl,
         &[("main.wsl", "/* open\n"), ("lib.wsl", lib)],
+        None,
     )
     .err()
     .unwrap_or_else(|| panic!("compiled"));

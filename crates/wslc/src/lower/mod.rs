@@ -36,7 +36,7 @@ use vworks_vm::math;
 use vworks_vm::{ConstValue, Dim, MAX_AXES, Module, Type};
 
 use crate::diag::{Code, Diagnostic};
-use crate::program::ProgramText;
+use crate::frontend::program::ProgramText;
 use crate::syntax::*;
 
 mod builtins;

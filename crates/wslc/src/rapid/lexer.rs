@@ -92,6 +92,27 @@ impl Token {
     }
 }
 
+impl crate::frontend::Lexeme for Token {
+    fn span_mut(&mut self) -> &mut Span {
+        &mut self.span
+    }
+    fn span(&self) -> Span {
+        self.span
+    }
+    fn is_eof(&self) -> bool {
+        self.tok == Tok::Eof
+    }
+    fn is_error(&self) -> bool {
+        self.tok == Tok::Error
+    }
+    fn eof(at: Span) -> Self {
+        Token {
+            tok: Tok::Eof,
+            span: at,
+        }
+    }
+}
+
 /// Turns a RAPID source into tokens, ending with [`Tok::Eof`]. Problems are added to
 /// `diags`.
 pub fn lex(src: &str, diags: &mut Vec<Diagnostic>) -> Vec<Token> {

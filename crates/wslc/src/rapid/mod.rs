@@ -21,16 +21,9 @@ pub mod syntax;
 use crate::diag::Diagnostic;
 use crate::{CompileError, Compiled};
 
-/// File extensions of RAPID modules: `.mod`, `.modx`, `.sys`, `.sysx`, `.prg`.
+/// File extensions of RAPID modules: `.mod`, `.modx`, `.sys`, `.sysx`, `.prg`
+/// ([`crate::Language::of_source_file`] reads them).
 pub const EXTENSIONS: &[&str] = &["mod", "modx", "sys", "sysx", "prg"];
-
-/// True if `path` names a RAPID module by its extension (any case).
-pub fn is_rapid_path(path: &str) -> bool {
-    std::path::Path::new(path)
-        .extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| EXTENSIONS.iter().any(|x| x.eq_ignore_ascii_case(e)))
-}
 
 /// The kind of an I/O signal.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -114,14 +107,11 @@ pub fn compile_files(
     files: &[(&str, &str)],
     io: Option<&[IoSignal]>,
 ) -> Result<Compiled, CompileError> {
-    let program = crate::program::ProgramText::new(files);
+    let program = crate::frontend::program::ProgramText::new(files);
     let mut diags: Vec<Diagnostic> = Vec::new();
     let mut modules = Vec::new();
     let mut empty = Vec::new();
-    for (_, start, text) in program.files() {
-        let toks =
-            crate::program::ProgramText::lex(start, text, &mut diags, lexer::lex, |t| &mut t.span);
-        let found = parser::parse(program.text(), toks, &mut diags);
+    for (start, found) in program.parse_each(&mut diags, lexer::lex, parser::parse) {
         if found.is_empty() {
             empty.push(start);
         }

@@ -10,6 +10,7 @@
 use super::lexer::{Tok, Token};
 use super::syntax::*;
 use crate::diag::{Code, Diagnostic};
+use crate::frontend::{Limits, PResult, Parser, Reported};
 use crate::syntax::Span;
 
 /// Deepest nesting of statements and expressions.
@@ -90,68 +91,28 @@ const RESERVED: &[&str] = &[
 
 /// Parses a task's text: every `MODULE … ENDMODULE` in it.
 pub fn parse(src: &str, toks: Vec<Token>, diags: &mut Vec<Diagnostic>) -> Vec<RapidModule> {
-    let mut p = Parser {
-        src,
-        toks,
-        pos: 0,
-        diags,
-        depth: 0,
+    let limits = Limits {
+        max_depth: MAX_DEPTH,
+        max_errors: usize::MAX,
     };
+    let mut p = Parser::new(src, toks, diags, limits);
     p.header();
     let mut out = Vec::new();
-    while p.tok().tok != Tok::Eof {
+    while !p.at_end() {
         if p.at("module") {
             match p.module() {
                 Ok(m) => out.push(m),
-                Err(Reported) => p.skip_past("endmodule"),
+                Err(Reported) => p.skip_past_word("endmodule"),
             }
         } else {
             let _ = p.unexpected("`MODULE`");
-            p.skip_past("endmodule");
+            p.skip_past_word("endmodule");
         }
     }
     out
 }
 
-/// An error already added to the diagnostics.
-#[derive(Debug)]
-struct Reported;
-
-type PResult<T> = Result<T, Reported>;
-
-struct Parser<'s, 'd> {
-    src: &'s str,
-    toks: Vec<Token>,
-    pos: usize,
-    diags: &'d mut Vec<Diagnostic>,
-    depth: u32,
-}
-
-impl Parser<'_, '_> {
-    fn tok(&self) -> &Token {
-        // The last token is always Eof and the parser never moves past it.
-        &self.toks[self.pos.min(self.toks.len() - 1)]
-    }
-    fn peek(&self, n: usize) -> &Token {
-        &self.toks[(self.pos + n).min(self.toks.len() - 1)]
-    }
-    fn span(&self) -> Span {
-        self.tok().span
-    }
-    fn prev_span(&self) -> Span {
-        if self.pos == 0 {
-            Span::default()
-        } else {
-            self.toks[(self.pos - 1).min(self.toks.len() - 1)].span
-        }
-    }
-    fn bump(&mut self) -> Token {
-        let t = self.tok().clone();
-        if t.tok != Tok::Eof {
-            self.pos += 1;
-        }
-        t
-    }
+impl Parser<'_, '_, Token> {
     fn at(&self, word: &str) -> bool {
         self.tok().is(self.src, word)
     }
@@ -159,23 +120,10 @@ impl Parser<'_, '_> {
         &self.tok().tok == t
     }
     fn eat(&mut self, word: &str) -> bool {
-        if self.at(word) {
-            self.bump();
-            true
-        } else {
-            false
-        }
+        self.eat_if(|p| p.at(word))
     }
     fn eat_tok(&mut self, t: &Tok) -> bool {
-        if self.at_tok(t) {
-            self.bump();
-            true
-        } else {
-            false
-        }
-    }
-    fn text(&self, s: Span) -> &str {
-        &self.src[s.range()]
+        self.eat_if(|p| p.at_tok(t))
     }
     fn at_block_end(&self) -> bool {
         self.at_tok(&Tok::Eof) || BLOCK_END.iter().any(|w| self.at(w))
@@ -190,14 +138,6 @@ impl Parser<'_, '_> {
             Tok::Ident => format!("`{}`", self.text(t.span)),
             _ => format!("`{}`", self.text(t.span)),
         }
-    }
-
-    fn report(&mut self, d: Diagnostic) -> Reported {
-        // A token that could not be lexed was reported already.
-        if self.tok().tok != Tok::Error {
-            self.diags.push(d);
-        }
-        Reported
     }
 
     fn unexpected(&mut self, expected: &str) -> Reported {
@@ -215,11 +155,10 @@ impl Parser<'_, '_> {
             Ok(self.bump().span)
         } else if t == Tok::Semi {
             // Point just after the previous token: that is where the `;` is missing.
-            let at = self.prev_span();
             let d = Diagnostic::error(
                 Code::E0005,
                 format!("expected `;`, found {}", self.describe()),
-                Span::new(at.end as usize, at.end as usize),
+                self.after_prev(),
             )
             .with_label("`;` missing here")
             .with_help("every RAPID statement and declaration ends with `;`");
@@ -258,8 +197,7 @@ impl Parser<'_, '_> {
     }
 
     fn enter(&mut self) -> PResult<()> {
-        self.depth += 1;
-        if self.depth > MAX_DEPTH {
+        if !self.deeper() {
             let d = Diagnostic::error(
                 Code::E0006,
                 format!("nesting deeper than {MAX_DEPTH} levels"),
@@ -268,21 +206,15 @@ impl Parser<'_, '_> {
             .with_help("move the inner part into a routine of its own");
             // Skip everything: the rest cannot be parsed sensibly at this depth.
             self.diags.push(d);
-            self.pos = self.toks.len() - 1;
+            self.skip_to_end();
             return Err(Reported);
         }
         Ok(())
     }
-    fn leave(&mut self) {
-        self.depth -= 1;
-    }
 
     /// Skips to just past `word` (or the end).
-    fn skip_past(&mut self, word: &str) {
-        while !self.at_tok(&Tok::Eof) && !self.at(word) {
-            self.bump();
-        }
-        self.bump();
+    fn skip_past_word(&mut self, word: &str) {
+        self.skip_past(|p| p.at(word));
     }
 
     /// After an error in a statement: to just past the next `;`, or to a block's end word.
@@ -292,12 +224,9 @@ impl Parser<'_, '_> {
                 return;
             }
             for w in ["if", "while", "for", "test"] {
-                if self.at(w) && self.pos > 0 {
-                    // The start of another statement: resume there.
-                    let prev = &self.toks[self.pos - 1];
-                    if prev.tok == Tok::Semi {
-                        return;
-                    }
+                // The start of another statement: resume there.
+                if self.at(w) && self.prev().is_some_and(|t| t.tok == Tok::Semi) {
+                    return;
                 }
             }
             if self.bump().tok == Tok::Semi {
@@ -308,14 +237,13 @@ impl Parser<'_, '_> {
 
     /// The `%%% … %%%` header of old `.prg` files.
     fn header(&mut self) {
-        let triple = |p: &Parser| (0..3).all(|k| p.peek(k).tok == Tok::Percent);
+        let triple = |p: &Self| (0..3).all(|k| p.peek(k).tok == Tok::Percent);
+        let past_triple = |p: &mut Self| (0..3).for_each(|_| drop(p.bump()));
         if triple(self) {
-            self.pos += 3;
-            while !self.at_tok(&Tok::Eof) && !triple(self) {
-                self.bump();
-            }
+            past_triple(self);
+            self.skip_until(triple);
             if triple(self) {
-                self.pos += 3;
+                past_triple(self);
             }
         }
     }
@@ -371,13 +299,12 @@ impl Parser<'_, '_> {
             if self.at_tok(&Tok::Eof) {
                 return;
             }
-            let prev_ends = self.pos > 0 && {
-                let prev = &self.toks[self.pos - 1];
+            let prev_ends = self.prev().is_some_and(|prev| {
                 prev.tok == Tok::Semi
                     || ["endproc", "endfunc", "endtrap", "endrecord"]
                         .iter()
                         .any(|w| prev.is(self.src, w))
-            };
+            });
             if prev_ends && starts.iter().any(|w| self.at(w)) || self.at("endmodule") {
                 return;
             }
@@ -404,7 +331,7 @@ impl Parser<'_, '_> {
             .with_help("use the built-in data types (docs/rapid.md lists them)");
             self.diags.push(d);
             if what == "RECORD" {
-                self.skip_past("endrecord");
+                self.skip_past_word("endrecord");
             } else {
                 self.skip_past_semi();
             }
@@ -416,10 +343,7 @@ impl Parser<'_, '_> {
     }
 
     fn skip_past_semi(&mut self) {
-        while !self.at_tok(&Tok::Eof) && !self.at_tok(&Tok::Semi) {
-            self.bump();
-        }
-        self.bump();
+        self.skip_past(|p| p.at_tok(&Tok::Semi));
     }
 
     fn data_decl(&mut self, local: bool, start: Span) -> PResult<DataDecl> {
@@ -529,7 +453,7 @@ impl Parser<'_, '_> {
             )
             .with_related(name.span, "the routine starts here");
             self.report(d);
-            self.skip_past(end);
+            self.skip_past_word(end);
         }
         Ok(Routine {
             local,
@@ -576,12 +500,12 @@ impl Parser<'_, '_> {
     fn stmts(&mut self) -> Vec<Stmt> {
         let mut out = Vec::new();
         while !self.at_block_end() {
-            let before = self.pos;
+            let before = self.mark();
             match self.stmt() {
                 Ok(s) => out.push(s),
                 Err(Reported) => {
                     self.sync_stmt();
-                    if self.pos == before {
+                    if self.mark() == before {
                         self.bump();
                     }
                 }

@@ -10,8 +10,8 @@
 
 use vworks_vm::bytecode::SrcPos;
 
+use super::{Lexeme, Span};
 use crate::diag::{Diagnostic, LineIndex};
-use crate::syntax::Span;
 
 /// One file of a program.
 struct File {
@@ -69,20 +69,36 @@ impl ProgramText {
             .map(|(i, f)| (i, f.start, &self.text[f.start..f.start + f.len]))
     }
 
+    /// Each file lexed with its front-end's `lex` and parsed on its own with `parse`
+    /// (which gets the joined text and the file's tokens), as (the offset of the file's
+    /// text, what `parse` made of it), in file order.
+    pub(crate) fn parse_each<T: Lexeme, R>(
+        &self,
+        diags: &mut Vec<Diagnostic>,
+        lex: impl Fn(&str, &mut Vec<Diagnostic>) -> Vec<T>,
+        mut parse: impl FnMut(&str, Vec<T>, &mut Vec<Diagnostic>) -> R,
+    ) -> Vec<(usize, R)> {
+        let mut out = Vec::with_capacity(self.files.len());
+        for (_, start, text) in self.files() {
+            let toks = ProgramText::lex(start, text, diags, &lex);
+            out.push((start, parse(self.text(), toks, diags)));
+        }
+        out
+    }
+
     /// Lexes a file's `text` (at byte `start` of the joined text) with its front-end's
-    /// `lex`, moving the spans of its tokens (`span_of`) and of the diagnostics it adds
-    /// onto the joined text.
-    pub(crate) fn lex<T>(
+    /// `lex`, moving the spans of its tokens and of the diagnostics it adds onto the
+    /// joined text.
+    fn lex<T: Lexeme>(
         start: usize,
         text: &str,
         diags: &mut Vec<Diagnostic>,
-        lex: impl FnOnce(&str, &mut Vec<Diagnostic>) -> Vec<T>,
-        span_of: impl Fn(&mut T) -> &mut Span,
+        lex: impl Fn(&str, &mut Vec<Diagnostic>) -> Vec<T>,
     ) -> Vec<T> {
         let first_new = diags.len();
         let mut toks = lex(text, diags);
         for t in &mut toks {
-            let s = span_of(t);
+            let s = t.span_mut();
             *s = s.shifted(start);
         }
         for d in &mut diags[first_new..] {
