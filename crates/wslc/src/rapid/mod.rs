@@ -25,6 +25,18 @@ use crate::{CompileError, Compiled};
 /// ([`crate::Language::of_source_file`] reads them).
 pub const EXTENSIONS: &[&str] = &["mod", "modx", "sys", "sysx", "prg"];
 
+/// RAPID's instructions the front-end knows, as (name, what it does in vworks), in
+/// docs/rapid.md's order: for editors, completions and documentation tools. (Those
+/// vworks does not run say `E0300`.)
+pub fn instructions() -> impl Iterator<Item = (&'static str, &'static str)> {
+    lower::table::INSTRUCTIONS.iter().map(|r| (r.name, r.doc))
+}
+
+/// RAPID's functions the front-end knows, as [`instructions`] lists the instructions.
+pub fn functions() -> impl Iterator<Item = (&'static str, &'static str)> {
+    lower::table::FUNCTIONS.iter().map(|r| (r.name, r.doc))
+}
+
 /// The kind of an I/O signal.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum SignalKind {

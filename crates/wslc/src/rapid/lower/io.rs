@@ -16,6 +16,7 @@
 use vworks_vm::Dim;
 
 use super::data::{Ty, build as b};
+use super::table::Call;
 use super::{Sig, Sym, Tr, Val, block};
 use crate::diag::{Code, Diagnostic};
 use crate::rapid::SignalKind;
@@ -260,185 +261,142 @@ impl Tr<'_> {
         }
     }
 
-    /// `DInput(s)`, `DOutput(s)`, `GInput(s)`, `GOutput(s)`, `TestDI(s)`; `None` if `key`
-    /// is not one of them.
-    pub(crate) fn io_function(
-        &mut self,
-        key: &str,
-        f: &r::Name,
-        args: &[Arg],
-        span: Span,
-    ) -> Option<Option<Val>> {
-        let kinds: &[SignalKind] = match key {
+    /// `DInput(s)`, `DOutput(s)`, `GInput(s)`, `GOutput(s)`, `TestDI(s)`: the signal's
+    /// value.
+    pub(crate) fn io_function(&mut self, c: &Call<'_>) -> Option<Val> {
+        let kinds: &[SignalKind] = match c.key {
             "dinput" | "testdi" => &[SignalKind::Di],
             "doutput" => &[SignalKind::Do],
             "ginput" => &[SignalKind::Gi],
-            "goutput" => &[SignalKind::Go],
-            _ => return None,
+            _ => &[SignalKind::Go],
         };
-        Some((|| {
-            let (p, _) = self.split_args(f, args, 1..=1, &[], span)?;
-            let g = self.signal_arg(p[0], kinds)?;
-            let v = b::name(&g, p[0].span);
-            if key == "testdi" {
-                let one = b::expr(w::ExprKind::Int(1), span);
-                return Some(Val::one(Ty::Bool, b::bin(w::BinOp::Eq, v, one)));
-            }
-            Some(Val::one(Ty::Num, b::call("num", vec![v], span)))
-        })())
+        let (p, span) = (&c.pos, c.span);
+        let g = self.signal_arg(p[0], kinds)?;
+        let v = b::name(&g, p[0].span);
+        if c.key == "testdi" {
+            let one = b::expr(w::ExprKind::Int(1), span);
+            return Some(Val::one(Ty::Bool, b::bin(w::BinOp::Eq, v, one)));
+        }
+        Some(Val::one(Ty::Num, b::call("num", vec![v], span)))
     }
 
-    /// The I/O and interrupt instructions; false if `key` is none of them.
-    pub(crate) fn io_instruction(
-        &mut self,
-        key: &str,
-        f: &r::Name,
-        args: &[Arg],
-        span: Span,
-        out: &mut Vec<w::Stmt>,
-    ) -> bool {
-        let digital_out = &[SignalKind::Do];
-        match key {
-            "set" | "reset" => {
-                if let Some((p, _)) = self.split_args(f, args, 1..=1, &[], span)
-                    && let Some(g) = self.signal_arg(p[0], digital_out)
-                {
-                    let v = i64::from(key == "set");
-                    out.push(assign(&g, b::expr(w::ExprKind::Int(v), span), span));
-                }
-            }
-            "setdo" | "setgo" => {
-                let kinds: &[SignalKind] = if key == "setdo" {
-                    digital_out
-                } else {
-                    &[SignalKind::Go]
-                };
-                let Some((p, opts)) = self.split_args(f, args, 2..=2, &["SDelay", "Sync"], span)
-                else {
-                    return true;
-                };
-                if let Some((_, n, _)) = opts.iter().find(|(k, _, _)| k == "sdelay") {
-                    self.unsupported(
-                        "`\\SDelay`",
-                        n.span,
-                        "wait with WaitTime before setting the signal",
-                    );
-                    return true;
-                }
-                let Some(g) = self.signal_arg(p[0], kinds) else {
-                    return true;
-                };
-                if let Some(v) = self.value(p[1], Ty::Num) {
-                    let v = b::call("int", vec![v.leaf()], p[1].span);
-                    out.push(assign(&g, v, span));
-                }
-            }
-            "pulsedo" => {
-                let Some((p, opts)) = self.split_args(f, args, 1..=1, &["High", "PLength"], span)
-                else {
-                    return true;
-                };
-                let Some(g) = self.signal_arg(p[0], digital_out) else {
-                    return true;
-                };
-                let length = match self.opt_value(&opts, "plength", "seconds") {
-                    Err(()) => return true,
-                    Ok(None) => b::quantity(0.2, Dim::TIME, span),
-                    Ok(Some(e)) => match self.value(e, Ty::Num) {
-                        Some(v) => b::with_unit(v.leaf(), Dim::TIME),
-                        None => return true,
-                    },
-                };
-                // WSL's pulse: 1 now, 0 after PLength by the robot's I/O; the program goes on
-                // at once, and the pulse ends even if the program ends first.
-                out.push(w::Stmt {
-                    kind: w::StmtKind::Pulse {
-                        global: b::ident(&g, span),
-                        length,
-                    },
-                    span,
-                });
-            }
-            "waitdi" | "waitdo" | "waitgi" | "waitgo" => {
-                let Some((p, opts)) =
-                    self.split_args(f, args, 2..=2, &["MaxTime", "TimeFlag"], span)
-                else {
-                    return true;
-                };
-                if let Some(cond) = self.signal_is(key, p[0], p[1]) {
-                    self.timed_wait(&f.text, cond, &opts, false, span, out);
-                }
-            }
-            "isignaldi" | "isignaldo" | "isignalgi" | "isignalgo" => {
-                let Some((p, opts)) =
-                    self.split_args(f, args, 3..=3, &["Single", "SingleSafe"], span)
-                else {
-                    return true;
-                };
-                let Some(cond) = self.signal_is(key, p[0], p[1]) else {
-                    return true;
-                };
-                let Some(trap) = self.connected(p[2]) else {
-                    return true;
-                };
-                let single = !opts.is_empty();
-                self.enable(w::TriggerExpr::Cond(cond), &trap, single, span, out);
-            }
-            "itimer" => {
-                let Some((p, opts)) =
-                    self.split_args(f, args, 2..=2, &["Single", "SingleSafe"], span)
-                else {
-                    return true;
-                };
-                let Some(t) = self.value(p[0], Ty::Num) else {
-                    return true;
-                };
-                let Some(trap) = self.connected(p[1]) else {
-                    return true;
-                };
-                let t = b::with_unit(t.leaf(), Dim::TIME);
-                let trigger = if opts.is_empty() {
-                    w::TriggerExpr::Every(t)
-                } else {
-                    w::TriggerExpr::After(t)
-                };
-                self.enable(trigger, &trap, false, span, out);
-            }
-            "idelete" | "isleep" => {
-                if let Some((p, _)) = self.split_args(f, args, 1..=1, &[], span)
-                    && let Some(trap) = self.connected(p[0])
-                {
-                    self.disable_trap(&trap, span, out);
-                }
-            }
-            "iwatch" => {
-                if let Some((p, _)) = self.split_args(f, args, 1..=1, &[], span)
-                    && let Some(trap) = self.connected(p[0])
-                    && let r::ExprKind::Name(n) = &p[0].kind
-                {
-                    self.watch(n, &trap, span, out);
-                }
-            }
-            "gripload" => self.grip_load(f, args, span, out),
-            "ienable" | "idisable" => {
-                self.unsupported(
-                    &format!("`{}`", f.text),
-                    f.span,
-                    "IDisable holds every interrupt of the task back until IEnable, then runs them; put the interrupts to sleep one by one with ISleep and wake them with IWatch (which discards, not holds, what happens meanwhile)",
-                );
-            }
-            _ => return false,
+    /// `Set s;`, `Reset s;` on a digital output.
+    pub(crate) fn set_reset(&mut self, c: &Call<'_>, out: &mut Vec<w::Stmt>) {
+        if let Some(g) = self.signal_arg(c.pos[0], &[SignalKind::Do]) {
+            let v = i64::from(c.key == "set");
+            out.push(assign(&g, b::expr(w::ExprKind::Int(v), c.span), c.span));
         }
-        true
+    }
+
+    /// `SetDO s, v;`, `SetGO s, v;`.
+    pub(crate) fn set_signal(&mut self, c: &Call<'_>, out: &mut Vec<w::Stmt>) {
+        let (p, span) = (&c.pos, c.span);
+        let kinds: &[SignalKind] = if c.key == "setdo" {
+            &[SignalKind::Do]
+        } else {
+            &[SignalKind::Go]
+        };
+        if let Some((_, n, _)) = c.opts.iter().find(|(k, _, _)| k == "sdelay") {
+            self.unsupported(
+                "`\\SDelay`",
+                n.span,
+                "wait with WaitTime before setting the signal",
+            );
+            return;
+        }
+        let Some(g) = self.signal_arg(p[0], kinds) else {
+            return;
+        };
+        if let Some(v) = self.value(p[1], Ty::Num) {
+            let v = b::call("int", vec![v.leaf()], p[1].span);
+            out.push(assign(&g, v, span));
+        }
+    }
+
+    /// `PulseDO [\High] [\PLength:=t] s;`
+    pub(crate) fn pulse_do(&mut self, c: &Call<'_>, out: &mut Vec<w::Stmt>) {
+        let span = c.span;
+        let Some(g) = self.signal_arg(c.pos[0], &[SignalKind::Do]) else {
+            return;
+        };
+        let length = match self.opt_value(&c.opts, "plength", "seconds") {
+            Err(()) => return,
+            Ok(None) => b::quantity(0.2, Dim::TIME, span),
+            Ok(Some(e)) => match self.value(e, Ty::Num) {
+                Some(v) => b::with_unit(v.leaf(), Dim::TIME),
+                None => return,
+            },
+        };
+        // WSL's pulse: 1 now, 0 after PLength by the robot's I/O; the program goes on
+        // at once, and the pulse ends even if the program ends first.
+        out.push(w::Stmt {
+            kind: w::StmtKind::Pulse {
+                global: b::ident(&g, span),
+                length,
+            },
+            span,
+        });
+    }
+
+    /// `WaitDI s, v;`, `WaitDO`, `WaitGI`, `WaitGO`.
+    pub(crate) fn wait_signal(&mut self, c: &Call<'_>, out: &mut Vec<w::Stmt>) {
+        if let Some(cond) = self.signal_is(c.key, c.pos[0], c.pos[1]) {
+            self.timed_wait(&c.name.text, cond, &c.opts, false, c.span, out);
+        }
+    }
+
+    /// `ISignalDI [\Single] s, v, i;` (and `DO`, `GI`, `GO`).
+    pub(crate) fn interrupt_on_signal(&mut self, c: &Call<'_>, out: &mut Vec<w::Stmt>) {
+        let p = &c.pos;
+        let Some(cond) = self.signal_is(c.key, p[0], p[1]) else {
+            return;
+        };
+        let Some(trap) = self.connected(p[2]) else {
+            return;
+        };
+        let single = !c.opts.is_empty();
+        self.enable(w::TriggerExpr::Cond(cond), &trap, single, c.span, out);
+    }
+
+    /// `ITimer [\Single] t, i;`
+    pub(crate) fn interrupt_timer(&mut self, c: &Call<'_>, out: &mut Vec<w::Stmt>) {
+        let p = &c.pos;
+        let Some(t) = self.value(p[0], Ty::Num) else {
+            return;
+        };
+        let Some(trap) = self.connected(p[1]) else {
+            return;
+        };
+        let t = b::with_unit(t.leaf(), Dim::TIME);
+        let trigger = if c.opts.is_empty() {
+            w::TriggerExpr::Every(t)
+        } else {
+            w::TriggerExpr::After(t)
+        };
+        self.enable(trigger, &trap, false, c.span, out);
+    }
+
+    /// `IDelete i;`, `ISleep i;`
+    pub(crate) fn interrupt_off(&mut self, c: &Call<'_>, out: &mut Vec<w::Stmt>) {
+        if let Some(trap) = self.connected(c.pos[0]) {
+            self.disable_trap(&trap, c.span, out);
+        }
+    }
+
+    /// `IWatch i;`
+    pub(crate) fn interrupt_watch(&mut self, c: &Call<'_>, out: &mut Vec<w::Stmt>) {
+        if let Some(trap) = self.connected(c.pos[0])
+            && let r::ExprKind::Name(n) = &c.pos[0].kind
+        {
+            self.watch(n, &trap, c.span, out);
+        }
     }
 
     /// `GripLoad part;` grips the workcell part the loaddata is named after (`grip`);
     /// `GripLoad load0;` releases the part the robot holds. Which part that is, is kept in
     /// the module variable `_held` (0: none; k: the k-th part the task's GripLoads name).
-    fn grip_load(&mut self, f: &r::Name, args: &[Arg], span: Span, out: &mut Vec<w::Stmt>) {
-        let Some((p, _)) = self.split_args(f, args, 1..=1, &[], span) else {
-            return;
-        };
+    pub(crate) fn grip_load(&mut self, c: &Call<'_>, out: &mut Vec<w::Stmt>) {
+        let (p, span) = (&c.pos, c.span);
         let Some((n, _)) = self.data_arg(p[0], "a loaddata", |d| d.ty == Ty::Load) else {
             return;
         };
@@ -544,7 +502,7 @@ impl Tr<'_> {
         match orders.as_slice() {
             [(instr, args)] => {
                 self.disable_trap(trap, span, out);
-                self.io_instruction(&instr.key(), instr, args, span, out);
+                self.instruction(&instr.key(), instr, args, span, out);
             }
             [] => {
                 self.error(

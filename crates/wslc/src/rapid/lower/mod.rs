@@ -16,8 +16,10 @@
 
 pub(crate) mod data;
 mod expr;
+mod functions;
 mod io;
 mod stmt;
+pub(crate) mod table;
 
 use std::collections::{BTreeMap, BTreeSet};
 

@@ -8,15 +8,14 @@ use vworks_vm::Dim;
 
 use super::data::{Ty, build as b};
 use super::expr::article;
+use super::table::Call;
 use super::{Data, Sym, Tr, block};
 use crate::diag::Code;
 use crate::rapid::syntax::{self as r, Arg, Storage};
 use crate::syntax::{self as w, Span};
 
-/// Instructions vworks accepts and that change nothing in a simulation.
-const NO_OPS: &[&str] = &["confj", "confl", "singarea", "tperase", "pathresol"];
-
-/// Instructions that exist in RAPID but that vworks does not run.
+/// Instructions that exist in RAPID but that vworks does not run (and that the table,
+/// [`super::table::INSTRUCTIONS`], does not name).
 const UNSUPPORTED: &[&str] = &[
     "syncmoveon",
     "syncmoveoff",
@@ -63,23 +62,7 @@ const UNSUPPORTED: &[&str] = &[
     "unload",
     "erase",
     "raisetouser",
-    "setdo",
-    "pulsedo",
-    "setgo",
     "setao",
-    "waitdi",
-    "waitdo",
-    "waitgi",
-    "waitgo",
-    "isignaldi",
-    "isignaldo",
-    "itimer",
-    "idelete",
-    "isleep",
-    "iwatch",
-    "ienable",
-    "idisable",
-    "waitsynctask",
 ];
 
 impl Tr<'_> {
@@ -570,184 +553,180 @@ impl Tr<'_> {
         w::StmtKind::Block(block(stmts, span))
     }
 
-    /// An instruction or a call of one of the task's PROCs.
+    /// An instruction (the table's, [`super::table::INSTRUCTIONS`]) or a call of one of
+    /// the task's PROCs.
     fn call(&mut self, name: &r::Name, args: &[Arg], span: Span, out: &mut Vec<w::Stmt>) {
         let key = name.key();
-        if self.io_instruction(&key, name, args, span, out) {
+        if self.instruction(&key, name, args, span, out) {
+            return;
+        }
+        if UNSUPPORTED.contains(&key.as_str()) {
+            self.unsupported(
+                &format!("the instruction `{}`", name.text),
+                name.span,
+                "write the program without it",
+            );
             return;
         }
         let mut push = |kind| out.push(w::Stmt { kind, span });
-        match key.as_str() {
-            "movej" | "movel" | "movec" | "moveabsj" => {
-                if let Some(k) = self.motion(&key, name, args, span) {
-                    push(k);
+        match self.lookup(&key) {
+            Some(Sym::Routine(sig)) if sig.kind == r::RoutineKind::Proc => {
+                if let Some(wargs) = self.call_args(name, &sig.params, args, span) {
+                    push(w::StmtKind::Call {
+                        name: b::ident(&sig.wsl, name.span),
+                        args: wargs,
+                    });
                 }
             }
-            "waittime" => {
-                if let Some((p, _)) = self.split_args(name, args, 1..=1, &["InPos"], span)
-                    && let Some(t) = self.value(p[0], Ty::Num)
-                {
-                    push(w::StmtKind::Delay(b::with_unit(t.leaf(), Dim::TIME)));
-                }
-            }
-            "waituntil" => self.wait_until(name, args, span, out),
-            "waitsynctask" => self.wait_sync_task(name, args, span, out),
-            "tpwrite" => {
-                let Some((p, opts)) = self.split_args(
-                    name,
-                    args,
-                    1..=1,
-                    &["Num", "Dnum", "Bool", "Pos", "Orient"],
-                    span,
-                ) else {
-                    return;
-                };
-                let mut parts = Vec::new();
-                self.text_parts(p[0], &mut parts);
-                for (_, _, v) in opts {
-                    if let Some(e) = v
-                        && let Some(v) = self.expr(e)
-                    {
-                        parts.extend(self.printable(v, e.span));
-                    }
-                }
-                push(w::StmtKind::Log(parts));
-            }
-            "errwrite" => {
-                let Some((p, _)) = self.split_args(name, args, 2..=6, &["W", "I"], span) else {
-                    return;
-                };
-                let mut parts = vec![b::expr(w::ExprKind::Str("ErrWrite: ".into()), span)];
-                for (k, e) in p.iter().enumerate() {
-                    if k > 0 {
-                        parts.push(b::expr(w::ExprKind::Str(" ".into()), span));
-                    }
-                    self.text_parts(e, &mut parts);
-                }
-                push(w::StmtKind::Log(parts));
-            }
-            "stop" | "break" => {
-                if self
-                    .split_args(name, args, 0..=0, &["NoRegain", "AllMoveTasks"], span)
-                    .is_some()
-                {
-                    push(w::StmtKind::Stop);
-                }
-            }
-            "incr" | "decr" | "add" => {
-                let n = if key == "add" { 2 } else { 1 };
-                let Some((p, _)) = self.split_args(name, args, n..=n, &[], span) else {
-                    return;
-                };
-                let Some((d, idx)) = self.place(p[0]) else {
-                    return;
-                };
-                if d.ty != Ty::Num {
-                    self.error(
-                        Code::E0020,
-                        format!("{} changes a num, not {}", name.text, article(d.ty)),
-                        p[0].span,
-                    );
-                    return;
-                }
-                let by = if key == "add" {
-                    match self.value(p[1], Ty::Num) {
-                        Some(v) => v.leaf(),
-                        None => return,
-                    }
-                } else {
-                    b::num(1.0, span)
-                };
-                let op = if key == "decr" {
-                    w::BinOp::Sub
-                } else {
-                    w::BinOp::Add
-                };
-                let target = b::name(&Tr::leaf_names(&d, idx)[0], p[0].span);
-                push(w::StmtKind::Assign {
-                    target,
-                    op: Some(op),
-                    value: by,
-                });
-            }
-            k if NO_OPS.contains(&k) => {}
-            k if UNSUPPORTED.contains(&k) => {
-                self.unsupported(
-                    &format!("the instruction `{}`", name.text),
+            Some(Sym::Routine(sig)) if sig.kind == r::RoutineKind::Func => {
+                self.error(
+                    Code::E0011,
+                    format!("`{}` is a FUNC: use its value", name.text),
                     name.span,
-                    "write the program without it",
+                );
+            }
+            Some(Sym::Routine(_)) => {
+                self.error(
+                    Code::E0011,
+                    format!(
+                        "`{}` is a TRAP: it runs on an interrupt, it is not called",
+                        name.text
+                    ),
+                    name.span,
                 );
             }
             _ => {
-                match self.lookup(&key) {
-                    Some(Sym::Routine(sig)) if sig.kind == r::RoutineKind::Proc => {
-                        if let Some(wargs) = self.call_args(name, &sig.params, args, span) {
-                            push(w::StmtKind::Call {
-                                name: b::ident(&sig.wsl, name.span),
-                                args: wargs,
-                            });
-                        }
+                let names: Vec<String> = self
+                    .scope
+                    .iter()
+                    .filter(|(_, s)| matches!(s, Sym::Routine(_)))
+                    .map(|(k, _)| k.clone())
+                    .collect();
+                let near = crate::nearest(&key, names.iter().map(String::as_str)).map(|m| {
+                    self.spelled
+                        .get(m)
+                        .cloned()
+                        .unwrap_or_else(|| m.to_string())
+                });
+                let elsewhere = self.local_elsewhere(&key);
+                let d = self.error(
+                    Code::E0011,
+                    format!("unknown instruction or procedure `{}`", name.text),
+                    name.span,
+                );
+                d.notes.extend(elsewhere);
+                d.help = Some(match near {
+                    Some(n) => format!("did you mean `{n}`?"),
+                    None => {
+                        "declare it with PROC; docs/rapid.md lists the instructions vworks runs"
+                            .into()
                     }
-                    Some(Sym::Routine(sig)) if sig.kind == r::RoutineKind::Func => {
-                        self.error(
-                            Code::E0011,
-                            format!("`{}` is a FUNC: use its value", name.text),
-                            name.span,
-                        );
-                    }
-                    Some(Sym::Routine(_)) => {
-                        self.error(
-                            Code::E0011,
-                            format!(
-                                "`{}` is a TRAP: it runs on an interrupt, it is not called",
-                                name.text
-                            ),
-                            name.span,
-                        );
-                    }
-                    _ => {
-                        let names: Vec<String> = self
-                            .scope
-                            .iter()
-                            .filter(|(_, s)| matches!(s, Sym::Routine(_)))
-                            .map(|(k, _)| k.clone())
-                            .collect();
-                        let near =
-                            crate::nearest(&key, names.iter().map(String::as_str)).map(|m| {
-                                self.spelled
-                                    .get(m)
-                                    .cloned()
-                                    .unwrap_or_else(|| m.to_string())
-                            });
-                        let elsewhere = self.local_elsewhere(&key);
-                        let d = self.error(
-                            Code::E0011,
-                            format!("unknown instruction or procedure `{}`", name.text),
-                            name.span,
-                        );
-                        d.notes.extend(elsewhere);
-                        d.help = Some(match near {
-                        Some(n) => format!("did you mean `{n}`?"),
-                        None => "declare it with PROC; docs/rapid.md lists the instructions vworks runs".into(),
-                    });
-                    }
-                }
+                });
             }
         }
     }
 
-    fn motion(&mut self, key: &str, f: &r::Name, args: &[Arg], span: Span) -> Option<w::StmtKind> {
+    /// `WaitTime t;`
+    pub(crate) fn wait_time(&mut self, c: &Call<'_>, out: &mut Vec<w::Stmt>) {
+        if let Some(t) = self.value(c.pos[0], Ty::Num) {
+            let kind = w::StmtKind::Delay(b::with_unit(t.leaf(), Dim::TIME));
+            out.push(w::Stmt { kind, span: c.span });
+        }
+    }
+
+    /// `TPWrite text [\Num:=n] …;`
+    pub(crate) fn tp_write(&mut self, c: &Call<'_>, out: &mut Vec<w::Stmt>) {
+        let mut parts = Vec::new();
+        self.text_parts(c.pos[0], &mut parts);
+        for (_, _, v) in &c.opts {
+            if let Some(e) = v
+                && let Some(v) = self.expr(e)
+            {
+                parts.extend(self.printable(v, e.span));
+            }
+        }
+        out.push(w::Stmt {
+            kind: w::StmtKind::Log(parts),
+            span: c.span,
+        });
+    }
+
+    /// `ErrWrite header, reason …;`
+    pub(crate) fn err_write(&mut self, c: &Call<'_>, out: &mut Vec<w::Stmt>) {
+        let span = c.span;
+        let mut parts = vec![b::expr(w::ExprKind::Str("ErrWrite: ".into()), span)];
+        for (k, e) in c.pos.iter().enumerate() {
+            if k > 0 {
+                parts.push(b::expr(w::ExprKind::Str(" ".into()), span));
+            }
+            self.text_parts(e, &mut parts);
+        }
+        out.push(w::Stmt {
+            kind: w::StmtKind::Log(parts),
+            span,
+        });
+    }
+
+    /// `Stop;`, `Break;`: the program ends.
+    pub(crate) fn stop(&mut self, c: &Call<'_>, out: &mut Vec<w::Stmt>) {
+        out.push(w::Stmt {
+            kind: w::StmtKind::Stop,
+            span: c.span,
+        });
+    }
+
+    /// `Incr x;`, `Decr x;`, `Add x, e;` on a num.
+    pub(crate) fn step(&mut self, c: &Call<'_>, out: &mut Vec<w::Stmt>) {
+        let (p, span) = (&c.pos, c.span);
+        let Some((d, idx)) = self.place(p[0]) else {
+            return;
+        };
+        if d.ty != Ty::Num {
+            self.error(
+                Code::E0020,
+                format!("{} changes a num, not {}", c.name.text, article(d.ty)),
+                p[0].span,
+            );
+            return;
+        }
+        let by = if c.key == "add" {
+            match self.value(p[1], Ty::Num) {
+                Some(v) => v.leaf(),
+                None => return,
+            }
+        } else {
+            b::num(1.0, span)
+        };
+        let op = if c.key == "decr" {
+            w::BinOp::Sub
+        } else {
+            w::BinOp::Add
+        };
+        let target = b::name(&Tr::leaf_names(&d, idx)[0], p[0].span);
+        let kind = w::StmtKind::Assign {
+            target,
+            op: Some(op),
+            value: by,
+        };
+        out.push(w::Stmt { kind, span });
+    }
+
+    /// `MoveL`, `MoveC`, `MoveJ`, `MoveAbsJ`.
+    pub(crate) fn motion(&mut self, c: &Call<'_>, out: &mut Vec<w::Stmt>) {
+        if let Some(kind) = self.motion_kind(c) {
+            out.push(w::Stmt { kind, span: c.span });
+        }
+    }
+
+    fn motion_kind(&mut self, c: &Call<'_>) -> Option<w::StmtKind> {
+        let (key, span, p, opts) = (c.key, c.span, &c.pos, &c.opts);
         let circular = key == "movec";
         let n = if circular { 5 } else { 4 };
-        let opts_ok: &[&str] = &[
-            "Conc", "ID", "V", "T", "Z", "InPos", "WObj", "TLoad", "NoEOffs", "Corr",
-        ];
-        let (p, opts) = self.split_args(f, args, n..=n, opts_ok, span)?;
         let mut v_override = None;
         let mut z_override = None;
         let mut duration = None;
         let mut wobj = None;
-        for (k, name, v) in &opts {
+        for (k, name, v) in opts {
             match k.as_str() {
                 "v" | "z" | "t" => {
                     let Some(e) = v else {
@@ -852,18 +831,9 @@ impl Tr<'_> {
         })
     }
 
-    fn wait_until(&mut self, f: &r::Name, args: &[Arg], span: Span, out: &mut Vec<w::Stmt>) {
-        let Some((p, opts)) = self.split_args(
-            f,
-            args,
-            1..=1,
-            &["InPos", "MaxTime", "TimeFlag", "PollRate"],
-            span,
-        ) else {
-            return;
-        };
-        let cond = self.condition(p[0]);
-        self.timed_wait(&f.text, cond, &opts, true, span, out);
+    pub(crate) fn wait_until(&mut self, c: &Call<'_>, out: &mut Vec<w::Stmt>) {
+        let cond = self.condition(c.pos[0]);
+        self.timed_wait(&c.name.text, cond, &c.opts, true, c.span, out);
     }
 
     /// A wait until `cond` holds, with RAPID's `\MaxTime` (then `\TimeFlag` is set, or
@@ -960,10 +930,8 @@ impl Tr<'_> {
     /// `WaitSyncTask s, tasks;`: this task arrives at sync point `s` and waits until every
     /// task of the list has arrived as often: WSL's `sync s with T_ROB1, T_ROB2;`, a
     /// barrier the engine keeps (the tasks are the workcell robots' `task` names).
-    fn wait_sync_task(&mut self, f: &r::Name, args: &[Arg], span: Span, out: &mut Vec<w::Stmt>) {
-        let Some((p, opts)) = self.split_args(f, args, 2..=2, &["InPos", "TimeOut"], span) else {
-            return;
-        };
+    pub(crate) fn wait_sync_task(&mut self, c: &Call<'_>, out: &mut Vec<w::Stmt>) {
+        let (span, p, opts) = (c.span, &c.pos, &c.opts);
         let Some((sync, _)) = self.data_arg(p[0], "a syncident declared at module level", |d| {
             d.ty == Ty::Syncident && !d.local
         }) else {
@@ -975,7 +943,7 @@ impl Tr<'_> {
             return;
         };
         let mut timeout = None;
-        for (k, n, v) in &opts {
+        for (k, n, v) in opts {
             if k == "timeout" {
                 match v {
                     Some(e) => {
