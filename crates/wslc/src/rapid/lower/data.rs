@@ -7,8 +7,14 @@
 //! `num`, a `robtarget` one `pose`, a `speeddata` a `speed` and an `angspeed`. Data that
 //! only a real controller uses (`loaddata`, `confdata`, external axes) has no leaves: it is
 //! type-checked and dropped, as docs/rapid.md says.
+//!
+//! This is the one place RAPID's types meet WSL's: [`TYPES`] names RAPID's types, and
+//! [`Ty::leaves`] gives each one's leaves in the shared vocabulary of the checker and the
+//! VM ([`vworks_vm::Type`], with its [`Dim`]); the WSL type written in the tree is that
+//! type's one spelling ([`Type::name`]). The WSL checker then checks the leaves as it
+//! checks WSL.
 
-use vworks_vm::Dim;
+use vworks_vm::{Dim, Type};
 
 use crate::syntax::{self as w, Span};
 
@@ -37,68 +43,74 @@ pub(crate) enum Ty {
     Tasks,
 }
 
+/// RAPID's type names the front-end knows, each with its type (the first name of a type
+/// is how messages write it; `dnum` is a `num`). Declarations may name the ones before
+/// `syncident` anywhere; `syncident` and `tasks` are MultiMove's.
+pub(crate) const TYPES: &[(&str, Ty)] = &[
+    ("num", Ty::Num),
+    ("dnum", Ty::Num),
+    ("bool", Ty::Bool),
+    ("string", Ty::Str),
+    ("pos", Ty::Pos),
+    ("orient", Ty::Orient),
+    ("pose", Ty::Pose),
+    ("robtarget", Ty::Robtarget),
+    ("jointtarget", Ty::Jointtarget),
+    ("speeddata", Ty::Speed),
+    ("zonedata", Ty::Zone),
+    ("tooldata", Ty::Tool),
+    ("wobjdata", Ty::Wobj),
+    ("loaddata", Ty::Load),
+    ("confdata", Ty::Conf),
+    ("extjoint", Ty::Extax),
+    ("intnum", Ty::Intnum),
+    ("syncident", Ty::Syncident),
+    ("tasks", Ty::Tasks),
+];
+
+/// A num's leaf: a plain WSL number.
+const NUM: Type = Type::Num(Dim::PLAIN);
+
 impl Ty {
     /// The type of a RAPID type name (any case).
     pub(crate) fn from_name(name: &str) -> Option<Ty> {
-        Some(match name.to_ascii_lowercase().as_str() {
-            "num" | "dnum" => Ty::Num,
-            "bool" => Ty::Bool,
-            "string" => Ty::Str,
-            "pos" => Ty::Pos,
-            "orient" => Ty::Orient,
-            "pose" => Ty::Pose,
-            "robtarget" => Ty::Robtarget,
-            "jointtarget" => Ty::Jointtarget,
-            "speeddata" => Ty::Speed,
-            "zonedata" => Ty::Zone,
-            "tooldata" => Ty::Tool,
-            "wobjdata" => Ty::Wobj,
-            "loaddata" => Ty::Load,
-            "confdata" => Ty::Conf,
-            "extjoint" => Ty::Extax,
-            "intnum" => Ty::Intnum,
-            "syncident" => Ty::Syncident,
-            "tasks" => Ty::Tasks,
-            _ => return None,
-        })
+        TYPES
+            .iter()
+            .find(|(n, _)| n.eq_ignore_ascii_case(name))
+            .map(|(_, t)| *t)
     }
 
     /// The name as RAPID writes it.
     pub(crate) fn name(self) -> &'static str {
+        TYPES
+            .iter()
+            .find(|(_, t)| *t == self)
+            .map_or("?", |(n, _)| n)
+    }
+
+    /// Its WSL leaves: (suffix of the WSL name, the leaf's type).
+    pub(crate) fn leaves(self) -> &'static [(&'static str, Type)] {
         match self {
-            Ty::Num => "num",
-            Ty::Bool => "bool",
-            Ty::Str => "string",
-            Ty::Pos => "pos",
-            Ty::Orient => "orient",
-            Ty::Pose => "pose",
-            Ty::Robtarget => "robtarget",
-            Ty::Jointtarget => "jointtarget",
-            Ty::Speed => "speeddata",
-            Ty::Zone => "zonedata",
-            Ty::Tool => "tooldata",
-            Ty::Wobj => "wobjdata",
-            Ty::Load => "loaddata",
-            Ty::Conf => "confdata",
-            Ty::Extax => "extjoint",
-            Ty::Intnum => "intnum",
-            Ty::Syncident => "syncident",
-            Ty::Tasks => "tasks",
+            Ty::Num | Ty::Intnum => &[("", NUM)],
+            Ty::Bool => &[("", Type::Bool)],
+            Ty::Pos | Ty::Orient | Ty::Pose | Ty::Robtarget => &[("", Type::Pose)],
+            Ty::Jointtarget => &[("", Type::Joints)],
+            Ty::Speed => &[
+                (".v_tcp", Type::Num(Dim::SPEED)),
+                (".v_ori", Type::Num(Dim::ANGSPEED)),
+            ],
+            Ty::Zone => &[(".pzone_tcp", Type::Num(Dim::LENGTH))],
+            Ty::Tool => &[(".tframe", Type::Pose)],
+            Ty::Wobj => &[(".uframe", Type::Pose), (".oframe", Type::Pose)],
+            Ty::Str | Ty::Load | Ty::Conf | Ty::Extax | Ty::Syncident | Ty::Tasks => &[],
         }
     }
 
-    /// Its WSL leaves: (suffix of the WSL name, WSL type name).
-    pub(crate) fn leaves(self) -> &'static [(&'static str, &'static str)] {
-        match self {
-            Ty::Num | Ty::Intnum => &[("", "num")],
-            Ty::Bool => &[("", "bool")],
-            Ty::Pos | Ty::Orient | Ty::Pose | Ty::Robtarget => &[("", "pose")],
-            Ty::Jointtarget => &[("", "joints")],
-            Ty::Speed => &[(".v_tcp", "speed"), (".v_ori", "angspeed")],
-            Ty::Zone => &[(".pzone_tcp", "length")],
-            Ty::Tool => &[(".tframe", "pose")],
-            Ty::Wobj => &[(".uframe", "pose"), (".oframe", "pose")],
-            Ty::Str | Ty::Load | Ty::Conf | Ty::Extax | Ty::Syncident | Ty::Tasks => &[],
+    /// Its one leaf's type, for a type held in one WSL value.
+    pub(crate) fn leaf_type(self) -> Option<Type> {
+        match self.leaves() {
+            [(_, t)] => Some(*t),
+            _ => None,
         }
     }
 
@@ -180,6 +192,10 @@ pub(crate) mod build {
     }
     pub(crate) fn name(n: &str, span: Span) -> w::Expr {
         expr(w::ExprKind::Name(n.to_string()), span)
+    }
+    /// The WSL type name of `t` (its one spelling, `Type::name`).
+    pub(crate) fn type_name(t: Type, span: Span) -> w::Ident {
+        ident(&t.name(), span)
     }
     pub(crate) fn ident(n: &str, span: Span) -> w::Ident {
         w::Ident {

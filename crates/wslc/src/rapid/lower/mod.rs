@@ -330,8 +330,6 @@ impl Tr<'_> {
             "signalgo",
             "signalai",
             "signalao",
-            "syncident",
-            "tasks",
             "clock",
             "errnum",
             "triggdata",
@@ -345,10 +343,18 @@ impl Tr<'_> {
                 "I/O signals, sync identifiers and task lists come with the I/O and MultiMove support; see docs/rapid.md",
             );
         } else {
-            self.error(Code::E0014, format!("unknown data type `{}`", n.text), n.span)
-                .help = Some(
-                "the types vworks knows are num, dnum, bool, string, pos, orient, pose, robtarget, jointtarget, speeddata, zonedata, tooldata, wobjdata, loaddata, confdata, extjoint, intnum".into(),
-            );
+            // The types a declaration may name anywhere (not MultiMove's).
+            let names: Vec<&str> = data::TYPES
+                .iter()
+                .map(|(n, _)| *n)
+                .take_while(|n| *n != "syncident")
+                .collect();
+            self.error(
+                Code::E0014,
+                format!("unknown data type `{}`", n.text),
+                n.span,
+            )
+            .help = Some(format!("the types vworks knows are {}", names.join(", ")));
         }
         None
     }
@@ -548,7 +554,7 @@ impl Tr<'_> {
                     .cloned();
                 let decl = w::VarDecl {
                     name: b::ident(&name, d.name.span),
-                    ty: Some(b::ident(wty, d.ty.span)),
+                    ty: Some(b::type_name(*wty, d.ty.span)),
                     init,
                     span: d.span,
                 };
@@ -674,7 +680,7 @@ impl Tr<'_> {
                     name: b::ident("i", span),
                     ty: b::ident("int", span),
                 }],
-                ret: Some(b::ident(wty, span)),
+                ret: Some(b::type_name(*wty, span)),
                 body: block(body, span),
                 span,
             }));
@@ -750,7 +756,7 @@ impl Tr<'_> {
             for (name, (_, wty)) in Self::leaf_names(&data, None).iter().zip(ty.leaves()) {
                 params.push(w::Param {
                     name: b::ident(name, p.name.span),
-                    ty: b::ident(wty, p.ty.span),
+                    ty: b::type_name(*wty, p.ty.span),
                 });
             }
             self.spelled
@@ -767,7 +773,10 @@ impl Tr<'_> {
         body.extend(self.stmts(&rt.body));
         let ret = match (rt.kind, sig.ret) {
             (r::RoutineKind::Func, Some(t)) => match t.leaves() {
-                [(_, wty)] => Some(b::ident(wty, rt.ret.as_ref().map_or(rt.span, |n| n.span))),
+                [(_, wty)] => Some(b::type_name(
+                    *wty,
+                    rt.ret.as_ref().map_or(rt.span, |n| n.span),
+                )),
                 _ => {
                     self.unsupported(
                         &format!("a FUNC returning `{}`", t.name()),

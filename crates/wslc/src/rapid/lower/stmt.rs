@@ -508,11 +508,11 @@ impl Tr<'_> {
         }
         let ty = v.ty;
         let t = self.temp("test");
-        let wty = if ty == Ty::Num { "num" } else { "bool" };
+        let wty = ty.leaf_type().map(|t| b::type_name(t, span));
         let decl = w::Stmt {
             kind: w::StmtKind::Var(w::VarDecl {
                 name: b::ident(&t, span),
-                ty: Some(b::ident(wty, span)),
+                ty: wty,
                 init: Some(v.leaf()),
                 span,
             }),
