@@ -6,6 +6,11 @@
 //! code and a `file:line:col` position. [`link`] checks a set of modules against a workcell
 //! (robots, axis counts, parts) before a simulation starts.
 //!
+//! [`Language`] says which language a file is in, and [`compile_program`] compiles a
+//! program's files with that language's front-end (WSL, or [`rapid`]); the front-ends'
+//! parsers share one kit (`frontend`: the token cursor, reporting, recovery, the nesting
+//! limit, a program's files joined).
+//!
 //! Passes, in order:
 //! - [`lexer`]: text → tokens (units resolved to SI with dimensions);
 //! - [`parser`]: tokens → [`syntax`] tree, recovering after errors;

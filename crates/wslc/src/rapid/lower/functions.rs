@@ -82,7 +82,7 @@ impl Tr<'_> {
         let mut out = b::call("tool_offset", a, span);
         // Rotations about the tool's x, then the new y, then the new z.
         for axis in ["rx", "ry", "rz"] {
-            let Some(e) = self.opt_value(&opts, axis, "degrees").ok()? else {
+            let Some(e) = self.opt_value(opts, axis, "degrees").ok()? else {
                 continue;
             };
             let angle = b::with_unit(self.value(e, Ty::Num)?.leaf(), Dim::ANGLE);
@@ -118,9 +118,9 @@ impl Tr<'_> {
     pub(crate) fn c_rob_t(&mut self, c: &Call<'_>) -> Option<Val> {
         let span = c.span;
         let opts = &c.opts;
-        let mut pose = self.tcp_with_tool(&opts, span)?;
+        let mut pose = self.tcp_with_tool(opts, span)?;
         // In a work object: (uframe · oframe)⁻¹ · the TCP.
-        if let Some(e) = self.opt_value(&opts, "wobj", "wobj1").ok()? {
+        if let Some(e) = self.opt_value(opts, "wobj", "wobj1").ok()? {
             let w = self.value(e, Ty::Wobj)?;
             let frame = b::call(
                 "pose_mul",
@@ -149,7 +149,7 @@ impl Tr<'_> {
     pub(crate) fn c_pos(&mut self, c: &Call<'_>) -> Option<Val> {
         let span = c.span;
         let opts = &c.opts;
-        let p = self.tcp_with_tool(&opts, span)?;
+        let p = self.tcp_with_tool(opts, span)?;
         Some(Val::one(Ty::Pos, self.pos_of(p, span, |e| e)))
     }
 
@@ -157,7 +157,7 @@ impl Tr<'_> {
     pub(crate) fn num_function(&mut self, c: &Call<'_>) -> Option<Val> {
         let (key, span) = (c.key, c.span);
         let p = &c.pos;
-        let x = self.nums(&p)?.remove(0);
+        let x = self.nums(p)?.remove(0);
         num(b::call(key, vec![x], span))
     }
 
@@ -165,7 +165,7 @@ impl Tr<'_> {
     pub(crate) fn trig(&mut self, c: &Call<'_>) -> Option<Val> {
         let (key, span) = (c.key, c.span);
         let p = &c.pos;
-        let x = b::with_unit(self.nums(&p)?.remove(0), Dim::ANGLE);
+        let x = b::with_unit(self.nums(p)?.remove(0), Dim::ANGLE);
         if key == "tan" {
             let s = b::call("sin", vec![x.clone()], span);
             let c = b::call("cos", vec![x], span);
@@ -178,7 +178,7 @@ impl Tr<'_> {
     pub(crate) fn arc(&mut self, c: &Call<'_>) -> Option<Val> {
         let (key, span) = (c.key, c.span);
         let p = &c.pos;
-        let v = self.nums(&p)?;
+        let v = self.nums(p)?;
         let one = || b::num(1.0, span);
         let x0 = v[0].clone();
         let root = || {
@@ -218,7 +218,7 @@ impl Tr<'_> {
             );
             return None;
         }
-        let x = self.nums(&p)?.remove(0);
+        let x = self.nums(p)?.remove(0);
         if key == "trunc" {
             return num(b::call("num", vec![b::call("int", vec![x], span)], span));
         }
@@ -230,7 +230,7 @@ impl Tr<'_> {
     pub(crate) fn orient_zyx(&mut self, c: &Call<'_>) -> Option<Val> {
         let span = c.span;
         let p = &c.pos;
-        let v = self.nums(&p)?;
+        let v = self.nums(p)?;
         let zero = b::quantity(0.0, Dim::LENGTH, span);
         let a = |e: &w::Expr| b::with_unit(e.clone(), Dim::ANGLE);
         Some(Val::one(
