@@ -18,7 +18,7 @@ mod verify;
 pub use disasm::disassemble;
 pub use encode::{FORMAT_VERSION, MAGIC};
 pub use instr::{Cmp, Instr, MoveFlags, StackEffect};
-pub use verify::{MAX_FRAME, MAX_STACK};
+pub use verify::{CodeProblem, MAX_FRAME, MAX_STACK, RuleRef, StringUser, VerifyError};
 
 use crate::types::{ConstValue, Type};
 
@@ -70,9 +70,9 @@ pub enum LoadError {
         /// What is wrong.
         message: String,
     },
-    /// The structure decoded, but the module is inconsistent.
+    /// The structure decoded, but the module is inconsistent: what and where.
     #[error("invalid module: {0}")]
-    Invalid(String),
+    Invalid(#[from] VerifyError),
 }
 
 /// What kind of code a procedure entry holds.
