@@ -23,6 +23,7 @@ use vworks_model::text::{escape_controls, escape_controls_owned};
 use vworks_model::urdf::{LoadOptions, load_file_with};
 use vworks_model::{RobotModel, builtin};
 use vworks_vm::{Dim, Module};
+pub use vworks_wslc::Stage;
 use vworks_wslc::link::{CellSpec, Linked, RobotSpec, link};
 use vworks_wslc::{Diagnostic, Sources};
 
@@ -32,7 +33,7 @@ use paths::{program_files, read_hint, ros_package_paths};
 pub mod params;
 pub mod variants;
 
-use variants::{Cache, Compiled};
+use variants::{Cache, Compiled, ModelKey, ProgramKey};
 pub use variants::{Loader, Override};
 /// Quantities as a workcell reads them (`"250mm"`, `0.25`), with WSL's units.
 pub use vworks_wslc::units::{Quantity, parse_quantity};
@@ -72,6 +73,8 @@ pub enum CellError {
     /// Programs did not compile or link: every diagnostic, rendered with its source.
     #[error("{rendered}")]
     Program {
+        /// Whether a program did not compile, or the cell's programs did not link.
+        stage: Stage,
         /// The diagnostics.
         diagnostics: Vec<Diagnostic>,
         /// The same, rendered with source lines.
@@ -733,7 +736,7 @@ fn load_parsed(
     let mut robots = Vec::new();
     // Each task name (lower case) and the robot that runs it.
     let mut tasks: BTreeMap<String, usize> = BTreeMap::new();
-    let mut modules: Vec<(String, Arc<Module>)> = Vec::new();
+    let mut modules: Vec<(ProgramKey, Arc<Module>)> = Vec::new();
     let mut diagnostics = Vec::new();
     let mut warnings = Vec::new();
     let mut render_sources = Sources::new();
@@ -742,10 +745,13 @@ fn load_parsed(
     let wiring = io::signals(&cx, &cf.io, &robot_names)?;
     for (i, r) in cf.robot.iter().enumerate() {
         let key = format!("robot[{i}] `{}`", r.name);
-        let model_key = format!(
-            "{:?}|{:?}|{:?}|{:?}|{:?}",
-            r.model, r.urdf, r.tool_link, r.package_path, r.jerk
-        );
+        let model_key = ModelKey {
+            model: r.model.clone(),
+            urdf: r.urdf.clone(),
+            tool_link: r.tool_link.clone(),
+            package_path: r.package_path.clone(),
+            jerk: r.jerk.as_ref().map(toml::Value::to_string),
+        };
         let model = if let Some((m, urdf)) = cache.model(&model_key) {
             files.extend(urdf);
             m
@@ -830,10 +836,9 @@ fn load_parsed(
             (Some(w), vworks_wslc::Language::Rapid) => w.get(i).map(Vec::as_slice),
             _ => None,
         };
-        let files_key = pnames.join("\u{1}");
-        let mkey = match signals {
-            Some(s) => format!("{files_key}\u{0}{s:?}"),
-            None => files_key,
+        let mkey = ProgramKey {
+            files: pnames.clone(),
+            signals: signals.map(<[_]>::to_vec),
         };
         let mut stub = false;
         let module = match modules.iter().find(|(p, _)| *p == mkey) {
@@ -881,7 +886,7 @@ fn load_parsed(
                 match &compiled.result {
                     Ok((m, w)) => {
                         warnings.extend(w.iter().cloned());
-                        modules.push((mkey.clone(), Arc::clone(m)));
+                        modules.push((mkey, Arc::clone(m)));
                         Arc::clone(m)
                     }
                     Err(d) => {
@@ -891,6 +896,7 @@ fn load_parsed(
                         };
                         let rendered = vworks_wslc::render(&diagnostics, &render_sources, false);
                         *out = Some(CellError::Program {
+                            stage: Stage::Compile,
                             diagnostics: diagnostics.clone(),
                             rendered,
                         });
@@ -1030,6 +1036,7 @@ fn load_parsed(
     if !diagnostics.is_empty() && lenient.is_none() {
         let rendered = vworks_wslc::render(&diagnostics, &render_sources, false);
         return Err(CellError::Program {
+            stage: Stage::Compile,
             diagnostics,
             rendered,
         });
@@ -1074,6 +1081,7 @@ fn load_parsed(
         Some(Ok(linked)) => linked,
         Some(Err(e)) => {
             let e = CellError::Program {
+                stage: Stage::Link,
                 rendered: vworks_wslc::render(&e.diagnostics, &render_sources, false),
                 diagnostics: e.diagnostics,
             };

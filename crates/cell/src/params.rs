@@ -88,7 +88,7 @@ pub(crate) fn apply(
 pub(crate) fn check_cell_params(
     cx: &Ctx,
     cell: &BTreeMap<String, toml::Value>,
-    modules: &[(String, Arc<Module>)],
+    modules: &[(crate::variants::ProgramKey, Arc<Module>)],
 ) -> Result<(), CellError> {
     let mut all: Vec<String> = modules
         .iter()

@@ -364,6 +364,7 @@ fn workcell_error(
         CellError::Program {
             diagnostics,
             rendered,
+            ..
         } => {
             report.rendered = rendered;
             report.diagnostics = diagnostics

@@ -777,6 +777,7 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
         Err(vworks_cell::CellError::Program {
             rendered,
             diagnostics,
+            ..
         }) => {
             eprint!("{rendered}");
             let errors = diagnostics

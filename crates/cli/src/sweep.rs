@@ -21,10 +21,11 @@ use std::time::Duration;
 
 use vworks_cell::{Cell, Disk, Loader};
 use vworks_model::output::{Output, OutputError};
+use vworks_se::result::Outcome;
 use vworks_sweep::run::{RunOptions, VariantSet};
 use vworks_sweep::stream::{Format, TableFile, TableWriter};
 use vworks_sweep::table::{self, Best, Value};
-use vworks_sweep::{Row, Sweep, Unit, per_second, run_streamed};
+use vworks_sweep::{Row, RowOutcome, Sweep, Unit, per_second, run_streamed};
 
 /// What `vworks sweep` was asked.
 #[derive(clap::Args, Debug)]
@@ -236,14 +237,15 @@ struct Tally {
     rows: usize,
     feasible: usize,
     collided: usize,
-    outcomes: std::collections::BTreeMap<String, usize>,
+    /// Rows by outcome, at [`RowOutcome::index`].
+    outcomes: [usize; RowOutcome::ALL.len()],
     logs_failed: usize,
     best: Best,
 }
 
 impl Tally {
-    fn count(&self, outcome: &str) -> usize {
-        self.outcomes.get(outcome).copied().unwrap_or(0)
+    fn count(&self, outcome: RowOutcome) -> usize {
+        self.outcomes[outcome.index()]
     }
 }
 
@@ -351,7 +353,7 @@ pub(crate) fn sweep(mut a: Args) -> Result<ExitCode, String> {
         rows: 0,
         feasible: 0,
         collided: 0,
-        outcomes: std::collections::BTreeMap::new(),
+        outcomes: [0; RowOutcome::ALL.len()],
         logs_failed: 0,
         best: Best::new(&columns, &objective, a.best),
     };
@@ -380,7 +382,7 @@ pub(crate) fn sweep(mut a: Args) -> Result<ExitCode, String> {
             tally.rows += 1;
             tally.feasible += usize::from(row.feasible());
             tally.collided += usize::from(row.collisions > 0);
-            *tally.outcomes.entry(row.outcome.clone()).or_default() += 1;
+            tally.outcomes[row.outcome.index()] += 1;
             tally.logs_failed += usize::from(row.log_failed);
             tally.best.offer(&columns, &values);
             if write_error.is_none() {
@@ -484,11 +486,11 @@ pub(crate) fn sweep(mut a: Args) -> Result<ExitCode, String> {
         per_second(tally.rows as f64 / seconds.max(1e-9)),
         tally.feasible,
         tally.collided,
-        tally.count("deadlock"),
-        tally.count("error"),
-        tally.count("until"),
-        tally.count("timeout"),
-        tally.count("invalid"),
+        tally.count(RowOutcome::Run(Outcome::Deadlock)),
+        tally.count(RowOutcome::Run(Outcome::Error)),
+        tally.count(RowOutcome::Run(Outcome::Until)),
+        tally.count(RowOutcome::Timeout),
+        tally.count(RowOutcome::Invalid),
         if interrupted { " (interrupted)" } else { "" },
     );
     let none = no_best(&tally, &sweep, &a.file, interrupted);
@@ -597,7 +599,9 @@ fn no_best(tally: &Tally, sweep: &Sweep, file: &Path, interrupted: bool) -> Stri
     if tally.rows == 0 {
         return "no variant finished: the sweep was interrupted before the first".into();
     }
-    let collided_completed = tally.count("completed").saturating_sub(tally.feasible);
+    let collided_completed = tally
+        .count(RowOutcome::Run(Outcome::Completed))
+        .saturating_sub(tally.feasible);
     let until = sweep.until_ns.map_or_else(String::new, |ns| {
         format!(" ({})", quantity(ns as f64 / 1e9, vworks_vm::Dim::TIME))
     });
@@ -605,27 +609,39 @@ fn no_best(tally: &Tally, sweep: &Sweep, file: &Path, interrupted: bool) -> Stri
     let mut todo = Vec::new();
     for (n, said) in [
         (collided_completed, "completed with a collision".to_string()),
-        (tally.count("collision"), "stopped at a collision".into()),
-        (tally.count("deadlock"), "deadlocked".into()),
-        (tally.count("error"), "ended with an error".into()),
-        (tally.count("until"), format!("stopped at `until`{until}")),
         (
-            tally.count("timeout"),
+            tally.count(RowOutcome::Run(Outcome::Collision)),
+            "stopped at a collision".into(),
+        ),
+        (
+            tally.count(RowOutcome::Run(Outcome::Deadlock)),
+            "deadlocked".into(),
+        ),
+        (
+            tally.count(RowOutcome::Run(Outcome::Error)),
+            "ended with an error".into(),
+        ),
+        (
+            tally.count(RowOutcome::Run(Outcome::Until)),
+            format!("stopped at `until`{until}"),
+        ),
+        (
+            tally.count(RowOutcome::Timeout),
             "timed out (--variant-timeout)".into(),
         ),
-        (tally.count("invalid"), "invalid".into()),
+        (tally.count(RowOutcome::Invalid), "invalid".into()),
     ] {
         if n > 0 {
             what.push(format!("{n} {said}"));
         }
     }
-    if tally.count("until") > 0 {
+    if tally.count(RowOutcome::Run(Outcome::Until)) > 0 {
         todo.push(format!(
             "raise `until` in {} (or remove it) for them to complete",
             file.display()
         ));
     }
-    if tally.count("timeout") > 0 {
+    if tally.count(RowOutcome::Timeout) > 0 {
         todo.push("raise --variant-timeout".into());
     }
     if tally.collided > 0 {
@@ -634,12 +650,16 @@ fn no_best(tally: &Tally, sweep: &Sweep, file: &Path, interrupted: bool) -> Stri
             sweep.cell.display()
         ));
     }
-    if tally.count("deadlock") + tally.count("error") + tally.count("invalid") > 0 {
+    if tally.count(RowOutcome::Run(Outcome::Deadlock))
+        + tally.count(RowOutcome::Run(Outcome::Error))
+        + tally.count(RowOutcome::Invalid)
+        > 0
+    {
         todo.push("the rows' `error` says why the others did not complete".into());
     }
     format!(
         "no variant completed{}: {}{}; the best are ranked among the variants that completed without a collision{}",
-        if tally.count("completed") > 0 {
+        if tally.count(RowOutcome::Run(Outcome::Completed)) > 0 {
             " without a collision"
         } else {
             ""

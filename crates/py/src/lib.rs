@@ -96,6 +96,7 @@ fn load_cell(py: Python<'_>, path: PathBuf) -> PyResult<Cell> {
             cell: Arc::new(cell),
         }),
         Err(WorkcellError::Program {
+            stage,
             diagnostics,
             rendered,
         }) => {
@@ -107,9 +108,7 @@ fn load_cell(py: Python<'_>, path: PathBuf) -> PyResult<Cell> {
                     sources.add(&d.at.file, &text);
                 }
             }
-            let link = diagnostics
-                .iter()
-                .any(|d| d.code.as_str().starts_with("E01"));
+            let link = stage == vworks_cell::Stage::Link;
             let diags = diagnostics
                 .iter()
                 .map(|d| diagnostic(d, &sources))

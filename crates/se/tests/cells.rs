@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use vworks_cell::{Cell, CellError, load};
+use vworks_cell::{Cell, CellError, Stage, load};
 use vworks_se::engine::Ending;
 use vworks_se::engine::{Outcome, RunResult, Simulation};
 use vworks_se::trace::Kind;
@@ -359,7 +359,11 @@ fn program_errors_are_rendered_with_their_source() {
         ],
     );
     match load(&path) {
-        Err(CellError::Program { rendered, .. }) => {
+        Err(CellError::Program {
+            stage: Stage::Compile,
+            rendered,
+            ..
+        }) => {
             assert!(
                 rendered.contains("r1.wsl:2:11") && rendered.contains("write 2s"),
                 "{rendered}"
@@ -382,7 +386,11 @@ fn program_errors_are_rendered_with_their_source() {
         ],
     );
     match load(&path) {
-        Err(CellError::Program { rendered, .. }) => assert!(
+        Err(CellError::Program {
+            stage: Stage::Link,
+            rendered,
+            ..
+        }) => assert!(
             rendered.contains("E0101") && rendered.contains("no robot `r9`"),
             "{rendered}"
         ),

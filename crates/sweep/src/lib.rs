@@ -39,7 +39,7 @@ pub mod run;
 pub mod stream;
 pub mod table;
 
-pub use run::{Row, run_streamed, run_variants};
+pub use run::{Row, RowOutcome, run_streamed, run_variants};
 pub use table::{Table, Unit};
 
 /// Why a sweep could not be set up (a run that fails is a row of the table, not this).

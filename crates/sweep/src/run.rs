@@ -20,6 +20,59 @@ use vworks_se::engine::{RunResult, Simulation};
 use vworks_se::mcaplog::McapLog;
 use vworks_se::result::Outcome;
 
+/// How a variant ended: its run's [`Outcome`], or what only a sweep says of a variant.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RowOutcome {
+    /// The run ended so (`error` also when its log could not be written).
+    Run(Outcome),
+    /// Stopped at its wall-time limit.
+    Timeout,
+    /// The variant did not load: the row's `error` says why.
+    Invalid,
+}
+
+impl RowOutcome {
+    /// Every outcome a row may have, in the order the sweep's summary counts them.
+    pub const ALL: [RowOutcome; 8] = [
+        RowOutcome::Run(Outcome::Completed),
+        RowOutcome::Run(Outcome::Collision),
+        RowOutcome::Run(Outcome::Deadlock),
+        RowOutcome::Run(Outcome::Error),
+        RowOutcome::Run(Outcome::Until),
+        RowOutcome::Run(Outcome::Interrupted),
+        RowOutcome::Timeout,
+        RowOutcome::Invalid,
+    ];
+
+    /// As the table writes it: the run's outcome as in `run --json`, `timeout`, `invalid`.
+    pub fn name(self) -> &'static str {
+        match self {
+            RowOutcome::Run(o) => o.name(),
+            RowOutcome::Timeout => "timeout",
+            RowOutcome::Invalid => "invalid",
+        }
+    }
+
+    /// The outcome a table names (`name`'s inverse), if it is one.
+    pub fn from_name(name: &str) -> Option<RowOutcome> {
+        RowOutcome::ALL.into_iter().find(|o| o.name() == name)
+    }
+
+    /// Its place in [`RowOutcome::ALL`]: an index for counting rows by outcome.
+    pub fn index(self) -> usize {
+        match self {
+            RowOutcome::Run(Outcome::Completed) => 0,
+            RowOutcome::Run(Outcome::Collision) => 1,
+            RowOutcome::Run(Outcome::Deadlock) => 2,
+            RowOutcome::Run(Outcome::Error) => 3,
+            RowOutcome::Run(Outcome::Until) => 4,
+            RowOutcome::Run(Outcome::Interrupted) => 5,
+            RowOutcome::Timeout => 6,
+            RowOutcome::Invalid => 7,
+        }
+    }
+}
+
 /// One variant's result: what the sweep table holds.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Row {
@@ -27,10 +80,10 @@ pub struct Row {
     pub index: usize,
     /// Its values (path, value as the workcell would write it).
     pub values: Vec<(String, toml::Value)>,
-    /// `completed`, `collision`, `deadlock`, `error` (also: its log could not be
-    /// written), `until`, `timeout` (stopped at its wall-time limit), or `invalid` (the
-    /// variant did not load: see `error`).
-    pub outcome: String,
+    /// How it ended: the run's outcome (`error` also when its log could not be
+    /// written), `timeout` (stopped at its wall-time limit), or `invalid` (the variant did
+    /// not load: see `error`).
+    pub outcome: RowOutcome,
     /// The run's end (s).
     pub end_time: f64,
     /// Each robot's cycle time (s): when its program ended (`None` if it did not).
@@ -56,7 +109,7 @@ impl Row {
         Row {
             index,
             values: values(overrides),
-            outcome: r.outcome.name().to_string(),
+            outcome: RowOutcome::Run(r.outcome),
             end_time: r.end_time_ns as f64 / 1e9,
             cycle_times: r
                 .robots
@@ -85,7 +138,7 @@ impl Row {
         Row {
             index,
             values: values(overrides),
-            outcome: "invalid".into(),
+            outcome: RowOutcome::Invalid,
             end_time: 0.0,
             cycle_times: Vec::new(),
             collisions: 0,
@@ -97,7 +150,7 @@ impl Row {
 
     /// The variant's log could not be written: the row is an `error` saying why.
     fn log_failed(mut self, why: &str) -> Row {
-        self.outcome = Outcome::Error.name().to_string();
+        self.outcome = RowOutcome::Run(Outcome::Error);
         self.error = why.lines().next().unwrap_or_default().to_string();
         self.log_failed = true;
         self
@@ -105,7 +158,7 @@ impl Row {
 
     /// Completed without a collision: a candidate for the summary's best.
     pub fn feasible(&self) -> bool {
-        self.outcome == Outcome::Completed.name() && self.collisions == 0
+        self.outcome == RowOutcome::Run(Outcome::Completed) && self.collisions == 0
     }
 }
 
@@ -421,7 +474,7 @@ fn run_watched(
     running: &Running,
 ) -> Option<Row> {
     let row = run_with(loader, index, overrides, options, Some(&running.stop));
-    if row.outcome != Outcome::Interrupted.name() {
+    if row.outcome != RowOutcome::Run(Outcome::Interrupted) {
         return Some(row);
     }
     if !running.timed_out.load(Ordering::Relaxed) {
@@ -429,7 +482,7 @@ fn run_watched(
     }
     let limit = options.variant_timeout.unwrap_or_default().as_secs_f64();
     Some(Row {
-        outcome: "timeout".into(),
+        outcome: RowOutcome::Timeout,
         error: format!(
             "ran longer than the variant timeout of {limit} s (wall time), stopped at {} s of simulated time",
             row.end_time

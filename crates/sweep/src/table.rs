@@ -12,6 +12,8 @@
 use std::fmt::Write as _;
 
 use crate::Row;
+use crate::run::RowOutcome;
+use vworks_se::result::Outcome;
 
 /// A value of the table.
 #[derive(Clone, Debug, PartialEq)]
@@ -267,7 +269,8 @@ pub fn feasible(columns: &[String], row: &[Value]) -> bool {
             .position(|c| c == name)
             .and_then(|k| row.get(k))
     };
-    matches!(at("outcome"), Some(Value::Text(o)) if o == "completed")
+    matches!(at("outcome"), Some(Value::Text(o))
+        if RowOutcome::from_name(o) == Some(RowOutcome::Run(Outcome::Completed)))
         && at("collisions").and_then(Value::number) == Some(0.0)
 }
 
@@ -311,8 +314,8 @@ pub fn row_values(variables: &[String], robots: &[String], r: &Row) -> Vec<Value
                 .map_or(Value::Empty, |(_, x)| shown(x)),
         );
     }
-    out.push(Value::Text(r.outcome.clone()));
-    out.push(if r.outcome == "invalid" {
+    out.push(Value::Text(r.outcome.name().to_string()));
+    out.push(if r.outcome == RowOutcome::Invalid {
         Value::Empty
     } else {
         Value::Num(r.end_time)

@@ -7,9 +7,10 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use vworks_cell::{Disk, Loader, MemoryFiles, Override};
+use vworks_se::result::Outcome;
 use vworks_sweep::run::{RunOptions, run_one};
 use vworks_sweep::table::{self, Value};
-use vworks_sweep::{Combine, Sweep, Table, run_variants};
+use vworks_sweep::{Combine, RowOutcome, Sweep, Table, run_variants};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -161,7 +162,7 @@ fn a_row_is_the_run_of_the_workcell_written_with_its_values() {
     let cell = Arc::new(vworks_cell::load(&dir.join("cell.toml")).unwrap());
     let plain = vworks_se::engine::Simulation::new(cell).run(None);
     let _ = std::fs::remove_dir_all(&dir);
-    assert_eq!(row.outcome, plain.outcome.name());
+    assert_eq!(row.outcome, RowOutcome::Run(plain.outcome));
     assert_eq!(row.end_time, plain.end_time_ns as f64 / 1e9);
     assert_eq!(row.end_time, 62.916117313);
     assert_eq!(
@@ -192,10 +193,9 @@ fn the_best_are_completed_without_collision_smallest_first() {
             assert!(t(i) >= t(best[0]));
         }
     }
-    assert!(
-        best.iter()
-            .all(|i| rows[*i].outcome == "completed" && rows[*i].collisions == 0)
-    );
+    assert!(best.iter().all(
+        |i| rows[*i].outcome == RowOutcome::Run(Outcome::Completed) && rows[*i].collisions == 0
+    ));
     let e = table.best("speed", 3).unwrap_err();
     assert!(e.contains("end_time") && e.contains("cycle_time.r1"), "{e}");
     // The page charts the objective over the one variable named (a scatter).
@@ -327,8 +327,8 @@ fn an_endless_variant_is_stopped_at_its_timeout() {
     };
     let rows = run_variants(&loader, &variants, &options, &|_| {}, None);
     let _ = std::fs::remove_dir_all(&dir);
-    let outcomes: Vec<&str> = rows.iter().map(|r| r.outcome.as_str()).collect();
-    assert_eq!(outcomes, ["timeout", "invalid"]);
+    let outcomes: Vec<RowOutcome> = rows.iter().map(|r| r.outcome).collect();
+    assert_eq!(outcomes, [RowOutcome::Timeout, RowOutcome::Invalid]);
     assert!(
         rows[0].error.contains("variant timeout of 0.3 s"),
         "{}",
@@ -357,14 +357,14 @@ fn a_log_that_cannot_be_written_is_the_variants_error() {
     };
     let rows = run_variants(&loader, &variants, &options, &|_| {}, None);
     let _ = std::fs::remove_dir_all(&dir);
-    assert_eq!(rows[0].outcome, "error");
+    assert_eq!(rows[0].outcome, RowOutcome::Run(Outcome::Error));
     assert!(rows[0].log_failed);
     assert!(
         rows[0].error.contains("No space left on device"),
         "{}",
         rows[0].error
     );
-    assert_eq!(rows[1].outcome, "completed");
+    assert_eq!(rows[1].outcome, RowOutcome::Run(Outcome::Completed));
     assert!(!rows[1].log_failed);
 }
 

@@ -113,6 +113,35 @@ impl Code {
     }
 }
 
+impl Code {
+    /// The step of making a program that gives this code: linking the cell's modules
+    /// (`E01xx`, `W0003`) or compiling one program (every other code).
+    pub fn stage(self) -> Stage {
+        match self {
+            Code::E0100
+            | Code::E0101
+            | Code::E0102
+            | Code::E0103
+            | Code::E0104
+            | Code::E0105
+            | Code::E0106
+            | Code::E0107
+            | Code::W0003 => Stage::Link,
+            _ => Stage::Compile,
+        }
+    }
+}
+
+/// The step of making a program that found a problem: callers tell a program that does
+/// not compile from programs that do not fit together by this, never by the code's text.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Stage {
+    /// Compiling one program: its text read, parsed, checked and turned into bytecode.
+    Compile,
+    /// Linking a cell's modules: globals, remote calls, signals, parts, joints, entries.
+    Link,
+}
+
 /// Error or warning.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Severity {
@@ -198,6 +227,11 @@ impl Diagnostic {
             col,
         };
         d
+    }
+
+    /// Compile or link, from the code.
+    pub fn stage(&self) -> Stage {
+        self.code.stage()
     }
 
     /// Error or warning, from the code.

@@ -37,7 +37,7 @@ pub mod units;
 
 use frontend::program::ProgramText;
 
-pub use diag::{Code, Diagnostic, Severity, Sources, render};
+pub use diag::{Code, Diagnostic, Severity, Sources, Stage, render};
 pub use language::Language;
 
 /// Every built-in function as (name, signature, result), in the order of

@@ -24,7 +24,7 @@ use vworks_vm::Module;
 use vworks_vm::bytecode::disassemble;
 use vworks_wslc::link::{CellSpec, RobotSpec, link};
 use vworks_wslc::rapid::{IoSignal, SignalKind};
-use vworks_wslc::{Code, Language, Sources, compile_as, render};
+use vworks_wslc::{Code, Language, Sources, Stage, compile_as, render};
 
 fn dir(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -217,6 +217,10 @@ fn bad_program_gives_the_expected_diagnostics(p: &Path) {
     let (diags, codes) = diagnostics_of(p);
     assert!(!diags.is_empty(), "{name} should give diagnostics");
     assert!(
+        diags.iter().all(|d| d.stage() == Stage::Compile),
+        "{name}: a compiler diagnostic of the link stage"
+    );
+    assert!(
         codes.contains(&want),
         "{name} is about {want} but gave {codes:?}"
     );
@@ -238,6 +242,10 @@ fn link_case_dirs() -> Vec<PathBuf> {
 
 fn link_case_gives_the_expected_diagnostics(case: &Path) {
     let (diags, sources) = link_diagnostics(case);
+    assert!(
+        diags.iter().all(|d| d.stage() == Stage::Link),
+        "{case:?}: a link diagnostic of the compile stage"
+    );
     expect_file![case.join("expected.txt")].assert_eq(&render(&diags, &sources, false));
 }
 
