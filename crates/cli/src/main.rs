@@ -369,12 +369,14 @@ fn parse_time(s: &str) -> Result<i64, String> {
             "--until `{s}` is not a time; write e.g. 10s or 250ms"
         ));
     };
-    if secs < 0.0 || !secs.is_finite() {
-        return Err(format!(
-            "--until `{s}` is before the run starts; give a time from 0, e.g. 10s"
-        ));
-    }
-    Ok((secs * 1e9).round() as i64)
+    vworks_app::until_ns(secs).map_err(|e| match e {
+        vworks_app::UntilError::Negative => {
+            format!("--until `{s}` is before the run starts; give a time from 0, e.g. 10s")
+        }
+        vworks_app::UntilError::OutOfRange => {
+            format!("--until `{s}` is past the simulation's clock range (146 years); give e.g. 10s")
+        }
+    })
 }
 
 fn secs(ns: i64) -> String {
@@ -767,18 +769,27 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
         Ok(o) => o,
         Err(e) => return cannot_start(vec![json_issue("usage", &e, None, None, 0, 0)], e),
     };
-    let loaded = if overrides.is_empty() {
-        vworks_cell::load(path)
-    } else {
-        vworks_cell::Loader::new(path, &vworks_cell::Disk).and_then(|l| l.load(&overrides))
+    // Ctrl-C ends the run between two events, so the summary prints and the log is finished.
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let request = vworks_app::RunRequest {
+        cell: vworks_app::CellSource::File {
+            path,
+            overrides: &overrides,
+        },
+        until_ns: until,
+        log: log.map(|path| vworks_app::LogRequest {
+            path,
+            every: log_every,
+        }),
+        stop: Some(std::sync::Arc::clone(&stop)),
     };
-    let cell = match loaded {
-        Ok(c) => std::sync::Arc::new(c),
-        Err(vworks_cell::CellError::Program {
+    let started_run = match vworks_app::start(request) {
+        Ok(run) => run,
+        Err(vworks_app::RunError::Load(vworks_cell::CellError::Program {
             rendered,
             diagnostics,
             ..
-        }) => {
+        })) => {
             eprint!("{rendered}");
             let errors = diagnostics
                 .iter()
@@ -798,49 +809,29 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
             let m = format!("{}: the programs have errors", path.display());
             return cannot_start(errors, m);
         }
-        Err(e) => {
+        Err(vworks_app::RunError::Load(e)) => {
             let m = e.to_string();
             let file = display(path);
             return cannot_start(vec![json_issue("workcell", &m, None, Some(&file), 0, 0)], m);
         }
+        Err(vworks_app::RunError::Log { cell, message }) => {
+            // Compile and link warnings, as `vworks check` prints them.
+            eprint!("{}", cell.render_warnings(color));
+            let file = log.map(display);
+            let issue = json_issue("log", &message, None, file.as_deref(), 0, 0);
+            return cannot_start(vec![issue], message);
+        }
     };
+    let cell = std::sync::Arc::clone(&started_run.cell);
     // Compile and link warnings, as `vworks check` prints them.
     eprint!("{}", cell.render_warnings(color));
     let started = std::time::Instant::now();
-    // Ctrl-C ends the run between two events, so the summary prints and the log is finished.
-    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
     let flag = std::sync::Arc::clone(&stop);
     let _ = ctrlc::set_handler(move || flag.store(true, std::sync::atomic::Ordering::Relaxed));
-    let mut sim = vworks_se::engine::Simulation::new(std::sync::Arc::clone(&cell)).with_stop(stop);
-    // The log goes to a temporary file beside it, renamed at the end (never over an input).
-    let mut log_temp = None;
-    if let Some(path) = log {
-        let created = vworks_model::output::temp_beside(path, &sweep::inputs_of(&cell))
-            .map_err(|e| e.to_string())
-            .and_then(|temp| {
-                let log = vworks_se::mcaplog::McapLog::create(&temp, &cell, log_every);
-                let named = |m: String| m.replace(&temp.display().to_string(), &display(path));
-                log.map_err(|e| named(e.to_string())).map(|l| (temp, l))
-            });
-        match created {
-            Ok((temp, l)) => (sim, log_temp) = (sim.with_log(l), Some(temp)),
-            Err(m) => {
-                let file = display(path);
-                return cannot_start(vec![json_issue("log", &m, None, Some(&file), 0, 0)], m);
-            }
-        }
-    }
     let print_logs = !json && trace.is_none() && !quiet;
-    let mut r = simulate(sim, until, progress.then_some(started), print_logs);
-    if let (Some(temp), Some(path)) = (&log_temp, log) {
-        let named = |m: &String| m.replace(&temp.display().to_string(), &display(path));
-        r.log_error = r.log_error.as_ref().map(named);
-        if r.log_error.is_some() {
-            vworks_model::output::discard(temp, path);
-        } else if let Err(e) = vworks_model::output::finish(temp, path) {
-            r.log_error = Some(e.to_string());
-        }
-    }
+    let r = started_run
+        .simulate(|sim| simulate(sim, until, progress.then_some(started), print_logs))
+        .result;
     if let Some(e) = &r.log_error {
         eprintln!("error: {e}");
     }

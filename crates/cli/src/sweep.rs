@@ -19,6 +19,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Duration;
 
+use vworks_app::inputs_of;
 use vworks_cell::{Cell, Disk, Loader};
 use vworks_model::output::{Output, OutputError};
 use vworks_se::result::Outcome;
@@ -70,19 +71,6 @@ pub(crate) struct Args {
     /// List every value of the workcell FILE a sweep may vary, with its value, and stop.
     #[arg(long)]
     pub(crate) variables: bool,
-}
-
-/// Every file a workcell was read from: what no output may overwrite.
-pub(crate) fn inputs_of(cell: &Cell) -> Vec<PathBuf> {
-    std::iter::once(cell.file.clone())
-        .chain(
-            cell.sources
-                .iter()
-                .map(|(p, _)| p)
-                .chain(cell.files.iter().map(|(p, _)| p))
-                .map(PathBuf::from),
-        )
-        .collect()
 }
 
 /// `--variant-timeout`: a wall time above 0.

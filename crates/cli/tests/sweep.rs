@@ -750,3 +750,49 @@ fn no_best_says_what_became_of_the_variants() {
     );
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// `until = 0` is the cell's start, from `run --until 0s` and in a sweep file alike (a
+/// sweep refused it while `run` and Python's `Cell.run` took it); a time before the start
+/// is refused by both.
+#[test]
+fn until_zero_is_the_start_in_run_and_in_a_sweep() {
+    let d = dir_with(
+        "until-zero",
+        &[
+            ("cell.toml", WAITING_CELL),
+            ("r1.wsl", WAITING_PROGRAM),
+            (
+                "s.toml",
+                "cell = \"cell.toml\"\nuntil = \"0s\"\n[[variable]]\npath = \"params.wait\"\nvalues = [\"1s\", \"2s\"]\n",
+            ),
+        ],
+    );
+    let out = vworks_in(&d, &["run", "cell.toml", "--until", "0s", "--json"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(
+        (&json["outcome"], &json["end_time_ns"]),
+        (&"until".into(), &0.into())
+    );
+    let out = vworks_in(&d, &["sweep", "s.toml", "-q", "-o", "t.csv"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let table = std::fs::read_to_string(d.join("t.csv")).unwrap();
+    let outcomes: Vec<String> = rows(&table)
+        .iter()
+        .map(|r| r.split(',').nth(2).unwrap_or_default().to_string())
+        .collect();
+    assert_eq!(outcomes, ["until", "until"], "{table}");
+    std::fs::write(
+        d.join("s.toml"),
+        "cell = \"cell.toml\"\nuntil = \"-1s\"\n[[variable]]\npath = \"params.wait\"\nvalues = [\"1s\"]\n",
+    )
+    .unwrap();
+    let out = vworks_in(&d, &["sweep", "s.toml", "-q", "-o", "t.csv"]);
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stderr).contains("not a time to stop at"),
+        "{}",
+        text(&out.stderr)
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}

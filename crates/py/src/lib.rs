@@ -70,14 +70,14 @@ fn secs(ns: i64) -> f64 {
     ns as f64 / NS
 }
 
-/// Seconds (a float or an int) to integer nanoseconds.
+/// A time to stop at, in seconds (a float or an int), to integer nanoseconds: any time
+/// from 0, as `vworks run --until` and sweeps take it ([`vworks_app::until_ns`]).
 fn to_ns(seconds: f64, what: &str) -> PyResult<i64> {
-    if !seconds.is_finite() || seconds < 0.0 || seconds * NS > i64::MAX as f64 {
-        return Err(PyValueError::new_err(format!(
+    vworks_app::until_ns(seconds).map_err(|_| {
+        PyValueError::new_err(format!(
             "{what} must be a time in seconds, at least 0 (got {seconds})"
-        )));
-    }
-    Ok((seconds * NS).round() as i64)
+        ))
+    })
 }
 
 /// A loaded workcell: robots with their models and compiled, linked programs; devices;
@@ -178,20 +178,29 @@ impl Cell {
             return Err(PyValueError::new_err("log_every must be 1 or more"));
         }
         let stop = Arc::new(AtomicBool::new(false));
-        let mut sim =
-            vworks_se::engine::Simulation::new(Arc::clone(&self.cell)).with_stop(Arc::clone(&stop));
-        if let Some(path) = &log {
-            let l = McapLog::create(path, &self.cell, log_every)
-                .map_err(|e| Error::new_err(e.to_string()))?;
-            sim = sim.with_log(l);
-        }
-        let (r, interrupted) = interrupt::interruptible(py, &stop, || sim.run(until));
+        let request = vworks_app::RunRequest {
+            cell: vworks_app::CellSource::Loaded(Arc::clone(&self.cell)),
+            until_ns: until,
+            log: log.as_deref().map(|path| vworks_app::LogRequest {
+                path,
+                every: log_every,
+            }),
+            stop: Some(Arc::clone(&stop)),
+        };
+        let run = vworks_app::start(request).map_err(|e| Error::new_err(e.to_string()))?;
+        let mut interrupted = None;
+        let out = run.simulate(|sim| {
+            let (r, i) = interrupt::interruptible(py, &stop, || sim.run(until));
+            interrupted = i;
+            r
+        });
         if let Some(e) = interrupted {
             return Err(e);
         }
         let log_file = log.as_ref().map(|p| p.display().to_string());
-        let report = RunReport::new(&self.cell, r, log_file.as_deref());
-        if check && report.outcome == Outcome::Error.name() {
+        let failed = out.result.outcome == Outcome::Error;
+        let report = RunReport::new(&self.cell, out.result, log_file.as_deref());
+        if check && failed {
             return Err(report.simulation_error(py));
         }
         if let (true, Some(e)) = (check, &report.log_error) {

@@ -77,15 +77,7 @@ pub(crate) fn run_variants<'py>(
         }
         parsed.push(o);
     }
-    let until_ns = match until {
-        Some(t) if t > 0.0 && t.is_finite() => Some((t * 1e9).round() as i64),
-        Some(t) => {
-            return Err(PyValueError::new_err(format!(
-                "until must be a positive time in seconds, not {t}"
-            )));
-        }
-        None => None,
-    };
+    let until_ns = until.map(|t| crate::to_ns(t, "until")).transpose()?;
     let memory = files.map(|f| MemoryFiles {
         files: f.into_iter().map(|(p, b)| (PathBuf::from(p), b)).collect(),
     });

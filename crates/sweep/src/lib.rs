@@ -565,14 +565,12 @@ fn value(x: f64, integer: bool) -> toml::Value {
     }
 }
 
+/// `until`: a time from 0, as `vworks run --until` and Python's `Cell.run` take it
+/// ([`vworks_app::until_ns`]).
 fn time_ns(v: &toml::Value) -> Result<i64, String> {
     let (s, _) = si(v)?;
-    if !(s > 0.0 && s < 1e9) {
-        return Err(format!(
-            "{s} s is not a time to stop at; write e.g. \"120s\""
-        ));
-    }
-    Ok((s * 1e9).round() as i64)
+    vworks_app::until_ns(s)
+        .map_err(|_| format!("{s} s is not a time to stop at; give a time from 0, e.g. \"120s\""))
 }
 
 const GOLDEN: u64 = 0x9E37_79B9_7F4A_7C15;

@@ -10,14 +10,13 @@
 //! at once (their rows are left out).
 
 use std::collections::BTreeMap;
-use std::path::Path;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard, PoisonError};
 use std::time::{Duration, Instant};
 
+use vworks_app::{CellSource, LogRequest, RunError, RunRequest};
 use vworks_cell::{Loader, Override};
-use vworks_se::engine::{RunResult, Simulation};
-use vworks_se::mcaplog::McapLog;
+use vworks_se::engine::RunResult;
 use vworks_se::result::Outcome;
 
 /// How a variant ended: its run's [`Outcome`], or what only a sweep says of a variant.
@@ -503,34 +502,34 @@ fn run_with(
     options: &RunOptions,
     stop: Option<&Arc<AtomicBool>>,
 ) -> Row {
-    let cell = match loader.load(overrides) {
-        Ok(c) => Arc::new(c),
-        Err(e) => return Row::invalid(index, overrides, e.to_string()),
+    let log = options
+        .keep_logs
+        .as_ref()
+        .filter(|_| {
+            options
+                .keep_logs_of
+                .as_ref()
+                .is_none_or(|of| of.contains(index))
+        })
+        .map(|dir| dir.join(format!("variant-{index:05}.mcap")));
+    let request = RunRequest {
+        cell: CellSource::Variant { loader, overrides },
+        until_ns: options.until_ns,
+        log: log.as_deref().map(|path| LogRequest { path, every: 1 }),
+        stop: stop.cloned(),
     };
-    let mut sim = Simulation::new(Arc::clone(&cell));
-    if let Some(stop) = stop {
-        sim = sim.with_stop(Arc::clone(stop));
-    }
-    if let Some(dir) = &options.keep_logs
-        && options
-            .keep_logs_of
-            .as_ref()
-            .is_none_or(|of| of.contains(index))
-    {
-        let path = dir.join(format!("variant-{index:05}.mcap"));
-        match McapLog::create(Path::new(&path), &cell, 1) {
-            Ok(log) => sim = sim.with_log(log),
-            Err(e) => {
-                let row = Row::invalid(index, overrides, String::new());
-                return row.log_failed(&e.to_string());
+    match vworks_app::run(request) {
+        Ok(out) => {
+            let row = Row::of(index, overrides, &out.result);
+            match &out.result.log_error {
+                Some(e) => row.log_failed(e),
+                None => row,
             }
         }
-    }
-    let r = sim.run(options.until_ns);
-    let row = Row::of(index, overrides, &r);
-    match &r.log_error {
-        Some(e) => row.log_failed(e),
-        None => row,
+        Err(RunError::Load(e)) => Row::invalid(index, overrides, e.to_string()),
+        Err(RunError::Log { message, .. }) => {
+            Row::invalid(index, overrides, String::new()).log_failed(&message)
+        }
     }
 }
 
