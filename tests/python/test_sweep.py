@@ -4,6 +4,7 @@ same table row for row; the CLI's table equal to Python's; the table (`SweepTabl
 without pandas, and `to_pandas()` makes the DataFrame."""
 
 import csv
+import math
 import os
 import re
 import subprocess
@@ -197,6 +198,25 @@ def test_a_list_of_variants_and_bad_input():
     # A value the workcell does not accept there: a row that says why.
     bad = vworks.sweep(CELL, {"robot.r2.base.xyz.0": ["tall"]})
     assert bad["outcome"] == ["invalid"] and "tall" in str(bad["error"][0])
+
+
+def test_until_zero_is_the_start_for_a_run_and_a_sweep_alike(tmp_path):
+    # Cell.run took until=0 while a sweep refused it: both now stop at the start, as
+    # `vworks run --until 0s` and a sweep file's `until = "0s"` do.
+    r = vworks.load_cell(CELL).run(until=0)
+    assert (r.outcome, r.end_time_ns) == ("until", 0)
+    table = vworks.sweep(CELL, [{"cycle": "4ms"}, {"cycle": "8ms"}], until=0)
+    assert table["outcome"] == ["until", "until"] and table["end_time"] == [0.0, 0.0]
+    for bad in (-1, math.nan, math.inf):
+        with pytest.raises(ValueError, match="until"):
+            vworks.load_cell(CELL).run(until=bad)
+        with pytest.raises(ValueError, match="until"):
+            vworks.sweep(CELL, [{"cycle": "4ms"}], until=bad)
+    sweep_file = tmp_path / "s.toml"
+    sweep_file.write_text(f'cell = "{CELL}"\nuntil = "0s"\n[[variable]]\npath = "cycle"\nvalues = ["4ms", "8ms"]\n')
+    out = tmp_path / "t.csv"
+    subprocess.run([VWORKS, "sweep", str(sweep_file), "-q", "-o", str(out)], check=True, capture_output=True)
+    assert [row["outcome"] for row in csv.DictReader(out.open())] == ["until", "until"]
 
 
 def test_the_package_imports_without_ray_or_dask():

@@ -600,14 +600,25 @@ fn keep_logs_best_after_ctrl_c_keeps_only_the_best() {
         ],
     );
     partial_rows_named(&d, "s.csv", 2);
-    // Variant 2 (endless) is running: its log is being written.
+    // Variant 2 (endless) is running: its log is being written, beside its name until
+    // the run ends (`variant-00002.mcap.PID.partial`).
+    let writing = || {
+        std::fs::read_dir(d.join("logs")).is_ok_and(|mut files| {
+            files.any(|f| {
+                f.is_ok_and(|f| {
+                    let name = f.file_name().to_string_lossy().into_owned();
+                    name.starts_with("variant-00002.mcap.") && name.ends_with(".partial")
+                })
+            })
+        })
+    };
     for _ in 0..1200 {
-        if d.join("logs/variant-00002.mcap").exists() {
+        if writing() {
             break;
         }
         std::thread::sleep(std::time::Duration::from_millis(50));
     }
-    assert!(d.join("logs/variant-00002.mcap").exists());
+    assert!(writing());
     signal(&child, "-INT");
     let out = child.wait_with_output().unwrap();
     let err = text(&out.stderr);
