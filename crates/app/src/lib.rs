@@ -160,9 +160,10 @@ pub fn inputs_of(cell: &Cell) -> Vec<PathBuf> {
 /// Loads the workcell a request names.
 pub fn load(source: CellSource<'_>) -> Result<Arc<Cell>, CellError> {
     match source {
-        CellSource::File { path, overrides } if overrides.is_empty() => {
-            vworks_cell::load(path).map(Arc::new)
-        }
+        CellSource::File {
+            path,
+            overrides: [],
+        } => vworks_cell::load(path).map(Arc::new),
         CellSource::File { path, overrides } => Loader::new(path, &Disk)
             .and_then(|l| l.load(overrides))
             .map(Arc::new),

@@ -1031,7 +1031,7 @@ fn load_parsed(
         ));
     }
     if diagnostics.is_empty() {
-        params::check_cell_params(&cx, &cf.params, &modules)?;
+        params::check_cell_params(&cx, &cf.params, modules.iter().map(|(_, m)| m))?;
     }
     if !diagnostics.is_empty() && lenient.is_none() {
         let rendered = vworks_wslc::render(&diagnostics, &render_sources, false);

@@ -85,14 +85,13 @@ pub(crate) fn apply(
 }
 
 /// Every `[params]` key must be a param of some program of the cell.
-pub(crate) fn check_cell_params(
+pub(crate) fn check_cell_params<'m>(
     cx: &Ctx,
     cell: &BTreeMap<String, toml::Value>,
-    modules: &[(crate::variants::ProgramKey, Arc<Module>)],
+    modules: impl Iterator<Item = &'m Arc<Module>>,
 ) -> Result<(), CellError> {
     let mut all: Vec<String> = modules
-        .iter()
-        .flat_map(|(_, m)| declared(m).into_iter().map(|d| d.0))
+        .flat_map(|m| declared(m).into_iter().map(|d| d.0))
         .collect();
     all.sort();
     all.dedup();

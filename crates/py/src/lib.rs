@@ -24,7 +24,7 @@ use pyo3::types::{PyDict, PyList, PySlice};
 use vworks_cell::CellError as WorkcellError;
 use vworks_cell::Files as _;
 use vworks_se::engine::{Issue, Outcome, RunResult, TraceEvent, Value};
-use vworks_se::mcaplog::{LoggedEvent, McapLog};
+use vworks_se::mcaplog::LoggedEvent;
 
 mod interrupt;
 mod place;
@@ -91,10 +91,14 @@ struct Cell {
 /// robot model, `CompileError` or `LinkError` (with `.diagnostics`) for its programs.
 #[pyfunction]
 fn load_cell(py: Python<'_>, path: PathBuf) -> PyResult<Cell> {
-    match py.detach(|| vworks_cell::load(&path)) {
-        Ok(cell) => Ok(Cell {
-            cell: Arc::new(cell),
-        }),
+    let source = || {
+        vworks_app::load(vworks_app::CellSource::File {
+            path: &path,
+            overrides: &[],
+        })
+    };
+    match py.detach(source) {
+        Ok(cell) => Ok(Cell { cell }),
         Err(WorkcellError::Program {
             stage,
             diagnostics,
