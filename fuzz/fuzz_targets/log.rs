@@ -7,8 +7,8 @@
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    let options = vworks_se::mcaplog::ReadOptions { poses: true };
-    if let Ok(contents) = vworks_se::mcaplog::read_log_bytes_with("fuzz.mcap", data, options) {
+    let options = vworks_log::mcaplog::ReadOptions { poses: true };
+    if let Ok(contents) = vworks_log::mcaplog::read_log_bytes_with("fuzz.mcap", data, options) {
         let _ = vworks_report::page(&contents, "fuzz.mcap");
     }
 });

@@ -8,6 +8,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use libfuzzer_sys::fuzz_target;
+use vworks_se::describe::CellNames;
 
 #[path = "cellfiles.rs"]
 mod cellfiles;
@@ -24,7 +25,7 @@ fuzz_target!(|data: &[u8]| {
     }
     let cell = Arc::new(cell);
     let log_path = std::env::temp_dir().join(format!("vworks-fuzz-run-{}.mcap", std::process::id()));
-    let log = vworks_se::mcaplog::McapLog::create(&log_path, &cell, 1).expect("a log file in the temp folder");
+    let log = vworks_log::mcaplog::McapLog::create(&log_path, &Arc::new(vworks_se::describe::describe(&cell)), 1).expect("a log file in the temp folder");
     // Zero-time loops end at a tenth of the default bounds: the point is that they end.
     let mut sim = vworks_se::engine::Simulation::new(Arc::clone(&cell))
         .with_log(log)
@@ -41,13 +42,13 @@ fuzz_target!(|data: &[u8]| {
     let result = sim.into_result();
     let mut last = 0i64;
     for e in &result.trace {
-        assert!(e.time >= 0, "negative event time: {}", e.line(&cell));
-        assert!(e.time >= last, "event time went back: {}", e.line(&cell));
+        assert!(e.time >= 0, "negative event time: {}", e.line(&CellNames(&cell)));
+        assert!(e.time >= last, "event time went back: {}", e.line(&CellNames(&cell)));
         last = e.time;
     }
     assert!(result.end_time_ns >= 0 && result.end_time_ns <= UNTIL_NS.max(last));
     assert!(result.log_error.is_none(), "{:?}", result.log_error);
-    let contents = vworks_se::mcaplog::read_log(&log_path).expect("the run's log reads back");
+    let contents = vworks_log::mcaplog::read_log(&log_path).expect("the run's log reads back");
     assert!(contents.damage.is_none(), "{:?}", contents.damage);
     assert_eq!(contents.events.len(), result.trace.len());
     let _ = std::fs::remove_file(&log_path);

@@ -12,7 +12,7 @@ use vworks_app::{
     CellSource, LogRequest, RunError, RunRequest, UNTIL_LIMIT_NS, UntilError, run, until_ns,
 };
 use vworks_cell::{CellError, Override, Stage};
-use vworks_se::engine::Outcome;
+use vworks_log::result::Outcome;
 
 /// A fresh folder under the system's temporary folder, with these files.
 fn folder(name: &str, files: &[(&str, &str)]) -> PathBuf {

@@ -239,7 +239,7 @@ pub struct Cell {
     pub files: Vec<(String, Vec<u8>)>,
     /// The programs' compile warnings (in robot order, each program once) and the link
     /// warnings: `vworks run` prints them as `vworks check` does, and every run's result
-    /// lists them (`vworks_se::engine::RunResult::warnings`).
+    /// lists them (`vworks_log::result::RunResult::warnings`).
     pub warnings: Vec<Diagnostic>,
     /// The values a [`Loader`] changed from the workcell file: (path, value as TOML), in
     /// order (empty for the file as written).

@@ -28,9 +28,9 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use vworks_cell::{Cell, CellError};
+use vworks_log::issue::issue_json;
 use vworks_model::math::Iso;
 use vworks_se::collide::{Collider, CollisionEvent};
-use vworks_se::result::issue_json;
 use vworks_vm::bytecode::{MoveFlags, ProcInfo};
 use vworks_vm::{ConstValue, Instr, Module};
 
@@ -142,7 +142,7 @@ pub(crate) fn check_cells(
         }
         eprintln!(
             "checked cell {}: {}, {}, {}",
-            vworks_se::trace::escape_controls(&r.name),
+            vworks_log::trace::escape_controls(&r.name),
             crate::plural(r.programs, "program"),
             crate::plural(errors, "error"),
             crate::plural(warnings, "warning")
@@ -459,7 +459,7 @@ fn targets(cell: &Cell, problems: &mut Vec<Problem>) {
                         width: 1,
                         message: format!(
                             "robot `{}` ({}): {message}",
-                            vworks_se::trace::escape_controls(&r.name),
+                            vworks_log::trace::escape_controls(&r.name),
                             r.model.name
                         ),
                     };
@@ -655,7 +655,7 @@ fn at_the_start(cell: &Cell, text: &str, problems: &mut Vec<Problem>) {
     // (Bodies that overlap are not also said to come near.)
     let touching: Vec<(Owner, Owner)> = groups.iter().filter(|g| g.1).map(|g| g.0).collect();
     groups.retain(|(k, collision, _)| *collision || !touching.contains(k));
-    let esc = |s: &str| vworks_se::trace::escape_controls(s).into_owned();
+    let esc = |s: &str| vworks_log::trace::escape_controls(s).into_owned();
     for ((oa, ob), collision, mut pairs) in groups {
         // The deepest first; the nearest first for near misses.
         pairs.sort_by(|x, y| {
@@ -767,13 +767,13 @@ impl Owner {
         };
         format!(
             "{what} `{}`",
-            vworks_se::trace::escape_controls(self.name(cell))
+            vworks_log::trace::escape_controls(self.name(cell))
         )
     }
 
     /// The keys that place it: `` `r1`'s `base` or `home` ``, `` `table`'s `pose` ``.
     fn keys(self, cell: &Cell) -> String {
-        let name = vworks_se::trace::escape_controls(self.name(cell)).into_owned();
+        let name = vworks_log::trace::escape_controls(self.name(cell)).into_owned();
         match self {
             Owner::Robot(_) => format!("`{name}`'s `base` or `home`"),
             _ => format!("`{name}`'s `pose`"),
@@ -980,7 +980,7 @@ fn render(p: &Problem, sources: &[(String, String)], color: bool) -> String {
     if let Some(src) = source {
         let num = p.line.to_string();
         let pad = " ".repeat(num.len());
-        let src = vworks_se::trace::escape_controls(src);
+        let src = vworks_log::trace::escape_controls(src);
         let lead: String = src
             .chars()
             .take((p.col as usize).saturating_sub(1))

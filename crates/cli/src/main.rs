@@ -17,6 +17,7 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use vworks_se::describe::CellNames;
 
 use clap::{Parser, Subcommand};
 
@@ -24,7 +25,7 @@ mod check;
 mod sweep;
 mod view;
 use view::view;
-use vworks_se::result::issue_json as json_issue;
+use vworks_log::issue::issue_json as json_issue;
 use vworks_vm::Module;
 use vworks_vm::bytecode::disassemble;
 use vworks_wslc::{Language, Sources, render};
@@ -389,7 +390,7 @@ fn read_log(what: LogCommand) -> Result<ExitCode, String> {
     };
     // A log cut short (the process was killed) still has every chunk written before the
     // kill: what was read is printed, and the damage is a warning and exit code 1.
-    let log = vworks_se::mcaplog::read_log(&file).map_err(|e| e.to_string())?;
+    let log = vworks_log::mcaplog::read_log(&file).map_err(|e| e.to_string())?;
     match &what {
         LogCommand::Events {
             kind,
@@ -398,9 +399,9 @@ fn read_log(what: LogCommand) -> Result<ExitCode, String> {
             ..
         } => {
             let times = if *seconds {
-                vworks_se::trace::Times::Seconds
+                vworks_log::trace::Times::Seconds
             } else {
-                vworks_se::trace::Times::Nanoseconds
+                vworks_log::trace::Times::Nanoseconds
             };
             for e in &log.events {
                 if kind.as_deref().is_some_and(|want| want != e.kind.name())
@@ -416,7 +417,7 @@ fn read_log(what: LogCommand) -> Result<ExitCode, String> {
         LogCommand::Info { .. } => {
             out!("{}", file.display());
             for (topic, n) in &log.counts {
-                let topic = vworks_se::trace::escape_controls(topic);
+                let topic = vworks_log::trace::escape_controls(topic);
                 let word = if *n == 1 { "message" } else { "messages" };
                 out!("  {topic:<10} {n:>8} {word}");
             }
@@ -617,8 +618,8 @@ fn report_to(log: &Path, out: &Path) -> Result<(vworks_report::Written, ExitCode
 }
 
 /// A program's `log` line as a plain run prints it: `[11.156 s] r1: done`.
-fn log_line(l: &vworks_se::trace::LogLine) -> String {
-    use vworks_se::trace::escape_controls as esc;
+fn log_line(l: &vworks_log::place::LogLine) -> String {
+    use vworks_log::trace::escape_controls as esc;
     format!("[{}] {}: {}", secs(l.time_ns), esc(&l.robot), esc(&l.text))
 }
 
@@ -632,7 +633,7 @@ fn simulate(
     until: Option<i64>,
     progress: Option<std::time::Instant>,
     print_logs: bool,
-) -> vworks_se::engine::RunResult {
+) -> vworks_log::result::RunResult {
     if progress.is_none() && !print_logs {
         return sim.run(until);
     }
@@ -643,7 +644,7 @@ fn simulate(
         let more = sim.step(until);
         if print_logs && sim.trace().len() > seen {
             for e in &sim.trace()[seen..] {
-                if let Some(l) = e.log_line(sim.cell()) {
+                if let Some(l) = e.log_line(&CellNames(sim.cell())) {
                     match &bar {
                         Some(bar) => bar.suspend(|| out!("{}", log_line(&l))),
                         None => out!("{}", log_line(&l)),
@@ -700,7 +701,7 @@ struct RunOptions<'a> {
     until: Option<&'a str>,
     json: bool,
     /// `--trace` (seconds) or `--trace-ns`: print the event trace in this style.
-    trace: Option<vworks_se::trace::Times>,
+    trace: Option<vworks_log::trace::Times>,
     log: Option<&'a Path>,
     log_every: u64,
     /// Show a progress bar (stderr is a terminal and not `--quiet`).
@@ -838,7 +839,7 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
     let wall = started.elapsed().as_secs_f64();
     if let Some(times) = trace {
         for e in &r.trace {
-            out!("{}", e.line_as(&cell, times));
+            out!("{}", e.line_as(&CellNames(&cell), times));
         }
     }
     if json {
@@ -861,15 +862,15 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
     }
     Ok(match r.outcome {
         // The run went well but the log asked for is missing or incomplete: an error.
-        vworks_se::engine::Outcome::Completed | vworks_se::engine::Outcome::Until
+        vworks_log::result::Outcome::Completed | vworks_log::result::Outcome::Until
             if r.log_error.is_some() =>
         {
             ExitCode::FAILURE
         }
-        vworks_se::engine::Outcome::Completed | vworks_se::engine::Outcome::Until => {
+        vworks_log::result::Outcome::Completed | vworks_log::result::Outcome::Until => {
             ExitCode::SUCCESS
         }
-        vworks_se::engine::Outcome::Interrupted => ExitCode::from(130),
+        vworks_log::result::Outcome::Interrupted => ExitCode::from(130),
         _ => ExitCode::FAILURE,
     })
 }
@@ -877,7 +878,7 @@ fn run_cell(path: &Path, opts: RunOptions<'_>) -> Result<ExitCode, String> {
 /// The summary of a run, line by line: the outcome, a line per robot, the collisions and
 /// near misses with each robot's motion, warnings, errors, globals, counts and the log.
 fn summary(
-    r: &vworks_se::engine::RunResult,
+    r: &vworks_log::result::RunResult,
     cell: &vworks_cell::Cell,
     wall: f64,
     log: Option<&Path>,
@@ -887,7 +888,7 @@ fn summary(
         ($($arg:tt)*) => { lines.push(format!($($arg)*)) };
     }
     // Names and messages from the workcell, escaped as log texts are.
-    use vworks_se::trace::escape_controls as esc;
+    use vworks_log::trace::escape_controls as esc;
     line!(
         "cell {}: {} at {}",
         esc(&cell.name),
@@ -1039,8 +1040,8 @@ fn run(cmd: Command, color: bool) -> Result<ExitCode, String> {
                 until: until.as_deref(),
                 json,
                 trace: match (trace, trace_ns) {
-                    (true, _) => Some(vworks_se::trace::Times::Seconds),
-                    (_, true) => Some(vworks_se::trace::Times::Nanoseconds),
+                    (true, _) => Some(vworks_log::trace::Times::Seconds),
+                    (_, true) => Some(vworks_log::trace::Times::Nanoseconds),
                     _ => None,
                 },
                 log: log.as_deref(),

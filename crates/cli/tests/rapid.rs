@@ -18,6 +18,7 @@ use std::sync::Arc;
 use common::{parse, test_every_case};
 use expect_test::expect_file;
 use vworks_cell::MemoryFiles;
+use vworks_se::describe::CellNames;
 use vworks_se::engine::Simulation;
 
 /// Runs the cell in `files` (with `cell.toml` edited by `edit`): the trace lines, each
@@ -42,7 +43,11 @@ fn run(
     };
     let cell = Arc::new(cell);
     let result = Simulation::new(cell.clone()).run(None);
-    let lines = result.trace.iter().map(|e| e.line(&cell)).collect();
+    let lines = result
+        .trace
+        .iter()
+        .map(|e| e.line(&CellNames(&cell)))
+        .collect();
     (lines, format!("{:?}", result.outcome))
 }
 

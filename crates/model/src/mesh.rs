@@ -3,6 +3,27 @@
 
 use crate::math::V3;
 
+/// The convex hull of `points` as a triangle list (three corners per triangle; empty if
+/// the points span no volume): how the log draws a mesh body.
+pub fn hull_triangles(points: &[V3]) -> Vec<V3> {
+    let pts: Vec<parry3d::math::Vector3> = points
+        .iter()
+        .map(|p| parry3d::math::Vector3::new(p[0], p[1], p[2]))
+        .collect();
+    let Ok((vertices, faces)) = parry3d::transformation::try_convex_hull(&pts) else {
+        return Vec::new();
+    };
+    let mut out = Vec::with_capacity(faces.len() * 3);
+    for face in faces {
+        for k in face {
+            if let Some(v) = vertices.get(k as usize) {
+                out.push([v.x, v.y, v.z]);
+            }
+        }
+    }
+    out
+}
+
 /// Reads the vertices of an STL or OBJ mesh, scaled. The error says what is wrong.
 pub fn read_vertices(bytes: &[u8], name: &str, scale: V3) -> Result<Vec<V3>, String> {
     let lower = name.to_ascii_lowercase();

@@ -23,8 +23,10 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PySlice};
 use vworks_cell::CellError as WorkcellError;
 use vworks_cell::Files as _;
-use vworks_se::engine::{Issue, Outcome, RunResult, TraceEvent, Value};
-use vworks_se::mcaplog::LoggedEvent;
+use vworks_log::issue::Issue;
+use vworks_log::mcaplog::LoggedEvent;
+use vworks_log::result::{Outcome, RunResult};
+use vworks_log::trace::{TraceEvent, Value};
 
 mod interrupt;
 mod place;
@@ -320,7 +322,9 @@ fn json_object(py: Python<'_>, json: &str) -> PyResult<Py<PyAny>> {
 }
 
 fn event(cell: &vworks_cell::Cell, e: &TraceEvent) -> Event {
-    Event { e: e.resolve(cell) }
+    Event {
+        e: e.resolve(&vworks_se::describe::CellNames(cell)),
+    }
 }
 
 /// A sequence of `Event`s (indexable, sliceable, iterable), with `to_pandas()`.
@@ -494,7 +498,7 @@ impl PyIssue {
 
 fn issue(i: &Issue) -> PyIssue {
     PyIssue {
-        kind: i.kind.clone(),
+        kind: i.kind.name().to_string(),
         message: i.message.clone(),
         robot: i.robot.clone(),
         file: i.file.clone(),
@@ -995,7 +999,7 @@ impl Robot {
 #[pyfunction]
 fn read_log(py: Python<'_>, path: PathBuf) -> PyResult<EventList> {
     let log = py
-        .detach(|| vworks_se::mcaplog::read_log(&path))
+        .detach(|| vworks_log::mcaplog::read_log(&path))
         .map_err(|e| Error::new_err(e.to_string()))?;
     if let Some((read, damage)) = &log.damage {
         let msg = format!(

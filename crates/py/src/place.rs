@@ -1,6 +1,6 @@
 //! Where in the programs something happened, for Python: the motion each robot in a
 //! collision or near miss was making (`RobotMotion`) and the lines the programs logged
-//! (`LogLine`). Mirrors `vworks_se::place`.
+//! (`LogLine`). Mirrors `vworks_log::place`.
 
 use pyo3::prelude::*;
 
@@ -36,8 +36,8 @@ impl PyRobotMotion {
 }
 
 impl PyRobotMotion {
-    fn inner(&self) -> vworks_se::place::RobotMotion {
-        vworks_se::place::RobotMotion {
+    fn inner(&self) -> vworks_log::place::RobotMotion {
+        vworks_log::place::RobotMotion {
             robot: self.robot.clone(),
             moving: self.moving,
             file: self.file.clone(),
@@ -49,7 +49,7 @@ impl PyRobotMotion {
 }
 
 /// The Python objects of a list of motions.
-pub(crate) fn motions(list: &[vworks_se::place::RobotMotion]) -> Vec<PyRobotMotion> {
+pub(crate) fn motions(list: &[vworks_log::place::RobotMotion]) -> Vec<PyRobotMotion> {
     list.iter()
         .map(|m| PyRobotMotion {
             robot: m.robot.clone(),
@@ -93,7 +93,7 @@ impl PyLogLine {
 }
 
 /// The Python object of a logged line.
-pub(crate) fn log_line(l: &vworks_se::place::LogLine) -> PyLogLine {
+pub(crate) fn log_line(l: &vworks_log::place::LogLine) -> PyLogLine {
     PyLogLine {
         time: l.time_ns as f64 / 1e9,
         time_ns: l.time_ns,

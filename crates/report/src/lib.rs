@@ -9,7 +9,7 @@
 //!   collisions (red lines across every row) and signals (ticks on the sender's row)
 //!   marked, as an inline SVG;
 //! - the cycle time of each robot and its time moving, waiting and idle — the same fold
-//!   over the same typed events as `vworks run` ([`vworks_se::stats`]), so the numbers
+//!   over the same typed events as `vworks run` ([`vworks_log::stats`]), so the numbers
 //!   agree;
 //! - the collisions and the warnings and errors;
 //! - the event table, filterable by text, robot and kind (a few lines of inline
@@ -22,11 +22,12 @@
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
-use vworks_se::mcaplog::{LogContents, LoggedEvent};
-use vworks_se::stats::{Ending, Fold, RobotStats};
-use vworks_se::trace::{Data, Kind, RobotMotion, Times, contact_text};
+use vworks_log::mcaplog::{LogContents, LoggedEvent};
+use vworks_log::place::RobotMotion;
+use vworks_log::stats::{Ending, Fold, RobotStats};
+use vworks_log::trace::{Data, Kind, Times, contact_text};
 
-pub use vworks_se::stats::Activity;
+pub use vworks_log::stats::Activity;
 
 pub mod playback;
 pub mod viewer;
@@ -261,7 +262,7 @@ impl Report {
 pub enum ReportError {
     /// The log cannot be read at all (missing, not MCAP, damaged before anything).
     #[error(transparent)]
-    Log(#[from] vworks_se::mcaplog::LogError),
+    Log(#[from] vworks_log::mcaplog::LogError),
     /// The page cannot be written.
     #[error("{0}")]
     Write(#[from] vworks_model::output::OutputError),
@@ -284,8 +285,8 @@ pub struct Written {
 /// Reads the log at `log` (with its poses) and writes its report to `out`: what
 /// `vworks report` and Python's `write_report` do.
 pub fn write_report(log: &std::path::Path, out: &std::path::Path) -> Result<Written, ReportError> {
-    let options = vworks_se::mcaplog::ReadOptions { poses: true };
-    let contents = vworks_se::mcaplog::read_log_with(log, options)?;
+    let options = vworks_log::mcaplog::ReadOptions { poses: true };
+    let contents = vworks_log::mcaplog::read_log_with(log, options)?;
     let (report, html) = page(&contents, &log.display().to_string());
     // Never over the log it reads; through a temporary file, so a failure keeps the old page.
     vworks_model::output::write_output(out, &[log], html.as_bytes())?;
@@ -715,6 +716,7 @@ th {{ background: #f6f6f6; position: sticky; top: 0; }} td.num, th.num {{ text-a
 #[cfg(test)]
 mod tests {
     use super::*;
+    use vworks_log::issue::IssueKind;
 
     fn ev(t: i64, robot: Option<&str>, kind: Kind, data: Data) -> LoggedEvent {
         LoggedEvent {
@@ -759,7 +761,7 @@ mod tests {
             None,
             Kind::Warning,
             Data::Issue {
-                kind: "near_miss".into(),
+                kind: IssueKind::NearMiss,
                 message: "near miss: r1.link_6 and r2.link_6 come within 2.00 mm".into(),
                 distance_m: Some(0.002),
                 motions: motions.clone(),
@@ -831,7 +833,7 @@ mod tests {
                     None,
                     Kind::Warning,
                     Data::Issue {
-                        kind: "near_miss".into(),
+                        kind: IssueKind::NearMiss,
                         message: "near miss: x and y come within 1mm".into(),
                         distance_m: Some(1e-3),
                         motions: Vec::new(),

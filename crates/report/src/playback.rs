@@ -12,8 +12,8 @@
 //! frame per sample. So the page does the forward kinematics, from the joint values and
 //! the tree, and a 60 s run of four 6-axis arms is 24 numbers per sample, not 168.
 
-use vworks_se::mcaplog::{FrameTransform, LogContents};
-use vworks_se::trace::Kind;
+use vworks_log::mcaplog::{FrameTransform, LogContents};
+use vworks_log::trace::Kind;
 
 /// Samples per simulated second the report plays back at (and more at collision starts).
 pub const FRAMES_PER_SECOND: u64 = 30;

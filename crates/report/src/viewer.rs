@@ -20,7 +20,7 @@
 use std::fmt::Write as _;
 
 use serde_json::{Value, json};
-use vworks_se::mcaplog::LogContents;
+use vworks_log::mcaplog::LogContents;
 
 use crate::esc;
 use crate::playback::{Playback, f32_base64};

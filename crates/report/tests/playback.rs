@@ -8,23 +8,23 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
+use vworks_log::mcaplog::{McapLog, ReadOptions, read_log_with};
+use vworks_log::trace::Kind;
 use vworks_report::playback::{FRAMES_PER_SECOND, Joint, Playback};
 use vworks_se::engine::Simulation;
-use vworks_se::mcaplog::{McapLog, ReadOptions, read_log_with};
-use vworks_se::trace::Kind;
 
-fn log_of(cell: &str) -> vworks_se::mcaplog::LogContents {
+fn log_of(cell: &str) -> vworks_log::mcaplog::LogContents {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
     log_of_cell(cell, &root.join(format!("workcells/{cell}/cell.toml")))
 }
 
-fn log_of_cell(cell: &str, file: &std::path::Path) -> vworks_se::mcaplog::LogContents {
+fn log_of_cell(cell: &str, file: &std::path::Path) -> vworks_log::mcaplog::LogContents {
     let c = Arc::new(vworks_cell::load(file).unwrap());
     let path = std::env::temp_dir().join(format!(
         "vworks-playback-{cell}-{}.mcap",
         std::process::id()
     ));
-    let log = McapLog::create(&path, &c, 1).unwrap();
+    let log = McapLog::create(&path, &Arc::new(vworks_se::describe::describe(&c)), 1).unwrap();
     Simulation::new(Arc::clone(&c)).with_log(log).run(None);
     let contents = read_log_with(&path, ReadOptions { poses: true }).unwrap();
     let _ = std::fs::remove_file(&path);
@@ -105,7 +105,7 @@ fn close(a: &[f64; 7], b: &[f64; 7]) -> bool {
 /// transform of its frame; returns the tracks by kind (revolute, prismatic, free).
 fn every_sample_is_the_logged_pose(
     cell: &str,
-    log: &vworks_se::mcaplog::LogContents,
+    log: &vworks_log::mcaplog::LogContents,
 ) -> [usize; 3] {
     let p = Playback::from_log(log).unwrap();
     let mut latest: Vec<Option<[f64; 7]>> = vec![None; p.frames.len()];

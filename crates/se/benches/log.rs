@@ -19,11 +19,17 @@ use std::time::Instant;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use vworks_cell::{Cell, load};
-use vworks_se::engine::{RunResult, Simulation};
-use vworks_se::mcaplog::{Encoding, LogOptions, McapLog};
+use vworks_log::mcaplog::{Encoding, LogOptions, McapLog};
+use vworks_log::result::RunResult;
+use vworks_se::engine::Simulation;
 
 fn logged(cell: &Arc<Cell>, path: &Path, encoding: Encoding) -> RunResult {
-    let log = McapLog::create_with(path, cell, LogOptions::new(1, encoding)).unwrap();
+    let log = McapLog::create_with(
+        path,
+        &Arc::new(vworks_se::describe::describe(cell)),
+        LogOptions::new(1, encoding),
+    )
+    .unwrap();
     Simulation::new(Arc::clone(cell)).with_log(log).run(None)
 }
 

@@ -1,9 +1,10 @@
 //! The cell's kinematic state at a cycle boundary: every robot's joints and link frames,
 //! which robot holds which part, and where the parts are. The collider brings it up to
 //! date at each boundary it checks ([`crate::collide::Collider::check`]); sinks such as
-//! the log read it there ([`crate::sink::RunSink::cycle`]).
+//! the log read it there, as a [`WorldView`] ([`vworks_log::sink::RunSink::cycle`]).
 
 use vworks_cell::Cell;
+use vworks_log::sink::WorldView;
 use vworks_model::math::Iso;
 use vworks_vm::MAX_AXES;
 
@@ -22,6 +23,8 @@ pub struct World {
     pub(crate) held: Vec<Option<(usize, Iso)>>,
     /// Per part: its pose in the cell when not held.
     pub(crate) part_pose: Vec<Iso>,
+    /// Per robot: its model's tool link (what a held part's offset is from).
+    tool_links: Vec<usize>,
 }
 
 impl World {
@@ -38,6 +41,7 @@ impl World {
             tools: cell.robots.iter().map(|r| r.tool).collect(),
             held: vec![None; cell.parts.len()],
             part_pose: cell.parts.iter().map(|p| p.pose).collect(),
+            tool_links: cell.robots.iter().map(|r| r.model.tool_link).collect(),
         }
     }
 
@@ -62,16 +66,29 @@ impl World {
     }
 
     /// Part `p`'s pose in the cell (identity if there is no part `p`).
-    pub fn part_pose(&self, cell: &Cell, p: usize) -> Iso {
+    pub fn part_pose(&self, p: usize) -> Iso {
         match self.held.get(p).copied().flatten() {
-            Some((r, offset)) => self.frames[r][cell.robots[r].model.tool_link].mul(&offset),
+            Some((r, offset)) => self.frames[r][self.tool_links[r]].mul(&offset),
             None => self.part_pose.get(p).copied().unwrap_or(Iso::IDENTITY),
         }
     }
+}
 
-    /// Every part's pose in the cell, into `out` (reused).
-    pub fn part_poses_into(&self, cell: &Cell, out: &mut Vec<Iso>) {
+impl WorldView for World {
+    fn joints(&self) -> &[[f64; MAX_AXES]] {
+        &self.joints
+    }
+
+    fn frames(&self) -> &[Vec<Iso>] {
+        &self.frames
+    }
+
+    fn tools(&self) -> &[Iso] {
+        &self.tools
+    }
+
+    fn part_poses_into(&self, out: &mut Vec<Iso>) {
         out.clear();
-        out.extend((0..cell.parts.len()).map(|p| self.part_pose(cell, p)));
+        out.extend((0..self.part_pose.len()).map(|p| self.part_pose(p)));
     }
 }

@@ -7,9 +7,12 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use vworks_cell::{Cell, CellError, Stage, load};
-use vworks_se::engine::Ending;
-use vworks_se::engine::{Outcome, RunResult, Simulation};
-use vworks_se::trace::Kind;
+use vworks_log::issue::IssueKind;
+use vworks_log::result::{Outcome, RunResult};
+use vworks_log::stats::Ending;
+use vworks_log::trace::Kind;
+use vworks_se::describe::CellNames;
+use vworks_se::engine::Simulation;
 
 /// Writes the files into a fresh directory and returns the path of `cell.toml`.
 fn write_cell(name: &str, files: &[(&str, &str)]) -> PathBuf {
@@ -65,7 +68,7 @@ fn a_set_queues_check_when_behind_events_already_due() {
                 "{} {} {}",
                 e.robot.map_or("-".into(), |i| cell.robots[i].name.clone()),
                 e.kind,
-                e.details(&cell)
+                e.details(&CellNames(&cell))
             )
         })
         .collect();
@@ -107,7 +110,11 @@ fn two_robots_setting_a_global_at_one_instant_is_a_race() {
         ],
     );
     let (_, r) = run(&path);
-    let race: Vec<_> = r.warnings.iter().filter(|w| w.kind == "race").collect();
+    let race: Vec<_> = r
+        .warnings
+        .iter()
+        .filter(|w| w.kind == IssueKind::Race)
+        .collect();
     assert_eq!(race.len(), 1, "{:?}", r.warnings);
     assert!(
         race[0].message.contains("a (a.wsl:4:5) and b (b.wsl:4:5)"),
@@ -136,7 +143,7 @@ fn wait_and_set_at_one_instant_is_a_race() {
     assert!(
         r.warnings
             .iter()
-            .any(|w| w.kind == "race" && w.message.contains("`g`")),
+            .any(|w| w.kind == IssueKind::Race && w.message.contains("`g`")),
         "{:?}",
         r.warnings
     );
@@ -429,7 +436,7 @@ allow_collision = [["r1.tool0", "block"], ["r1.link_6", "block"]]
         .trace
         .iter()
         .filter(|e| matches!(e.kind, Kind::CollisionStart | Kind::CollisionEnd))
-        .map(|e| (e.kind.name(), e.details(&cell)))
+        .map(|e| (e.kind.name(), e.details(&CellNames(&cell))))
         .collect();
     // Only the carried block (gripped 200 mm away from the post) meets the post: it starts
     // touching, and stops when it has passed.
@@ -487,7 +494,7 @@ fn the_language_references_motion_example_runs_with_its_zones() {
     );
     let (cell, r) = run(&path);
     assert_eq!(r.outcome, Outcome::Completed, "{:?}", r.errors);
-    let lines: Vec<String> = r.trace.iter().map(|e| e.line(&cell)).collect();
+    let lines: Vec<String> = r.trace.iter().map(|e| e.line(&CellNames(&cell))).collect();
     let zoned_ends = lines
         .iter()
         .filter(|l| l.contains("motion_end zone="))
@@ -532,7 +539,7 @@ fn a_sync_timeout_tied_with_the_last_arrival_warns_in_either_order() {
         let races: Vec<&str> = sim
             .warnings()
             .iter()
-            .filter(|w| w.kind == "race")
+            .filter(|w| w.kind == IssueKind::Race)
             .map(|w| w.message.as_str())
             .collect();
         assert_eq!(races.len(), 1, "ranks {ranks:?}: {races:?}");

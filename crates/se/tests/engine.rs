@@ -10,8 +10,11 @@ use std::sync::Arc;
 use expect_test::expect_file;
 use proptest::prelude::*;
 use vworks_cell::{Cell, load};
-use vworks_se::engine::{Outcome, RunResult, Simulation};
-use vworks_se::trace::Kind;
+use vworks_log::issue::IssueKind;
+use vworks_log::result::{Outcome, RunResult};
+use vworks_log::trace::Kind;
+use vworks_se::describe::CellNames;
+use vworks_se::engine::Simulation;
 
 const EXAMPLES: &[(&str, Outcome)] = &[
     ("handoff", Outcome::Completed),
@@ -36,7 +39,11 @@ fn cell(name: &str) -> Arc<Cell> {
 }
 
 fn trace(cell: &Cell, r: &RunResult) -> String {
-    let mut s: String = r.trace.iter().map(|e| e.line(cell) + "\n").collect();
+    let mut s: String = r
+        .trace
+        .iter()
+        .map(|e| e.line(&CellNames(cell)) + "\n")
+        .collect();
     s.push_str(&format!(
         "# outcome {} at {} ns\n",
         r.outcome.name(),
@@ -55,7 +62,7 @@ fn per_robot(cell: &Cell, r: &RunResult) -> BTreeMap<String, Vec<(i64, String, S
             m.entry(cell.robots[i].name.clone()).or_default().push((
                 e.time,
                 e.kind.to_string(),
-                e.details(cell),
+                e.details(&CellNames(cell)),
             ));
         }
     }
@@ -159,7 +166,7 @@ proptest! {
         for (name, _) in EXAMPLES {
             let c = cell(name);
             let base = Simulation::new(Arc::clone(&c)).run(None);
-            if base.warnings.iter().any(|w| w.kind == "race") {
+            if base.warnings.iter().any(|w| w.kind == IssueKind::Race) {
                 continue;
             }
             // A permutation of the robots from the seed.

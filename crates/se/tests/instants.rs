@@ -12,8 +12,10 @@ use std::sync::Arc;
 
 use proptest::prelude::*;
 use vworks_cell::{MemoryFiles, load_with};
-use vworks_se::engine::{Outcome, Simulation};
-use vworks_se::trace::Kind;
+use vworks_log::result::Outcome;
+use vworks_log::trace::Kind;
+use vworks_se::describe::CellNames;
+use vworks_se::engine::Simulation;
 
 const GLOBALS: [&str; 2] = ["a", "b"];
 
@@ -122,7 +124,7 @@ fn run_and_check(programs: &[Vec<Step>]) {
         next[robot] += 1;
         let want = format!("{}={value}", GLOBALS[g]);
         assert_eq!(
-            e.details(&cell),
+            e.details(&CellNames(&cell)),
             want,
             "r{robot}'s set at {} ns is not the serial run's:\n{}",
             e.time,
@@ -138,8 +140,11 @@ fn run_and_check(programs: &[Vec<Step>]) {
     assert_eq!(r.globals, finals);
 }
 
-fn lines(cell: &vworks_cell::Cell, r: &vworks_se::engine::RunResult) -> String {
-    r.trace.iter().map(|e| e.line(cell) + "\n").collect()
+fn lines(cell: &vworks_cell::Cell, r: &vworks_log::result::RunResult) -> String {
+    r.trace
+        .iter()
+        .map(|e| e.line(&CellNames(cell)) + "\n")
+        .collect()
 }
 
 #[test]

@@ -10,12 +10,14 @@ use std::sync::Arc;
 use foxglove::messages::FrameTransforms;
 use prost::Message as _;
 use vworks_cell::{Cell, load};
-use vworks_model::math::Iso;
-use vworks_se::engine::{Outcome, RunResult, Simulation};
-use vworks_se::mcaplog::{
+use vworks_log::mcaplog::{
     Encoding, LogOptions, McapLog, ReadOptions, read_log_bytes, read_log_bytes_with,
 };
-use vworks_se::trace::Kind;
+use vworks_log::result::{Outcome, RunResult};
+use vworks_log::trace::Kind;
+use vworks_model::math::Iso;
+use vworks_se::describe::CellNames;
+use vworks_se::engine::Simulation;
 
 /// `vworks.CycleState` as the log's descriptor defines it (the descriptor itself is checked
 /// in the unit tests and, independently, by the Python tests).
@@ -50,7 +52,8 @@ fn run_logged(
     name: &str,
 ) -> (RunResult, Vec<u8>) {
     let path = std::env::temp_dir().join(format!("vworks-log-{name}-{}.mcap", std::process::id()));
-    let log = McapLog::create(&path, cell, every).unwrap();
+    let log =
+        McapLog::create(&path, &Arc::new(vworks_se::describe::describe(cell)), every).unwrap();
     let r = Simulation::new(Arc::clone(cell)).with_log(log).run(until);
     assert!(r.log_error.is_none(), "{:?}", r.log_error);
     let bytes = std::fs::read(&path).unwrap();
@@ -141,7 +144,7 @@ fn check(cell: &Arc<Cell>, r: &RunResult, bytes: &[u8]) {
         .map(|(k, v)| (k.to_string(), *v))
         .collect();
     assert_eq!(counts, own, "per-topic counts");
-    let trace: Vec<String> = r.trace.iter().map(|e| e.line(cell)).collect();
+    let trace: Vec<String> = r.trace.iter().map(|e| e.line(&CellNames(cell))).collect();
     assert_eq!(events, trace, "the log's events are the trace");
 }
 
@@ -430,7 +433,12 @@ fn protobuf_and_json_logs_carry_the_same_states_and_poses() {
     for (encoding, name) in [(Encoding::Protobuf, "pb"), (Encoding::Json, "json")] {
         let path =
             std::env::temp_dir().join(format!("vworks-log-{name}-{}.mcap", std::process::id()));
-        let log = McapLog::create_with(&path, &cell, LogOptions::new(1, encoding)).unwrap();
+        let log = McapLog::create_with(
+            &path,
+            &Arc::new(vworks_se::describe::describe(&cell)),
+            LogOptions::new(1, encoding),
+        )
+        .unwrap();
         let r = Simulation::new(Arc::clone(&cell)).with_log(log).run(None);
         let bytes = std::fs::read(&path).unwrap();
         let _ = std::fs::remove_file(&path);
@@ -564,7 +572,7 @@ fn frame_transforms_are_the_forward_kinematics_of_the_logged_joints() {
                 }
                 let tcp = robot.base.mul(&fk[robot.model.tool_link]).mul(&robot.tool);
                 let logged = iso(*tcp_p, *tcp_q);
-                let framed = in_world(&latest, &vworks_se::mcaplog::tcp_frame(&robot.name));
+                let framed = in_world(&latest, &vworks_log::mcaplog::tcp_frame(&robot.name));
                 for got in [logged, framed] {
                     assert!(close(&tcp, &got), "{name} {} TCP at {t}", robot.name);
                 }
@@ -581,7 +589,12 @@ fn a_log_that_cannot_be_written_is_reported_and_the_run_goes_on() {
     // stops, the run finishes as it would without a log and says why the log is missing.
     let cell = Arc::new(load(&root().join("workcells/handoff/cell.toml")).unwrap());
     let plain = Simulation::new(Arc::clone(&cell)).run(None);
-    let log = McapLog::create(Path::new("/dev/full"), &cell, 1).unwrap();
+    let log = McapLog::create(
+        Path::new("/dev/full"),
+        &Arc::new(vworks_se::describe::describe(&cell)),
+        1,
+    )
+    .unwrap();
     let r = Simulation::new(Arc::clone(&cell)).with_log(log).run(None);
     let err = r.log_error.clone().expect("the log error is reported");
     assert!(
@@ -592,12 +605,19 @@ fn a_log_that_cannot_be_written_is_reported_and_the_run_goes_on() {
         (r.outcome, r.end_time_ns),
         (plain.outcome, plain.end_time_ns)
     );
-    let lines = |x: &RunResult| x.trace.iter().map(|e| e.line(&cell)).collect::<Vec<_>>();
+    let lines = |x: &RunResult| {
+        x.trace
+            .iter()
+            .map(|e| e.line(&CellNames(&cell)))
+            .collect::<Vec<_>>()
+    };
     assert_eq!(lines(&r), lines(&plain));
     assert!(r.log_counts.is_empty());
     // A file that cannot be created is an error at once, naming it.
     let missing = root().join("no such dir").join("run.mcap");
-    let err = McapLog::create(&missing, &cell, 1).unwrap_err().to_string();
+    let err = McapLog::create(&missing, &Arc::new(vworks_se::describe::describe(&cell)), 1)
+        .unwrap_err()
+        .to_string();
     assert!(
         err.contains("no such dir") && err.contains("No such file"),
         "{err}"
@@ -623,8 +643,11 @@ fn chunks_are_compressed_at_the_documented_zstd_level() {
         let raw = zstd::decode_all(&data[..]).unwrap();
         assert_eq!(raw.len() as u64, header.uncompressed_size);
         let at = |level: i32| zstd::bulk::compress(&raw, level).unwrap().len() as f64;
-        let (ours, documented, level1) =
-            (data.len() as f64, at(vworks_se::mcaplog::ZSTD_LEVEL), at(1));
+        let (ours, documented, level1) = (
+            data.len() as f64,
+            at(vworks_log::mcaplog::ZSTD_LEVEL),
+            at(1),
+        );
         assert!(
             (ours / documented - 1.0).abs() < 0.03,
             "{ours} vs {documented}"
@@ -658,7 +681,7 @@ fn bodies_turn_red_while_they_touch() {
         .iter()
         .filter(|e| matches!(e.kind, Kind::CollisionStart | Kind::CollisionEnd))
         .map(|e| {
-            let details = e.details(&cell);
+            let details = e.details(&CellNames(&cell));
             let mut n = details.split(' ');
             let (a, b) = (n.next().unwrap(), n.next().unwrap());
             (
@@ -847,7 +870,7 @@ ENDMODULE
             .base
             .mul(&robot.model.fk(q)[robot.model.tool_link])
             .mul(&tool);
-        let framed = in_world(&latest, &vworks_se::mcaplog::tcp_frame(&robot.name));
+        let framed = in_world(&latest, &vworks_log::mcaplog::tcp_frame(&robot.name));
         for got in [iso(*tcp_p, *tcp_q), framed] {
             assert!(close(&want, &got), "TCP at {t}: {want:?} != {got:?}");
         }

@@ -9,8 +9,11 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use vworks_cell::load;
-use vworks_se::engine::{Outcome, RunResult, Simulation};
-use vworks_se::trace::Kind;
+use vworks_log::issue::IssueKind;
+use vworks_log::result::{Outcome, RunResult};
+use vworks_log::trace::Kind;
+use vworks_se::describe::CellNames;
+use vworks_se::engine::Simulation;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -255,7 +258,12 @@ fn adaptive_checking_finds_what_the_exhaustive_check_finds() {
                 .run(None)
         };
         let (fast, all) = (run(true), run(false));
-        let lines = |r: &RunResult| r.trace.iter().map(|e| e.line(&cell)).collect::<Vec<_>>();
+        let lines = |r: &RunResult| {
+            r.trace
+                .iter()
+                .map(|e| e.line(&CellNames(&cell)))
+                .collect::<Vec<_>>()
+        };
         assert_eq!(lines(&fast), lines(&all), "{}", path.display());
         assert_eq!(fast.collisions, all.collisions);
         assert!(fast.queries <= all.queries, "{}", path.display());
@@ -308,7 +316,12 @@ fn the_horizon_skips_only_what_cannot_matter() {
                 .run(Some(12_000_000_000))
         };
         let (fast, all) = (run(true), run(false));
-        let lines = |r: &RunResult| r.trace.iter().map(|e| e.line(&cell)).collect::<Vec<_>>();
+        let lines = |r: &RunResult| {
+            r.trace
+                .iter()
+                .map(|e| e.line(&CellNames(&cell)))
+                .collect::<Vec<_>>()
+        };
         assert_eq!(lines(&fast), lines(&all), "{name}");
         assert_eq!(fast.cycles, all.cycles, "{name}");
         assert!(
@@ -321,7 +334,7 @@ fn the_horizon_skips_only_what_cannot_matter() {
         let near = fast
             .warnings
             .iter()
-            .filter(|w| w.kind == "near_miss")
+            .filter(|w| w.kind == IssueKind::NearMiss)
             .count();
         match name {
             "raised" => assert!(collisions > 0, "{name}"),
@@ -371,7 +384,7 @@ proptest::proptest! {
         let cell = Arc::new(load(&path).unwrap());
         let run = |adaptive: bool| Simulation::new(Arc::clone(&cell)).with_adaptive(adaptive).run(None);
         let (fast, all) = (run(true), run(false));
-        let lines = |r: &RunResult| r.trace.iter().map(|e| e.line(&cell)).collect::<Vec<_>>();
+        let lines = |r: &RunResult| r.trace.iter().map(|e| e.line(&CellNames(&cell))).collect::<Vec<_>>();
         proptest::prop_assert_eq!(lines(&fast), lines(&all));
         // One bounded query per pair and checked boundary, adaptive or not: adaptive
         // checking makes no more queries than checking every boundary. (It used to add an

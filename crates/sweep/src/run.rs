@@ -16,8 +16,7 @@ use std::time::{Duration, Instant};
 
 use vworks_app::{CellSource, LogRequest, RunError, RunRequest};
 use vworks_cell::{Loader, Override};
-use vworks_se::engine::RunResult;
-use vworks_se::result::Outcome;
+use vworks_log::result::{Outcome, RunResult};
 
 /// How a variant ended: its run's [`Outcome`], or what only a sweep says of a variant.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -114,7 +113,7 @@ impl Row {
                 .robots
                 .iter()
                 .map(|s| {
-                    let ended = s.ended == vworks_se::stats::Ending::Ended;
+                    let ended = s.ended == vworks_log::stats::Ending::Ended;
                     (s.name.clone(), ended.then_some(s.end_time_ns as f64 / 1e9))
                 })
                 .collect(),

@@ -13,7 +13,7 @@ use std::fmt::Write as _;
 
 use crate::Row;
 use crate::run::RowOutcome;
-use vworks_se::result::Outcome;
+use vworks_log::result::Outcome;
 
 /// A value of the table.
 #[derive(Clone, Debug, PartialEq)]

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use vworks_cell::{Disk, Loader, MemoryFiles, Override};
-use vworks_se::result::Outcome;
+use vworks_log::result::Outcome;
 use vworks_sweep::run::{RunOptions, run_one};
 use vworks_sweep::table::{self, Value};
 use vworks_sweep::{Combine, RowOutcome, Sweep, Table, run_variants};

@@ -6,7 +6,7 @@
 use std::sync::Arc;
 
 use vworks_model::builtin;
-use vworks_vm::machine::{Event, EventKind, Next, Vm, VmConfig};
+use vworks_vm::machine::{Event, EventKind, Next, Vm, VmConfig, WarningKind};
 
 fn vm(src: &str, robot: &str, cfg: VmConfig) -> Vm {
     let out = vworks_wslc::compile("t.wsl", src).unwrap_or_else(|e| panic!("{e}"));
@@ -608,8 +608,9 @@ fn limits_reach_and_speed_are_checked() {
     );
     let w = v.take_warnings();
     assert!(
-        w.iter()
-            .any(|w| w.message.contains("slowed") && w.pos.line == 3 && w.kind == "slowdown"),
+        w.iter().any(|w| w.message.contains("slowed")
+            && w.pos.line == 3
+            && w.kind == WarningKind::Slowdown),
         "{w:?}"
     );
 }

@@ -23,7 +23,7 @@ use std::sync::Arc;
 use proptest::prelude::*;
 use vworks_model::builtin;
 use vworks_model::math::{norm, sub};
-use vworks_vm::machine::{Event, EventKind, Next, Vm, VmConfig};
+use vworks_vm::machine::{Event, EventKind, Next, Vm, VmConfig, WarningKind};
 
 const HOME: &str = "joints(0deg, -30deg, 30deg, 0deg, 60deg, 0deg)";
 const MS: i64 = 1_000_000;
@@ -338,7 +338,7 @@ fn a_delay_after_a_zoned_point_waits_for_the_robot_with_one_warning() {
     let r = run(&mut v, 50.0);
     let warnings = v.take_warnings();
     assert_eq!(warnings.len(), 1, "{warnings:?}");
-    assert_eq!(warnings[0].kind, "stop-point");
+    assert_eq!(warnings[0].kind, WarningKind::StopPoint);
     assert!(
         warnings[0].message.contains(
             "`delay` makes the zoned point of the motion at line 6 of t.wsl a stop point"

@@ -28,6 +28,7 @@ use vworks_model::math::Iso;
 use vworks_vm::machine::Vm;
 
 use vworks_cell::Cell;
+use vworks_log::place::Contact;
 
 use crate::world::World;
 
@@ -40,24 +41,6 @@ use broadphase::SweepAndPrune;
 use narrow::*;
 use pairs::{BodyKeys, PairFilter, Promises};
 use sweep::SweepScratch;
-
-/// A collision that started.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Contact {
-    /// When (ns).
-    pub time_ns: i64,
-    /// First body (`r1.link_4`, `table`, `part1`).
-    pub a: String,
-    /// Second body.
-    pub b: String,
-    /// Penetration depth (m).
-    pub depth: f64,
-    /// A contact point in the cell frame (m).
-    pub point: [f64; 3],
-    /// Each robot whose body is in the pair and the motion it was making (filled in by
-    /// the engine, which knows the programs; the collider leaves it empty).
-    pub motions: Vec<crate::place::RobotMotion>,
-}
 
 /// A contact's depth from the signed gap between two bodies (m): how far they overlap, 0 for
 /// bodies just touching (never `-0`, which would print as `-0.0 mm`).
@@ -425,7 +408,7 @@ impl Collider {
         let (robot, vm) = (&cell.robots[r], &vms[r]);
         let link = Collider::tool_world(cell, vm, r, t);
         let tcp = link.mul(&vm.tool_at(t)).to_pose().translation;
-        let (link, part) = (link.to_pose(), self.world.part_pose(cell, p).to_pose());
+        let (link, part) = (link.to_pose(), self.world.part_pose(p).to_pose());
         let gripper = Owner::Link {
             robot: r,
             link: robot.model.tool_link,

@@ -6,6 +6,8 @@
 
 use vworks_vm::machine::EventKind;
 
+use vworks_log::issue::IssueKind;
+
 use super::{Detail, Kind, Simulation};
 
 /// How many events a run records at most by default (see
@@ -53,7 +55,7 @@ impl Simulation {
                 "the run has recorded {} events, the most a run keeps; simulate less time (`--until`)",
                 self.event_limit
             );
-            self.error(t, None, None, "runtime", m);
+            self.error(t, None, None, IssueKind::Runtime, m);
             self.outcome = Some(super::Outcome::Error);
             return;
         };
@@ -112,7 +114,7 @@ impl Simulation {
                 )
             }
         };
-        self.error(t, Some(r), Some(pos), "runtime", message);
+        self.error(t, Some(r), Some(pos), IssueKind::Runtime, message);
         self.outcome = Some(super::Outcome::Error);
     }
 }
@@ -122,6 +124,6 @@ mod tests {
     /// The memory bound [`super::EVENT_LIMIT`] documents: events of fixed size.
     #[test]
     fn a_trace_event_takes_at_most_104_bytes() {
-        assert!(size_of::<crate::trace::TraceEvent>() <= 104);
+        assert!(size_of::<vworks_log::trace::TraceEvent>() <= 104);
     }
 }

@@ -25,15 +25,16 @@ use vworks_vm::bytecode::SrcPos;
 use vworks_vm::machine::{Event, EventKind, Next, Vm, VmConfig};
 use vworks_vm::types::fmt_quantity;
 
-use crate::collide::{Collider, Contact};
-use crate::place::RobotMotion;
-pub use crate::result::{Outcome, RunResult};
-use crate::sink::{RunEnd, RunSink};
-use crate::stats::Fold;
-pub use crate::stats::{Ending, RobotStats};
-use crate::trace::format_value;
-pub use crate::trace::{Detail, Issue, Kind, TraceEvent, Value};
+use crate::collide::Collider;
+use crate::describe::{CellNames, statement_at};
 use vworks_cell::Cell;
+use vworks_log::issue::{Issue, IssueKind};
+use vworks_log::mcaplog::McapLog;
+use vworks_log::place::{Contact, RobotMotion};
+use vworks_log::result::{Outcome, RunResult};
+use vworks_log::sink::{RunEnd, RunSink};
+use vworks_log::stats::{Ending, Fold};
+use vworks_log::trace::{Detail, Kind, TraceEvent, Value, format_value};
 
 mod limit;
 mod queue;
@@ -215,7 +216,7 @@ impl Simulation {
             .warnings
             .iter()
             .map(|d| Issue {
-                kind: d.code.as_str().to_string(),
+                kind: IssueKind::Compiler(d.code.as_str().to_string()),
                 message: d.message.clone(),
                 robot: None,
                 file: Some(d.at.file.clone()),
@@ -284,8 +285,8 @@ impl Simulation {
         }
     }
 
-    /// Writes the run to an MCAP log (see [`crate::mcaplog`]).
-    pub fn with_log(self, log: crate::mcaplog::McapLog) -> Simulation {
+    /// Writes the run to an MCAP log (see [`vworks_log::mcaplog`]).
+    pub fn with_log(self, log: McapLog) -> Simulation {
         self.with_sink(Box::new(log))
     }
 
@@ -485,9 +486,8 @@ impl Simulation {
         if !self.sinks.is_empty()
             && let Some(e) = self.trace.last()
         {
-            let cell = &self.cell;
             let failed = &mut self.log_error;
-            self.sinks.retain_mut(|s| match s.event(cell, e) {
+            self.sinks.retain_mut(|s| match s.event(e) {
                 Ok(()) => true,
                 Err(err) => {
                     failed.get_or_insert(err);
@@ -503,9 +503,9 @@ impl Simulation {
         if self.sinks.is_empty() {
             return;
         }
-        let (cell, world) = (&self.cell, self.collider.world());
+        let world = self.collider.world();
         let failed = &mut self.log_error;
-        self.sinks.retain_mut(|s| match s.cycle(cell, b, world) {
+        self.sinks.retain_mut(|s| match s.cycle(b, world) {
             Ok(()) => true,
             Err(err) => {
                 failed.get_or_insert(err);
@@ -516,13 +516,13 @@ impl Simulation {
 
     fn issue(
         &self,
-        kind: &str,
+        kind: IssueKind,
         message: String,
         robot: Option<usize>,
         pos: Option<SrcPos>,
     ) -> Issue {
         Issue {
-            kind: kind.into(),
+            kind,
             message,
             robot: robot.map(|r| self.cell.robots[r].name.clone()),
             file: robot
@@ -552,7 +552,7 @@ impl Simulation {
                         file: Some(self.cell.robots[r].module.file_of(pos).to_string()),
                         line: pos.line,
                         col: pos.col,
-                        statement: crate::place::statement_at(&self.cell, r, pos),
+                        statement: statement_at(&self.cell, r, pos),
                     },
                     None => RobotMotion::not_moved(robot),
                 }
@@ -766,7 +766,7 @@ impl Simulation {
                             "near miss: {a} and {bname} come within {:.2} mm",
                             dist * 1e3
                         );
-                        let mut issue = self.issue("near_miss", m, None, None);
+                        let mut issue = self.issue(IssueKind::NearMiss, m, None, None);
                         issue.distance_m = Some(dist);
                         issue.motions = self.motions_of(&a, &bname, b);
                         // The warning's own place: the first robot moving (else the
@@ -805,7 +805,13 @@ impl Simulation {
         // Found while the VM described this event (or planned it): at its time at the
         // earliest, so the trace stays in time order.
         for w in self.vms[r].take_warnings() {
-            self.warning(w.time.max(e.time), Some(r), Some(w.pos), w.kind, w.message);
+            self.warning(
+                w.time.max(e.time),
+                Some(r),
+                Some(w.pos),
+                w.kind.into(),
+                w.message,
+            );
         }
         if self.outcome.is_none() {
             self.requeue(r);
@@ -839,7 +845,7 @@ impl Simulation {
         t: i64,
         robot: Option<usize>,
         pos: Option<SrcPos>,
-        kind: &str,
+        kind: IssueKind,
         message: String,
     ) {
         let issue = self.issue(kind, message, robot, pos);
@@ -872,7 +878,7 @@ impl Simulation {
         t: i64,
         robot: Option<usize>,
         pos: Option<SrcPos>,
-        kind: &str,
+        kind: IssueKind,
         message: String,
     ) {
         let issue = self.issue(kind, message, robot, pos);
@@ -908,7 +914,7 @@ impl Simulation {
         );
         let robot = busy.first().map(|&(_, r)| r);
         let pos = robot.map(|r| self.vms[r].loop_position());
-        self.error(t, robot, pos, "runtime", m);
+        self.error(t, robot, pos, IssueKind::Runtime, m);
         self.outcome = Some(Outcome::Error);
     }
 
@@ -940,7 +946,7 @@ impl Simulation {
             ));
         }
         let m = format!("deadlock: {}", parts.join("; "));
-        self.error(self.time, None, None, "deadlock", m);
+        self.error(self.time, None, None, IssueKind::Deadlock, m);
         self.outcome = Some(Outcome::Deadlock);
     }
 
@@ -1043,7 +1049,7 @@ impl Simulation {
             logs: self
                 .trace
                 .iter()
-                .filter_map(|e| e.log_line(&self.cell))
+                .filter_map(|e| e.log_line(&CellNames(&self.cell)))
                 .collect(),
             trace: self.trace,
             cycles: self.cycles,

@@ -8,6 +8,8 @@ use std::sync::Arc;
 use vworks_vm::bytecode::SrcPos;
 use vworks_vm::types::fmt_quantity;
 
+use vworks_log::issue::IssueKind;
+
 use super::Simulation;
 
 /// Whose vector clock a released robot takes in (see [`Simulation::merge_clock`]).
@@ -130,7 +132,7 @@ impl Simulation {
             self.short(r, pos),
             pos
         );
-        self.warning(t, Some(r), Some(pos), "race", m);
+        self.warning(t, Some(r), Some(pos), IssueKind::Race, m);
     }
 
     /// The globals robot `r`'s last segment read at this instant: a race with a set of

@@ -12,6 +12,8 @@ use vworks_vm::types::fmt_quantity;
 
 use super::queue::Entry;
 use super::races::Seen;
+use vworks_log::issue::IssueKind;
+
 use super::{Detail, Kind, Outcome, Simulation};
 
 impl Simulation {
@@ -210,7 +212,7 @@ impl Simulation {
                 }
             }
             EventKind::Error { message } => {
-                let issue = self.issue("runtime", message.clone(), Some(r), Some(e.pos));
+                let issue = self.issue(IssueKind::Runtime, message.clone(), Some(r), Some(e.pos));
                 self.errors.push(issue);
                 self.outcome = Some(Outcome::Error);
             }
@@ -357,7 +359,7 @@ impl Simulation {
     /// A runtime error the SE finds in robot `r`'s event at `t` (a part gripped twice):
     /// an `error` event at the statement, and the run stops.
     pub(super) fn runtime_error(&mut self, r: usize, t: i64, pos: SrcPos, message: String) {
-        self.error(t, Some(r), Some(pos), "runtime", message);
+        self.error(t, Some(r), Some(pos), IssueKind::Runtime, message);
         self.vms[r].halt();
         self.outcome = Some(Outcome::Error);
     }

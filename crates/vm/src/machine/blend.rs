@@ -226,7 +226,7 @@ impl Vm {
             self.warn_once(
                 self.main.pc,
                 point,
-                "corner",
+                WarningKind::Corner,
                 format!(
                     "this motion cannot start inside the zone of the motion at line {} of {} within the zone and the axes' limits: the robot stops at that point first (a corner path failure); a larger zone, a lower speed or a jerk limit can let it fly by",
                     at.line,
@@ -265,7 +265,7 @@ impl Vm {
 
     /// A warning about the statement at `pc`, at `time`, once per statement (a loop
     /// repeats it every round).
-    fn warn_once(&mut self, pc: u32, time: i64, kind: &'static str, message: String) {
+    fn warn_once(&mut self, pc: u32, time: i64, kind: WarningKind, message: String) {
         if self.zone_warned.contains(&pc) {
             return;
         }
@@ -524,7 +524,7 @@ impl Vm {
         self.warn_once(
             pc,
             end,
-            "stop-point",
+            WarningKind::StopPoint,
             format!(
                 "{what} makes the zoned point of the motion at line {} of {} a stop point: the robot reaches it first; make that motion stop at its point to say so (`zone fine`; in RAPID, `fine`)",
                     at.line,

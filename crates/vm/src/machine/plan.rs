@@ -488,7 +488,7 @@ impl Vm {
             self.warnings.push(Warning {
                 time: self.time,
                 pos,
-                kind: "duration",
+                kind: WarningKind::Duration,
                 message: format!(
                     "the motion takes {}, longer than the {} asked: it cannot be faster {how}",
                     fmt_quantity(lasts as f64 / NS, Dim::TIME),
@@ -747,7 +747,7 @@ impl Vm {
             self.warnings.push(Warning {
                 time: self.time,
                 pos,
-                kind: "slowdown",
+                kind: WarningKind::Slowdown,
                 message: format!("the motion is slowed to {:.0}% of its speed: axis {} `{}` would exceed its speed limit", worst * 100.0, worst_axis + 1, j.name),
             });
         }

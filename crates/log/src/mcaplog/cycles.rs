@@ -24,7 +24,7 @@ use vworks_model::model::RobotModel;
 use vworks_vm::MAX_AXES;
 
 use super::{Encoding, KEYFRAME_NS, json, proto};
-use vworks_cell::Cell;
+use crate::cell::CellInfo;
 
 /// Bytes of one pose in a cycle record: rotation (9) and translation (3), f64 each.
 const POSE_BYTES: usize = 12 * 8;
@@ -41,7 +41,7 @@ fn append_pose(b: &mut Vec<u8>, p: &Iso) {
 /// [`CycleEncoder::payload_len`] bytes.
 pub(crate) fn append_cycle(
     b: &mut Vec<u8>,
-    cell: &Cell,
+    cell: &CellInfo,
     joints: &[[f64; MAX_AXES]],
     frames: &[Vec<Iso>],
     tools: &[Iso],
@@ -122,7 +122,7 @@ pub(crate) struct CycleEncoder {
 }
 
 impl CycleEncoder {
-    pub(crate) fn new(cell: &Cell, encoding: Encoding) -> CycleEncoder {
+    pub(crate) fn new(cell: &CellInfo, encoding: Encoding) -> CycleEncoder {
         let mut edges: Vec<(String, String)> = Vec::new();
         for r in &cell.robots {
             let link = |l: usize| format!("{}.{}", r.name, r.model.links[l].name);

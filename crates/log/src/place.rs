@@ -1,11 +1,15 @@
-//! Where in the programs something happened, for people to find it: the motion statement
-//! each robot in a collision or near miss was making ([`RobotMotion`]), the lines the
-//! programs logged ([`LogLine`]), and a statement's text as written ([`statement_at`]).
+//! Where in the cell and the programs something happened, for people to find it: a
+//! collision's bodies and contact ([`Contact`]), the motion statement each robot in a
+//! collision or near miss was making ([`RobotMotion`]), the lines the programs logged
+//! ([`LogLine`]), and a statement's text as written ([`statement_in`]).
+//!
+//! Their JSON is derived (serde); serialized into a `serde_json::Value`, whose objects
+//! keep their keys sorted, it is byte for byte the form written by hand before.
 
 use std::path::Path;
 
-use serde_json::{Value as Json, json};
-use vworks_cell::Cell;
+use serde::{Deserialize, Serialize};
+use serde_json::Value as Json;
 use vworks_vm::bytecode::SrcPos;
 
 /// `path`'s file name (the whole text if it has none).
@@ -15,9 +19,36 @@ pub(crate) fn file_name(path: &str) -> String {
         .map_or(path.to_string(), |n| n.to_string_lossy().into_owned())
 }
 
+/// Two bodies that started touching: what the collider finds and the run reports.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Contact {
+    /// When (ns).
+    pub time_ns: i64,
+    /// First body (`r1.link_4`, `table`, `part1`).
+    pub a: String,
+    /// Second body.
+    pub b: String,
+    /// Penetration depth (m).
+    #[serde(rename = "depth_m")]
+    pub depth: f64,
+    /// A contact point in the cell frame (m).
+    #[serde(rename = "point_m")]
+    pub point: [f64; 3],
+    /// Each robot whose body is in the pair and the motion it was making (filled in by
+    /// the engine, which knows the programs; the collider leaves it empty).
+    pub motions: Vec<RobotMotion>,
+}
+
+impl Contact {
+    /// As in `run --json`: `time_ns`, `a`, `b`, `depth_m`, `point_m`, `motions`.
+    pub fn to_json(&self) -> Json {
+        serde_json::to_value(self).unwrap_or(Json::Null)
+    }
+}
+
 /// A robot whose body (a link, or a part it holds) is in a collision or a near miss, and
 /// the motion statement it was making then — or, standing, the last one it made.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RobotMotion {
     /// The robot's name.
     pub robot: String,
@@ -31,7 +62,7 @@ pub struct RobotMotion {
     /// Its column (0 if none).
     pub col: u32,
     /// The statement's text as written (`move_l above speed 250mm/s;`): see
-    /// [`statement_at`].
+    /// [`statement_in`].
     pub statement: String,
 }
 
@@ -88,24 +119,12 @@ impl RobotMotion {
 
     /// As JSON: `robot`, `moving`, `file`, `line`, `col`, `statement`.
     pub fn to_json(&self) -> Json {
-        json!({"robot": self.robot, "moving": self.moving, "file": self.file,
-               "line": self.line, "col": self.col, "statement": self.statement})
+        serde_json::to_value(self).unwrap_or(Json::Null)
     }
 
-    /// From the JSON [`RobotMotion::to_json`] writes.
+    /// From the JSON [`RobotMotion::to_json`] writes (`file` may be absent).
     pub fn from_json(v: &Json) -> Option<RobotMotion> {
-        let file = match v.get("file") {
-            None | Some(Json::Null) => None,
-            Some(f) => Some(f.as_str()?.to_string()),
-        };
-        Some(RobotMotion {
-            robot: v.get("robot")?.as_str()?.to_string(),
-            moving: v.get("moving")?.as_bool()?,
-            file,
-            line: u32::try_from(v.get("line")?.as_u64()?).ok()?,
-            col: u32::try_from(v.get("col")?.as_u64()?).ok()?,
-            statement: v.get("statement")?.as_str()?.to_string(),
-        })
+        RobotMotion::deserialize(v).ok()
     }
 
     /// Sets `object`'s `motions` to the list, if it is not empty (a JSON object of a
@@ -137,7 +156,7 @@ impl RobotMotion {
 
 /// A line a program logged (`log "…";`, RAPID's `TPWrite`): what a run prints as it
 /// happens and lists in its result.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct LogLine {
     /// When (ns).
     pub time_ns: i64,
@@ -156,23 +175,15 @@ pub struct LogLine {
 impl LogLine {
     /// As JSON: `time_ns`, `robot`, `text`, `file`, `line`, `col`.
     pub fn to_json(&self) -> Json {
-        json!({"time_ns": self.time_ns, "robot": self.robot, "text": self.text,
-               "file": self.file, "line": self.line, "col": self.col})
+        serde_json::to_value(self).unwrap_or(Json::Null)
     }
 }
 
-/// The statement at `pos` of robot `r`'s program as written: from its column to its `;`,
-/// over as many lines as it takes (each line trimmed, joined by one space), at most
-/// [`STATEMENT_LINES`] lines (then it ends with ` …`); the first line alone if the file
-/// ends before a `;`. Empty if the source is not in the cell.
-pub fn statement_at(cell: &Cell, r: usize, pos: SrcPos) -> String {
-    let Some(robot) = cell.robots.get(r) else {
-        return String::new();
-    };
-    let file = robot.module.file_of(pos);
-    let Some((_, text)) = cell.sources.iter().find(|(p, _)| p == file) else {
-        return String::new();
-    };
+/// The statement at `pos` of a program file whose text is `text`, as written: from its
+/// column to its `;`, over as many lines as it takes (each line trimmed, joined by one
+/// space), at most [`STATEMENT_LINES`] lines (then it ends with ` …`); the first line alone
+/// if the file ends before a `;`.
+pub fn statement_in(text: &str, pos: SrcPos) -> String {
     let line_start: usize = text
         .split_inclusive('\n')
         .take((pos.line as usize).saturating_sub(1))

@@ -1,6 +1,6 @@
 //! Time per robot — moving, waiting, idle, motions, cycle time — as one fold over the
 //! typed events ([`crate::trace::Kind`]). The engine folds its events as it records them
-//! ([`crate::engine::RunResult::robots`]); the report folds a log's events the same way,
+//! ([`crate::result::RunResult::robots`]); the report folds a log's events the same way,
 //! so `vworks run`, `run --json`, Python and the report give the same numbers.
 //!
 //! The definitions (docs/engine.md, "Results"):

@@ -52,10 +52,9 @@ pub use read::{
     read_log_with,
 };
 
-use crate::sink::{RunEnd, RunSink};
+use crate::cell::CellInfo;
+use crate::sink::{RunEnd, RunSink, WorldView};
 use crate::trace::{Data, Kind, TraceEvent};
-use crate::world::World;
-use vworks_cell::Cell;
 
 /// An event as a log holds it: the run's typed event with names.
 pub type LoggedEvent = crate::trace::Event;
@@ -171,6 +170,8 @@ fn media_type(name: &str, text: bool) -> &'static str {
 
 /// The MCAP log being written.
 pub struct McapLog {
+    /// The cell logged: events are resolved with its names; boundaries read its models.
+    cell: Arc<CellInfo>,
     /// The writer thread's end: records are appended to its batch.
     sink: writer::Sink,
     file: String,
@@ -244,7 +245,7 @@ impl std::fmt::Debug for McapLog {
 /// writes the metadata and the attachments. Runs on the writer thread.
 fn open(
     w: &mut writer::Mcap,
-    cell: &Cell,
+    cell: &CellInfo,
     encoding: Encoding,
 ) -> Result<[u16; TOPICS.len()], String> {
     let io = |e: &dyn std::error::Error| error_chain(e);
@@ -291,7 +292,7 @@ fn open(
     meta.insert("log_version".to_string(), LOG_VERSION.to_string());
     meta.insert("cell".to_string(), cell.name.clone());
     meta.insert("cycle_ns".to_string(), cell.cycle_ns.to_string());
-    meta.insert("workcell_file".to_string(), cell.file.display().to_string());
+    meta.insert("workcell_file".to_string(), cell.file.clone());
     meta.insert("clearance_m".to_string(), cell.clearance.to_string());
     // The engine draws no random numbers: the same inputs give the same run.
     meta.insert("seed".to_string(), "none (deterministic)".to_string());
@@ -329,7 +330,7 @@ fn open(
 
 impl McapLog {
     /// Creates the log for `cell`; `every` thins cycle states (1 = every boundary).
-    pub fn create(path: &Path, cell: &Arc<Cell>, every: u64) -> Result<McapLog, LogError> {
+    pub fn create(path: &Path, cell: &Arc<CellInfo>, every: u64) -> Result<McapLog, LogError> {
         McapLog::create_with(
             path,
             cell,
@@ -345,7 +346,7 @@ impl McapLog {
     /// (a full disk, say) come out of [`McapLog::finish`] or the run's `log_error`.
     pub fn create_with(
         path: &Path,
-        cell: &Arc<Cell>,
+        cell: &Arc<CellInfo>,
         options: LogOptions,
     ) -> Result<McapLog, LogError> {
         let file = path.display().to_string();
@@ -372,6 +373,7 @@ impl McapLog {
                 reason: format!("{}{hint}", error_chain(&e)),
             }
         })?);
+        let names = Arc::clone(cell);
         let cell = Arc::clone(cell);
         let encoding = options.encoding;
         let open = move || {
@@ -386,6 +388,7 @@ impl McapLog {
         };
         let sink = writer::Sink::spawn(open).map_err(|e| io(&e))?;
         Ok(McapLog {
+            cell: names,
             sink,
             file,
             every: options.every.max(1),
@@ -414,8 +417,8 @@ impl McapLog {
 
     /// Logs an event (and, for `log`, `warning` and `error`, a Foxglove log message); on
     /// `collision_start`/`collision_end` the two bodies change colour.
-    pub(crate) fn event(&mut self, cell: &Cell, e: &TraceEvent) -> Result<(), LogError> {
-        let ev = e.resolve(cell);
+    pub(crate) fn event(&mut self, e: &TraceEvent) -> Result<(), LogError> {
+        let ev = e.resolve(&*self.cell);
         self.write(EVENTS, e.time, &ev.to_json())?;
         let level = match e.kind {
             Kind::Log => Some(2),
@@ -484,22 +487,22 @@ impl McapLog {
 }
 
 impl RunSink for McapLog {
-    fn event(&mut self, cell: &Cell, e: &TraceEvent) -> Result<(), String> {
-        McapLog::event(self, cell, e).map_err(|e| e.to_string())
+    fn event(&mut self, e: &TraceEvent) -> Result<(), String> {
+        McapLog::event(self, e).map_err(|e| e.to_string())
     }
 
     /// Logs every `every`-th boundary: the robots' joints and link frames and the parts'
     /// poses, from which the writer thread builds `/state` and `/tf` (in the module `cycles`).
     /// Other boundaries are only counted.
-    fn cycle(&mut self, cell: &Cell, t: i64, world: &World) -> Result<(), String> {
+    fn cycle(&mut self, t: i64, world: &dyn WorldView) -> Result<(), String> {
         let k = self.boundary;
         self.boundary += 1;
         if !k.is_multiple_of(self.every) {
             return Ok(());
         }
-        world.part_poses_into(cell, &mut self.parts);
+        world.part_poses_into(&mut self.parts);
         let (joints, frames, tools) = (world.joints(), world.frames(), world.tools());
-        let parts = &self.parts;
+        let (cell, parts) = (&*self.cell, &self.parts);
         let payload = |b: &mut Vec<u8>| cycles::append_cycle(b, cell, joints, frames, tools, parts);
         let done = self.sink.cycle(t.max(0) as u64, k, payload);
         done.map_err(|reason| self.failed(reason).to_string())

@@ -6,10 +6,10 @@ use std::collections::BTreeMap;
 
 use serde_json::{Value as Json, json};
 
-use crate::collide::Contact;
-use crate::place::{LogLine, RobotMotion};
+use crate::issue::Issue;
+use crate::place::{Contact, LogLine};
 use crate::stats::RobotStats;
-use crate::trace::{Issue, TraceEvent, Value};
+use crate::trace::{TraceEvent, Value};
 
 /// How the run ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -24,7 +24,7 @@ pub enum Outcome {
     Error,
     /// The `until` time was reached.
     Until,
-    /// Stopped from outside (Ctrl-C) through `Simulation::with_stop` ([`crate::engine::Simulation`]).
+    /// Stopped from outside (Ctrl-C) through the engine's `Simulation::with_stop`.
     Interrupted,
 }
 
@@ -75,38 +75,6 @@ pub struct RunResult {
     pub log_error: Option<String>,
 }
 
-impl Issue {
-    /// As JSON: `kind`, `message`, `robot`, `file`, `line`, `col`, and for a near miss
-    /// `distance_m` and `motions` (each robot in the pair and its motion).
-    pub fn to_json(&self) -> Json {
-        let mut v = issue_json(
-            &self.kind,
-            &self.message,
-            self.robot.as_deref(),
-            self.file.as_deref(),
-            self.line,
-            self.col,
-        );
-        if let Some(d) = self.distance_m {
-            v["distance_m"] = d.into();
-        }
-        RobotMotion::put_list(&mut v, &self.motions);
-        v
-    }
-}
-
-/// An issue as JSON from its parts (load and compile errors use it too).
-pub fn issue_json(
-    kind: &str,
-    message: &str,
-    robot: Option<&str>,
-    file: Option<&str>,
-    line: u32,
-    col: u32,
-) -> Json {
-    json!({"kind": kind, "message": message, "robot": robot, "file": file, "line": line, "col": col})
-}
-
 impl RunResult {
     /// The result as JSON (`cell`: the cell's name): the contract's fields (outcome,
     /// end time, robots, collisions, warnings, errors, globals as JSON values of their
@@ -120,10 +88,7 @@ impl RunResult {
                 "name": s.name, "moving_ns": s.moving_ns, "waiting_ns": s.waiting_ns, "idle_ns": s.idle_ns,
                 "motions": s.motions, "end_time_ns": s.end_time_ns, "ended": s.ended.name(),
             })).collect::<Vec<_>>(),
-            "collisions": self.collisions.iter().map(|c| json!({
-                "time_ns": c.time_ns, "a": c.a, "b": c.b, "depth_m": c.depth, "point_m": c.point,
-                "motions": c.motions.iter().map(RobotMotion::to_json).collect::<Vec<_>>(),
-            })).collect::<Vec<_>>(),
+            "collisions": self.collisions.iter().map(Contact::to_json).collect::<Vec<_>>(),
             "warnings": self.warnings.iter().map(Issue::to_json).collect::<Vec<_>>(),
             "errors": self.errors.iter().map(Issue::to_json).collect::<Vec<_>>(),
             "logs": self.logs.iter().map(LogLine::to_json).collect::<Vec<_>>(),

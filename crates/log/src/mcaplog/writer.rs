@@ -400,7 +400,41 @@ mod tests {
     use std::collections::BTreeMap;
 
     use super::*;
+    use crate::cell::{BodyInfo, CellInfo, RobotInfo};
     use crate::mcaplog::Encoding;
+    use vworks_model::math::Iso;
+    use vworks_model::model::Geometry;
+
+    /// A cell of two built-in robots, a device and a part.
+    fn cell() -> CellInfo {
+        let robot = |name: &str, model: &str, x: f64| RobotInfo {
+            name: name.into(),
+            model: std::sync::Arc::new(vworks_model::builtin::load(model).unwrap()),
+            base: Iso::from_xyz_rpy([x, 0.0, 0.0], [0.0; 3]),
+            tool: Iso::IDENTITY,
+            module: Default::default(),
+        };
+        let body = |name: &str| BodyInfo {
+            name: name.into(),
+            geometry: Geometry::Box {
+                half: [0.1, 0.1, 0.1],
+            },
+            pose: Iso::IDENTITY,
+        };
+        CellInfo {
+            name: "test".into(),
+            file: "cell.toml".into(),
+            cycle_ns: 10_000_000,
+            clearance: 0.01,
+            robots: vec![robot("r1", "ur5", 0.0), robot("t", "track", 1.0)],
+            devices: vec![body("table")],
+            parts: vec![body("part1")],
+            globals: Vec::new(),
+            sources: Vec::new(),
+            files: Vec::new(),
+            overrides: Vec::new(),
+        }
+    }
 
     /// A file that takes `room` bytes, then fails every write as a full disk does.
     struct FillsUp {
@@ -428,11 +462,7 @@ mod tests {
 
     #[test]
     fn a_write_error_in_the_thread_reaches_the_simulation() {
-        let cell = vworks_cell::load(
-            &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-                .join("../../workcells/handoff/cell.toml"),
-        )
-        .unwrap();
+        let cell = cell();
         let file = FillsUp {
             data: std::io::Cursor::new(Vec::new()),
             room: 200_000,
@@ -473,11 +503,7 @@ mod tests {
 
     #[test]
     fn records_come_out_in_order_with_their_counts() {
-        let cell = vworks_cell::load(
-            &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-                .join("../../workcells/track/cell.toml"),
-        )
-        .unwrap();
+        let cell = cell();
         let path = std::env::temp_dir().join(format!("vworks-writer-{}.mcap", std::process::id()));
         let mut mcap = mcap::WriteOptions::new()
             .create(BufWriter::new(File::create(&path).unwrap()))

@@ -1,5 +1,7 @@
 //! The event vocabulary's names, JSON round trips and time styles.
 
+#![allow(clippy::expect_used)]
+
 use super::*;
 
 #[test]
@@ -12,6 +14,89 @@ fn kinds_have_distinct_names_and_come_back_from_them() {
     names.dedup();
     assert_eq!(names.len(), Kind::ALL.len());
     assert_eq!(Kind::from_name("wait_signal"), None);
+}
+
+#[test]
+fn kinds_are_declared_in_table_order() {
+    for (i, k) in Kind::ALL.into_iter().enumerate() {
+        assert_eq!(k as usize, i, "{k}");
+    }
+    assert_eq!(
+        Kind::ALL.len(),
+        EVENT_NAMES.len() + Kind::ENGINE_NAMES.len()
+    );
+}
+
+#[test]
+fn a_vm_event_s_kind_is_named_by_the_vm_s_table() {
+    // One of each VM event kind (the three waits are all `wait_until`).
+    let events = [
+        EventKind::MotionStart {
+            command: "move_l",
+            duration_ns: 1,
+            zone_m: None,
+            blend_m: None,
+        },
+        EventKind::MotionEnd {
+            zone_m: None,
+            programmed_m: None,
+        },
+        EventKind::Delay { duration_ns: 1 },
+        EventKind::DelayEnd,
+        EventKind::Set {
+            global: 0,
+            value: 0,
+            ty: Type::Int,
+        },
+        EventKind::WaitUntil {
+            cond: 0,
+            deadline: None,
+            poll_ns: None,
+        },
+        EventKind::WaitSignal {
+            name: 0,
+            deadline: None,
+        },
+        EventKind::WaitSync {
+            site: 0,
+            deadline: None,
+        },
+        EventKind::WaitEnd { timed_out: false },
+        EventKind::Signal { site: 0 },
+        EventKind::Grip { site: 0 },
+        EventKind::Release { site: 0 },
+        EventKind::Log {
+            text: String::new(),
+        },
+        EventKind::Error {
+            message: String::new(),
+        },
+        EventKind::EnableWhen { handler: 0 },
+        EventKind::DisableWhen { proc: 0 },
+        EventKind::WhenFire { handler: 0 },
+        EventKind::WhenEnd { handler: 0 },
+        EventKind::RemoteCall {
+            site: 0,
+            req: 0,
+            args: Vec::new(),
+        },
+        EventKind::Join,
+        EventKind::RemoteStart { proc: 0 },
+        EventKind::RemoteEnd { proc: 0 },
+        EventKind::End,
+    ];
+    let mut named: Vec<&str> = Vec::new();
+    for e in &events {
+        let kind = Kind::of(e);
+        assert_eq!(kind.name(), e.name());
+        assert_eq!(Kind::from_name(e.name()), Some(kind));
+        named.push(e.name());
+    }
+    named.dedup();
+    assert_eq!(
+        named, EVENT_NAMES,
+        "every name of the VM's table, in its order"
+    );
 }
 
 #[test]
@@ -118,7 +203,7 @@ fn data_round_trips_through_json() {
         (
             Kind::Warning,
             Data::Issue {
-                kind: "near_miss".into(),
+                kind: IssueKind::NearMiss,
                 message: "near miss".into(),
                 distance_m: Some(0.00245),
                 motions: vec![RobotMotion {
@@ -201,4 +286,20 @@ fn unknown_kinds_and_misfitting_data_are_errors() {
     assert!(Event::from_json(&e).is_err());
     let e = json!({"time_ns": 0, "kind": "end", "details": ""});
     assert_eq!(Event::from_json(&e).map(|e| e.data), Ok(Data::None));
+}
+
+#[test]
+fn docs_log_md_lists_every_kind_in_table_order() {
+    let doc = include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/log.md"));
+    let row = doc
+        .lines()
+        .find(|l| l.starts_with("| `kind` | string | one of "))
+        .expect("docs/log.md has the `kind` row of `/events`");
+    let listed: Vec<&str> = row
+        .trim_start_matches("| `kind` | string | one of ")
+        .split(", ")
+        .map(|k| k.split('`').nth(1).unwrap_or(""))
+        .collect();
+    let names: Vec<&str> = Kind::ALL.iter().map(|k| k.name()).collect();
+    assert_eq!(listed, names);
 }

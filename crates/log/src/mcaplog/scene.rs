@@ -8,7 +8,7 @@ use vworks_model::math::Iso;
 use vworks_model::model::Geometry;
 
 use super::proto;
-use vworks_cell::Cell;
+use crate::cell::CellInfo;
 
 /// A body of the scene: its frame and primitives.
 pub(crate) struct SceneBody {
@@ -37,27 +37,12 @@ pub(crate) struct Scene {
     red: Vec<bool>,
 }
 
-/// The convex hull of `points` as a triangle list (three corners per triangle).
+/// A mesh body's convex hull as a triangle list (empty for other shapes).
 fn hull_triangles(geometry: &Geometry) -> Vec<[f64; 3]> {
-    let Geometry::Hull { points, .. } = geometry else {
-        return Vec::new();
-    };
-    let pts: Vec<parry3d::math::Vector3> = points
-        .iter()
-        .map(|p| parry3d::math::Vector3::new(p[0], p[1], p[2]))
-        .collect();
-    let Ok((vertices, faces)) = parry3d::transformation::try_convex_hull(&pts) else {
-        return Vec::new();
-    };
-    let mut out = Vec::with_capacity(faces.len() * 3);
-    for face in faces {
-        for k in face {
-            if let Some(v) = vertices.get(k as usize) {
-                out.push([v.x, v.y, v.z]);
-            }
-        }
+    match geometry {
+        Geometry::Hull { points, .. } => vworks_model::mesh::hull_triangles(points),
+        _ => Vec::new(),
     }
-    out
 }
 
 /// A Foxglove time of `t` nanoseconds (negative: 0), as JSON.
@@ -72,7 +57,7 @@ fn pose_json(p: &Iso) -> serde_json::Value {
 
 impl Scene {
     /// Every body of `cell`: robots' link shapes, devices, parts.
-    pub(crate) fn new(cell: &Cell) -> Scene {
+    pub(crate) fn new(cell: &CellInfo) -> Scene {
         let mut bodies = Vec::new();
         for r in &cell.robots {
             for l in &r.model.links {

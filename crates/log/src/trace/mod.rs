@@ -5,27 +5,27 @@
 //! - [`TraceEvent`]: an event as the engine records it — indices into the cell and the
 //!   robot's module, nothing formatted, so that recording a VM event allocates nothing.
 //! - [`Event`]: the same event resolved with the cell's names ([`TraceEvent::resolve`]), or
-//!   read back from a log (`mcaplog::read_log`): names instead of indices, the typed
+//!   read back from a log ([`crate::mcaplog::read_log`]): names instead of indices, the typed
 //!   [`Data`] and the details text of a trace line. This is what leaves the engine.
 //!
 //! The trace line `time_ns robot kind details file:line:col` (the golden files, `vworks
 //! log events`) is rendered from these types ([`TraceEvent::line`], [`Event::line`]); no
 //! consumer parses it back.
 
+use serde::{Deserialize, Serialize};
 use serde_json::{Value as Json, json};
-use vworks_cell::Cell;
 /// Names from a workcell or a log as a terminal may print them (control characters
 /// escaped as in log texts' `{:?}`): the CLI's summary and `log info` use it too.
 pub use vworks_model::text::escape_controls;
 use vworks_model::text::escape_controls_owned;
 use vworks_vm::bytecode::{Module, SrcPos};
-use vworks_vm::machine::EventKind;
+use vworks_vm::machine::{EVENT_NAMES, EventKind};
 use vworks_vm::types::fmt_quantity;
 use vworks_vm::{Dim, Type};
 
-use crate::collide::Contact;
-use crate::place::file_name;
-pub use crate::place::{LogLine, RobotMotion, statement_at};
+use crate::cell::Names;
+use crate::issue::{Issue, IssueKind};
+use crate::place::{Contact, LogLine, RobotMotion, file_name};
 
 /// How a trace line writes times: integer nanoseconds (the contract's format: golden files,
 /// `vworks log events`, `run --trace-ns`) or seconds for people (`run --trace`).
@@ -162,35 +162,23 @@ impl Kind {
         Kind::Warning,
     ];
 
-    /// The kind's name in trace lines and logs.
+    /// The names of the kinds the engine adds to the VM's (`check_wait` … `warning`), in
+    /// declaration order after the VM's.
+    const ENGINE_NAMES: [&'static str; 5] = [
+        "check_wait",
+        "check_when",
+        "collision_start",
+        "collision_end",
+        "warning",
+    ];
+
+    /// The kind's name in trace lines and logs: the VM's kinds are named by the VM's table
+    /// ([`EVENT_NAMES`], in the same order), the engine's own after them.
     pub fn name(self) -> &'static str {
-        match self {
-            Kind::MotionStart => "motion_start",
-            Kind::MotionEnd => "motion_end",
-            Kind::Delay => "delay",
-            Kind::DelayEnd => "delay_end",
-            Kind::Set => "set",
-            Kind::WaitUntil => "wait_until",
-            Kind::WaitEnd => "wait_end",
-            Kind::Signal => "signal",
-            Kind::Grip => "grip",
-            Kind::Release => "release",
-            Kind::Log => "log",
-            Kind::Error => "error",
-            Kind::EnableWhen => "enable_when",
-            Kind::DisableWhen => "disable_when",
-            Kind::WhenFire => "when_fire",
-            Kind::WhenEnd => "when_end",
-            Kind::RemoteCall => "remote_call",
-            Kind::Join => "join",
-            Kind::RemoteStart => "remote_start",
-            Kind::RemoteEnd => "remote_end",
-            Kind::End => "end",
-            Kind::CheckWait => "check_wait",
-            Kind::CheckWhen => "check_when",
-            Kind::CollisionStart => "collision_start",
-            Kind::CollisionEnd => "collision_end",
-            Kind::Warning => "warning",
+        let i = self as usize;
+        match EVENT_NAMES.get(i) {
+            Some(name) => name,
+            None => Self::ENGINE_NAMES[i - EVENT_NAMES.len()],
         }
     }
 
@@ -199,33 +187,9 @@ impl Kind {
         Kind::ALL.into_iter().find(|k| k.name() == name)
     }
 
-    /// The kind of a VM event.
+    /// The kind of a VM event (the VM's kinds come first, in the order of its table).
     pub fn of(kind: &EventKind) -> Kind {
-        match kind {
-            EventKind::MotionStart { .. } => Kind::MotionStart,
-            EventKind::MotionEnd { .. } => Kind::MotionEnd,
-            EventKind::Delay { .. } => Kind::Delay,
-            EventKind::DelayEnd => Kind::DelayEnd,
-            EventKind::Set { .. } => Kind::Set,
-            EventKind::WaitUntil { .. }
-            | EventKind::WaitSignal { .. }
-            | EventKind::WaitSync { .. } => Kind::WaitUntil,
-            EventKind::WaitEnd { .. } => Kind::WaitEnd,
-            EventKind::Signal { .. } => Kind::Signal,
-            EventKind::Grip { .. } => Kind::Grip,
-            EventKind::Release { .. } => Kind::Release,
-            EventKind::Log { .. } => Kind::Log,
-            EventKind::Error { .. } => Kind::Error,
-            EventKind::EnableWhen { .. } => Kind::EnableWhen,
-            EventKind::DisableWhen { .. } => Kind::DisableWhen,
-            EventKind::WhenFire { .. } => Kind::WhenFire,
-            EventKind::WhenEnd { .. } => Kind::WhenEnd,
-            EventKind::RemoteCall { .. } => Kind::RemoteCall,
-            EventKind::Join => Kind::Join,
-            EventKind::RemoteStart { .. } => Kind::RemoteStart,
-            EventKind::RemoteEnd { .. } => Kind::RemoteEnd,
-            EventKind::End => Kind::End,
-        }
+        Kind::ALL[kind.index()]
     }
 }
 
@@ -235,8 +199,10 @@ impl std::fmt::Display for Kind {
     }
 }
 
-/// The value of a global.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// The value of a global. Its JSON (derived) is the bare value: `true`, `3`, `0.25`
+/// (`null` if not finite, which a global never is).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
 #[non_exhaustive]
 pub enum Value {
     /// A `bool` global.
@@ -260,21 +226,13 @@ impl Value {
     /// As JSON: `true`/`false`, an integer, or a number in SI units (`null` if not finite,
     /// which a global never is).
     pub fn to_json(self) -> Json {
-        match self {
-            Value::Bool(b) => Json::Bool(b),
-            Value::Int(i) => Json::from(i),
-            Value::Num(x) => serde_json::Number::from_f64(x).map_or(Json::Null, Json::Number),
-        }
+        serde_json::to_value(self).unwrap_or(Json::Null)
     }
 
-    /// From JSON as [`Value::to_json`] writes it.
+    /// From JSON as [`Value::to_json`] writes it (an integer is an `Int`, any other
+    /// number a `Num`).
     pub fn from_json(v: &Json) -> Option<Value> {
-        match v {
-            Json::Bool(b) => Some(Value::Bool(*b)),
-            Json::Number(n) if n.is_i64() => n.as_i64().map(Value::Int),
-            Json::Number(n) => n.as_f64().map(Value::Num),
-            _ => None,
-        }
+        Value::deserialize(v).ok()
     }
 }
 
@@ -287,30 +245,6 @@ pub fn format_value(bits: u64, ty: Type) -> String {
         Type::Num(d) => fmt_quantity(f64::from_bits(bits), d),
         _ => format!("{bits:#x}"),
     }
-}
-
-/// A warning or error of the run.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Issue {
-    /// `race`, `near_miss`, `slowdown`, `runtime`, `deadlock`, or a compiler warning's
-    /// code (`W0001`).
-    pub kind: String,
-    /// The message.
-    pub message: String,
-    /// The robot, if one.
-    pub robot: Option<String>,
-    /// Source position, if known.
-    pub file: Option<String>,
-    /// Line (0 if unknown).
-    pub line: u32,
-    /// Column (0 if unknown).
-    pub col: u32,
-    /// For a near miss, how close the bodies came (m), exactly; the message rounds it.
-    pub distance_m: Option<f64>,
-    /// For a near miss, each robot whose body is in the pair and the motion it was
-    /// making (the first moving one's, else the first one's, is also `robot`, `file`,
-    /// `line`, `col`).
-    pub motions: Vec<RobotMotion>,
 }
 
 /// One event as the engine records it. Recording one allocates nothing for a VM event:
@@ -481,8 +415,8 @@ pub enum Data {
     /// `warning` / `error`: its kind (`race`, `near_miss`, `runtime`, `deadlock`, a
     /// compiler code), message, and for a near miss the distance (m).
     Issue {
-        /// `race`, `near_miss`, `slowdown`, `runtime`, `deadlock`, …
-        kind: String,
+        /// What kind of warning or error.
+        kind: IssueKind,
         /// The message.
         message: String,
         /// For a near miss, how close the bodies came (m).
@@ -557,7 +491,8 @@ impl Event {
     }
 
     /// The event as the JSON object of the log's `/events` topic (schema in
-    /// `docs/log.md`).
+    /// `docs/log.md`). By hand, as [`Event::from_json`] is: `data` is [`Data::to_json`],
+    /// whose form the kind decides.
     pub fn to_json(&self) -> Json {
         json!({
             "time_ns": self.time_ns,
@@ -572,7 +507,9 @@ impl Event {
     }
 
     /// An event from the JSON object [`Event::to_json`] writes. An object without
-    /// `data` (a log of vworks before log version 2) gives [`Data::None`].
+    /// `data` (a log of vworks before log version 2) gives [`Data::None`]. By hand: a
+    /// derived reader would refuse what this one reads leniently (absent fields of old
+    /// logs as defaults, a line past `u32` as `u32::MAX`).
     pub fn from_json(v: &Json) -> Result<Event, String> {
         let text = |k: &str| v[k].as_str().map(str::to_string);
         let int = |k: &str| u32::try_from(v[k].as_u64().unwrap_or(0)).unwrap_or(u32::MAX);
@@ -685,6 +622,12 @@ impl Data {
     }
 
     /// The `data` object of a `/events` message (`null` for [`Data::None`]).
+    ///
+    /// Written by hand, not derived: the object carries no tag (the event's `kind`, outside
+    /// it, says which variant it is, and a `wait_until`'s fields say which wait), a
+    /// collision's contact is two fields (`depth_m`, `point_m`) only for a start, and the
+    /// motions are left out when there are none. Serde's enum representations give other
+    /// bytes.
     pub fn to_json(&self) -> Json {
         match self {
             Data::None => Json::Null,
@@ -752,7 +695,8 @@ impl Data {
                 distance_m,
                 motions,
             } => {
-                let mut o = json!({"kind": kind, "message": message, "distance_m": distance_m});
+                let mut o =
+                    json!({"kind": kind.name(), "message": message, "distance_m": distance_m});
                 RobotMotion::put_list(&mut o, motions);
                 o
             }
@@ -760,6 +704,7 @@ impl Data {
     }
 
     /// The data of a `kind` event from its `data` object; `None` if it does not fit.
+    /// By hand for the reasons of [`Data::to_json`]: the variant comes from `kind`.
     pub fn from_json(kind: Kind, d: &Json) -> Option<Data> {
         let s = |k: &str| d.get(k)?.as_str().map(str::to_string);
         let i = |k: &str| d.get(k)?.as_i64();
@@ -848,7 +793,7 @@ impl Data {
                 motions: RobotMotion::list_from_json(d.get("motions"))?,
             },
             Kind::Warning | Kind::Error => Data::Issue {
-                kind: s("kind")?,
+                kind: IssueKind::from_name(d.get("kind")?.as_str()?)?,
                 message: s("message")?,
                 distance_m: f("distance_m"),
                 motions: RobotMotion::list_from_json(d.get("motions"))?,
@@ -861,73 +806,69 @@ impl Data {
 impl TraceEvent {
     /// The program file the source position refers to (the robot's program file that
     /// holds it).
-    pub fn file<'c>(&self, cell: &'c Cell) -> Option<&'c str> {
+    pub fn file<'c>(&self, names: &'c dyn Names) -> Option<&'c str> {
         let pos = self.pos?;
         self.robot
-            .and_then(|r| cell.robots.get(r))
-            .map(|r| r.module.file_of(pos))
+            .and_then(|r| names.module(r))
+            .map(|m| m.file_of(pos))
     }
 
     /// The line logged, if this is a `log` event of a robot's program.
-    pub fn log_line(&self, cell: &Cell) -> Option<LogLine> {
+    pub fn log_line(&self, names: &dyn Names) -> Option<LogLine> {
         let Detail::Vm(EventKind::Log { text }) = &self.detail else {
             return None;
         };
-        let robot = cell.robots.get(self.robot?)?;
+        let robot = names.robot_name(self.robot?)?;
         Some(LogLine {
             time_ns: self.time,
-            robot: robot.name.clone(),
+            robot: robot.to_string(),
             text: text.clone(),
-            file: self.file(cell).map(str::to_string),
+            file: self.file(names).map(str::to_string),
             line: self.pos.map_or(0, |p| p.line),
             col: self.pos.map_or(0, |p| p.col),
         })
     }
 
     /// The details as trace lines show them (empty when there are none).
-    pub fn details(&self, cell: &Cell) -> String {
-        self.details_of(cell, &self.data(cell), Times::Nanoseconds)
+    pub fn details(&self, names: &dyn Names) -> String {
+        self.details_of(names, &self.data(names), Times::Nanoseconds)
     }
 
     /// The details text from the event's typed `data`: the text of [`Data`] with times as
     /// `times` says, except that a set's value is shown in display units (`250mm`), which
     /// needs the global's type.
-    fn details_of(&self, cell: &Cell, data: &Data, times: Times) -> String {
+    fn details_of(&self, names: &dyn Names, data: &Data, times: Times) -> String {
         match (&self.detail, data) {
             (Detail::Set { global, new, .. }, Data::Set { global: name, .. }) => {
-                let ty = cell.linked.globals[*global as usize].ty;
-                format!("{name}={}", format_value(*new, ty))
+                match names.global(*global as usize) {
+                    Some((_, ty)) => format!("{name}={}", format_value(*new, ty)),
+                    None => data.text_as(times),
+                }
             }
             _ => data.text_as(times),
         }
     }
 
     /// The typed details with the cell's names.
-    pub fn data(&self, cell: &Cell) -> Data {
-        let module = self
-            .robot
-            .and_then(|r| cell.robots.get(r))
-            .map(|r| &*r.module);
+    pub fn data(&self, names: &dyn Names) -> Data {
+        let module = self.robot.and_then(|r| names.module(r));
         match (&self.detail, module) {
             (Detail::None, _) => Data::None,
             (Detail::Vm(kind), Some(m)) => vm_data(kind, m),
             (Detail::Vm(_), None) => Data::None,
-            (Detail::Set { global, old, new }, _) => {
-                match cell.linked.globals.get(*global as usize) {
-                    Some(g) => Data::Set {
-                        global: g.name.clone(),
-                        old: Value::of(*old, g.ty),
-                        new: Value::of(*new, g.ty),
-                    },
-                    None => Data::None,
-                }
-            }
+            (Detail::Set { global, old, new }, _) => match names.global(*global as usize) {
+                Some((name, ty)) => Data::Set {
+                    global: name.to_string(),
+                    old: Value::of(*old, ty),
+                    new: Value::of(*new, ty),
+                },
+                None => Data::None,
+            },
             (Detail::Global(g), _) => {
-                cell.linked
-                    .globals
-                    .get(*g as usize)
-                    .map_or(Data::None, |g| Data::Global {
-                        global: g.name.clone(),
+                names
+                    .global(*g as usize)
+                    .map_or(Data::None, |(name, _)| Data::Global {
+                        global: name.to_string(),
                     })
             }
             (Detail::Collision(c), _) => Data::Collision {
@@ -952,19 +893,19 @@ impl TraceEvent {
     }
 
     /// The event with the cell's names.
-    pub fn resolve(&self, cell: &Cell) -> Event {
+    pub fn resolve(&self, names: &dyn Names) -> Event {
         let (line, col) = self.pos.map_or((0, 0), |p| (p.line, p.col));
-        let data = self.data(cell);
+        let data = self.data(names);
         Event {
             time_ns: self.time,
             robot: self
                 .robot
-                .and_then(|r| cell.robots.get(r))
-                .map(|r| r.name.clone()),
+                .and_then(|r| names.robot_name(r))
+                .map(str::to_string),
             kind: self.kind,
-            details: self.details_of(cell, &data, Times::Nanoseconds),
+            details: self.details_of(names, &data, Times::Nanoseconds),
             data,
-            file: self.file(cell).map(str::to_string),
+            file: self.file(names).map(str::to_string),
             line,
             col,
         }
@@ -972,21 +913,18 @@ impl TraceEvent {
 
     /// The trace line: `time_ns robot kind details file:line:col`, `-` for empty fields;
     /// control characters (in the workcell's names) escaped as in log texts.
-    pub fn line(&self, cell: &Cell) -> String {
-        self.line_as(cell, Times::Nanoseconds)
+    pub fn line(&self, names: &dyn Names) -> String {
+        self.line_as(names, Times::Nanoseconds)
     }
 
     /// The trace line with times written as `times` says (`run --trace` shows seconds).
-    pub fn line_as(&self, cell: &Cell, times: Times) -> String {
-        let robot = self
-            .robot
-            .and_then(|r| cell.robots.get(r))
-            .map_or("-", |r| r.name.as_str());
-        let mut details = self.details_of(cell, &self.data(cell), times);
+    pub fn line_as(&self, names: &dyn Names, times: Times) -> String {
+        let robot = self.robot.and_then(|r| names.robot_name(r)).unwrap_or("-");
+        let mut details = self.details_of(names, &self.data(names), times);
         if details.is_empty() {
             details.push('-');
         }
-        let pos = match (self.file(cell), self.pos) {
+        let pos = match (self.file(names), self.pos) {
             (Some(f), Some(p)) => format!("{}:{}:{}", file_name(f), p.line, p.col),
             _ => "-".to_string(),
         };
@@ -1069,7 +1007,7 @@ fn vm_data(kind: &EventKind, m: &Module) -> Data {
         },
         EventKind::Log { text } => Data::Text { text: text.clone() },
         EventKind::Error { message } => Data::Issue {
-            kind: "runtime".into(),
+            kind: IssueKind::Runtime,
             message: message.clone(),
             distance_m: None,
             motions: Vec::new(),
