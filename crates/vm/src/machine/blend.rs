@@ -12,9 +12,16 @@
 //!   zoned point a stop point: its event waits until the robot is there (`stop_point`).
 //!
 //! Everything that samples the robot (`joints_at`, `tcp_at`, `axis_rate_bounds`,
-//! `moving_at`) sees the blended path.
+//! `moving_at`, in `arm`) sees the blended path. The functions here are pure: the robot
+//! model, the motions and the times in, a time or a radius out.
 
-use super::*;
+use vworks_model::RobotModel;
+use vworks_model::math::Iso;
+
+use super::plan::{JOINT_SPEED_TOLERANCE, Trajectory};
+use crate::MAX_AXES;
+use crate::bytecode::{Instr, SrcPos};
+use crate::motion::{NS, Path, Profile};
 
 /// The rest of a zoned motion after its `motion_end`: the robot goes on along it until
 /// it reaches its point ([`Fading::end`]), and the next motion is superposed on it.
@@ -36,7 +43,7 @@ impl Fading {
     }
 
     /// Seconds from the motion's start to `t` (ns).
-    fn dt(&self, t: i64) -> f64 {
+    pub(super) fn dt(&self, t: i64) -> f64 {
         (t - self.motion.start) as f64 / NS
     }
 }
@@ -63,476 +70,316 @@ pub(super) struct Planned {
 /// the zone.
 const CORNER_SAMPLES: usize = 32;
 
-impl Vm {
-    /// The previous motion's rest, while it goes on at `t`.
-    fn fading_at(&self, t: i64) -> Option<&Fading> {
-        self.fading.as_ref().filter(|f| t < f.end())
+/// The joints at `t` of motion `next` starting at `ts` superposed on the rest of `f`
+/// (in Cartesian space when both are Cartesian); `None` where IK fails.
+pub(super) fn blend_joints(
+    model: &RobotModel,
+    f: &Fading,
+    next: &Trajectory,
+    ts: i64,
+    t: i64,
+) -> Option<[f64; MAX_AXES]> {
+    let d1 = f.dt(t);
+    let d2 = (t - ts) as f64 / NS;
+    if f.motion.traj.is_cartesian() && next.is_cartesian() {
+        if t <= ts {
+            return f.motion.traj.joints_at(model, d1);
+        }
+        if t >= f.end() {
+            return next.joints_at(model, d2);
+        }
+        return next.ik_on(model, &blend_pose(model, f, next, ts, t));
     }
-
-    /// While the robot finishes a zoned motion after its `motion_end` (the next motion,
-    /// if any, superposed on it): the time it reaches that point and the point's TCP
-    /// position.
-    pub fn zoned_point(&self) -> Option<(i64, [f64; 3])> {
-        self.fading.as_ref().map(|f| (f.end(), f.corner_pose.t))
+    let q1 = f.motion.traj.joints_at(model, d1)?;
+    let mut q = next.joints_at(model, d2)?;
+    for ((qi, a), c) in q.iter_mut().zip(q1).zip(f.corner) {
+        *qi += a - c;
     }
+    Some(q)
+}
 
-    /// The joints at time `t` (inside or after the current motion, through a corner).
-    pub fn joints_at(&self, t: i64) -> [f64; MAX_AXES] {
-        let Some(f) = self.fading_at(t) else {
-            return match &self.motion {
-                Some(m) => self
-                    .eval_joints(&m.traj, (t - m.start) as f64 / NS)
-                    .unwrap_or(self.rest),
-                None => self.rest,
-            };
-        };
-        match &self.motion {
-            Some(m) => self
-                .blend_joints(f, &m.traj, m.start, t)
-                .unwrap_or(self.rest),
-            None => self
-                .eval_joints(&f.motion.traj, f.dt(t))
-                .unwrap_or(self.rest),
+/// The TCP of a Cartesian corner at `t`: `p₁ + p₂ − P`, orientation `R₂·R_Pᵀ·R₁`.
+pub(super) fn blend_pose(
+    model: &RobotModel,
+    f: &Fading,
+    next: &Trajectory,
+    ts: i64,
+    t: i64,
+) -> Iso {
+    use vworks_model::math::{mat_mul, transpose};
+    let a = f.motion.traj.pose_at(model, &Iso::IDENTITY, f.dt(t));
+    let b = next.pose_at(model, &Iso::IDENTITY, (t - ts) as f64 / NS);
+    let p = f.corner_pose;
+    Iso {
+        r: mat_mul(&mat_mul(&b.r, &transpose(&p.r)), &a.r),
+        t: [
+            a.t[0] + b.t[0] - p.t[0],
+            a.t[1] + b.t[1] - p.t[1],
+            a.t[2] + b.t[2] - p.t[2],
+        ],
+    }
+}
+
+/// Where a motion of `point_ns` enters the zone of radius `r` around its point: the
+/// time from its start, and the radius used. A Cartesian motion's zone is at most
+/// half its path (`s = 1 − r/L` along it); a joint motion's begins where the TCP comes
+/// within `r` of the point, and not before half its duration.
+pub(super) fn zone_entry(
+    model: &RobotModel,
+    tool: &Iso,
+    rest: &[f64; MAX_AXES],
+    traj: &Trajectory,
+    point_ns: i64,
+    r: f64,
+) -> (i64, f64) {
+    let total = point_ns as f64 / NS;
+    let to_ns = |t: f64| ((t * NS).ceil() as i64).clamp(0, point_ns);
+    if let Trajectory::Cartesian { path, profile, .. } = traj {
+        let len = path.length();
+        if len <= 1e-7 || profile.dist <= 0.0 {
+            return (point_ns, 0.0);
+        }
+        let r1 = r.min(0.5 * len);
+        let t = profile.time_at(profile.dist * (1.0 - r1 / len));
+        return (to_ns(t), r1);
+    }
+    let n = model.dof();
+    let point = model.tcp(&traj.end_joints()[..n], tool).t;
+    let dist = |t: f64| {
+        let q = traj.joints_at(model, t).unwrap_or(*rest);
+        vworks_model::math::norm(vworks_model::math::sub(model.tcp(&q[..n], tool).t, point))
+    };
+    const STEPS: usize = 32;
+    let at = |k: usize| 0.5 * total + 0.5 * total * k as f64 / STEPS as f64;
+    // The last sample still outside the zone, from the end back to the middle.
+    let Some(k) = (0..STEPS).rev().find(|&k| dist(at(k)) > r) else {
+        // The TCP is within `r` all through the second half, but its distance from
+        // the point need not fall all the way: the zone is the farthest it gets.
+        let farthest = (0..=STEPS).map(|k| dist(at(k))).fold(0.0, f64::max);
+        return (to_ns(0.5 * total), farthest);
+    };
+    let (mut lo, mut hi) = (at(k), at(k + 1));
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if dist(mid) > r {
+            lo = mid;
+        } else {
+            hi = mid;
         }
     }
+    (to_ns(hi), r)
+}
 
-    /// The joints at `t` of motion `next` starting at `ts` superposed on the rest of `f`
-    /// (in Cartesian space when both are Cartesian); `None` where IK fails.
-    fn blend_joints(
-        &self,
-        f: &Fading,
-        next: &Trajectory,
-        ts: i64,
-        t: i64,
-    ) -> Option<[f64; MAX_AXES]> {
-        let d1 = f.dt(t);
-        let d2 = (t - ts) as f64 / NS;
-        if f.motion.traj.is_cartesian() && next.is_cartesian() {
-            if t <= ts {
-                return self.eval_joints(&f.motion.traj, d1);
+/// The earliest start of `next` (lasting `next_ns`, planned from the corner) within
+/// the rest of `f` at which the corner is feasible, and the radius around the point
+/// the corner stays within. Feasibility only gets easier as the start moves later
+/// (less overlap), so a bisection over whole nanoseconds finds it; at `f.end()` there
+/// is no overlap (a stop point).
+pub(super) fn blend_start(
+    model: &RobotModel,
+    tool: &Iso,
+    time: i64,
+    f: &Fading,
+    next: &Trajectory,
+    next_ns: i64,
+) -> (i64, f64) {
+    let lo = time.max(f.motion.start);
+    let hi = f.end();
+    if lo >= hi {
+        return (hi, 0.0);
+    }
+    let search = |ok: &dyn Fn(i64) -> Option<f64>, mut lo: i64| -> (i64, f64) {
+        if let Some(r) = ok(lo) {
+            return (lo, r);
+        }
+        let mut hi = hi;
+        let mut best = 0.0;
+        while hi - lo > 1 {
+            let mid = lo + (hi - lo) / 2;
+            match ok(mid) {
+                Some(r) => {
+                    hi = mid;
+                    best = r;
+                }
+                None => lo = mid,
             }
-            if t >= f.end() {
-                return self.eval_joints(next, d2);
-            }
-            return self.ik_on(next, &self.blend_pose(f, next, ts, t));
         }
-        let q1 = self.eval_joints(&f.motion.traj, d1)?;
-        let mut q = self.eval_joints(next, d2)?;
-        for ((qi, a), c) in q.iter_mut().zip(q1).zip(f.corner) {
-            *qi += a - c;
-        }
-        Some(q)
+        (hi, if hi >= f.end() { 0.0 } else { best })
+    };
+    let (ts, radius) = search(&|ts| corner_bounds(model, f, next, next_ns, ts), lo);
+    if ts >= f.end() {
+        return (f.end(), 0.0);
     }
-
-    /// The TCP of a Cartesian corner at `t`: `p₁ + p₂ − P`, orientation `R₂·R_Pᵀ·R₁`.
-    fn blend_pose(&self, f: &Fading, next: &Trajectory, ts: i64, t: i64) -> Iso {
-        use vworks_model::math::{mat_mul, transpose};
-        let a = self.eval_pose(&f.motion.traj, f.dt(t));
-        let b = self.eval_pose(next, (t - ts) as f64 / NS);
-        let p = f.corner_pose;
-        Iso {
-            r: mat_mul(&mat_mul(&b.r, &transpose(&p.r)), &a.r),
-            t: [
-                a.t[0] + b.t[0] - p.t[0],
-                a.t[1] + b.t[1] - p.t[1],
-                a.t[2] + b.t[2] - p.t[2],
-            ],
-        }
+    // The sampled checks (inverse kinematics, axis speeds, the zone of a joint-space
+    // corner) cost more: at the start found, and only if they fail, searched again.
+    if let Some(r) = corner_samples(model, tool, f, next, ts) {
+        return (ts, radius.max(r));
     }
+    search(
+        &|t| {
+            let a = corner_bounds(model, f, next, next_ns, t)?;
+            Some(a.max(corner_samples(model, tool, f, next, t)?))
+        },
+        ts,
+    )
+}
 
-    /// The TCP pose at time `t`.
-    pub fn tcp_at(&self, t: i64) -> Iso {
-        match (self.fading_at(t), &self.motion) {
-            (None, Some(m)) if m.traj.is_cartesian() => {
-                self.eval_pose(&m.traj, (t - m.start) as f64 / NS)
-            }
-            (Some(f), Some(m))
-                if f.motion.traj.is_cartesian() && m.traj.is_cartesian() && t > m.start =>
-            {
-                self.blend_pose(f, &m.traj, m.start, t)
-            }
-            _ => {
-                let q = self.joints_at(t);
-                self.model.tcp(&q[..self.model.dof()], &self.tool_at(t))
-            }
-        }
+/// The exact conditions of a corner starting at `ts`; the radius it stays within (a
+/// bound) if they hold.
+///
+/// - Cartesian corners: the TCP is at most `A` from the point on the way in and `B`
+///   on the way out (`A` the path left of the first motion at `ts`, `B` the path the
+///   second has covered when the first ends); for two lines it stays within
+///   `max(A, B, |B·u₂ − A·u₁|)` (a norm is convex: its maximum over the box is at a
+///   corner), else within `A + B`. That must be at most the zone, itself at most half
+///   the second path. The path speed (the two speeds' sum bounds it) stays within the
+///   faster motion's cruise speed.
+/// - Joint-space corners: every axis's summed speed and acceleration within its limits
+///   (exact: checked at every phase boundary of both profiles and where the summed
+///   acceleration crosses zero), and at most half the second motion's time overlaps.
+fn corner_bounds(
+    model: &RobotModel,
+    f: &Fading,
+    next: &Trajectory,
+    next_ns: i64,
+    ts: i64,
+) -> Option<f64> {
+    let window = (f.end() - ts) as f64 / NS;
+    if window <= 0.0 {
+        return Some(0.0);
     }
-
-    /// The TCP in the tool link's frame at `t`: the tool of the motion the robot is in
-    /// (a tool change never blends: the next motion starts at the point), else the last
-    /// motion's (or the workcell's, before any).
-    pub fn tool_at(&self, t: i64) -> Iso {
-        match (self.fading_at(t), &self.motion) {
-            (Some(f), _) => f.motion.tool,
-            (None, Some(m)) if t >= m.start => m.tool,
-            (None, Some(m)) => self.fading.as_ref().map_or(m.tool, |f| f.motion.tool),
-            (None, None) => self.tool,
-        }
-    }
-
-    /// Per axis, a bound on its speed during the current motion (rad/s or m/s; 0 when
-    /// not moving): for a joint motion exact; for a Cartesian one the largest speed at the
-    /// samples its axis speeds were checked at (between samples it can be somewhat higher;
-    /// the collision sweep adds a margin). Through a corner, the two motions' bounds add.
-    pub fn axis_rate_bounds(&self) -> [f64; MAX_AXES] {
-        let mut out = match &self.motion {
-            Some(m) => m.traj.rates(),
-            None => [0.0; MAX_AXES],
-        };
-        if let Some(f) = &self.fading {
-            for (o, r) in out.iter_mut().zip(f.motion.traj.rates()) {
-                *o += r;
-            }
-        }
-        out
-    }
-
-    /// Plans motion `ins`: its path and profile, when it starts (at once, or later within
-    /// the corner of a zoned motion still finishing), and where its own zone begins.
-    pub(super) fn plan(&mut self, ins: Instr) -> Result<Planned, String> {
-        let operands = self.motion_operands(ins);
-        let programmed = match operands.zone.or(self.cfg.default_zone) {
-            Some(z) if z.is_nan() || z < 0.0 => {
-                return Err(format!(
-                    "the zone cannot be negative (got {}); write a radius such as `zone 10mm`, or `zone fine`",
-                    fmt_quantity(z, Dim::LENGTH)
-                ));
-            }
-            Some(z) if z > 0.0 => Some(z),
-            _ => None,
-        };
-        if let Some(tool) = operands.tool {
-            self.tool = tool;
-        }
-        let (traj, point_ns) = self.plan_path(ins)?;
-        // Inside a zoned motion's corner: when this one can start, the radius it blends
-        // within, and when the robot would reach that corner's point. **Choice:** a motion
-        // with another tool than the zoned one does not blend: it starts at the point.
-        let tool_changed = self
-            .fading_at(self.time)
-            .is_some_and(|f| f.motion.tool != self.tool);
-        let corner = self.fading_at(self.time).map(|f| {
-            let (ts, radius) = if tool_changed {
-                (f.end(), 0.0)
-            } else {
-                self.blend_start(f, &traj, point_ns)
-            };
-            (ts, radius, f.end(), f.pos)
-        });
-        if let Some((ts, _, point, at)) = corner
-            && ts >= point
-            && !tool_changed
-        {
-            self.warn_once(
-                self.main.pc,
-                point,
-                WarningKind::Corner,
-                format!(
-                    "this motion cannot start inside the zone of the motion at line {} of {} within the zone and the axes' limits: the robot stops at that point first (a corner path failure); a larger zone, a lower speed or a jerk limit can let it fly by",
-                    at.line,
-                    self.m.file_name_of(at)
-                ),
-            );
-        }
-        let (start, blend) = match corner {
-            Some((ts, _, _, _)) if tool_changed => (ts, None),
-            Some((ts, r, ..)) => (ts, Some(r)),
-            None => (self.time, None),
-        };
-        let (mut end_ns, zone) = match programmed {
-            // A TCP that does not move (a turntable's, on its axis) enters no zone.
-            Some(r) => match self.zone_entry(&traj, point_ns, r) {
-                (_, z) if z <= 1e-9 => (point_ns, 0.0),
-                entry => entry,
+    let off1 = (ts - f.motion.start) as f64 / NS;
+    match (&f.motion.traj, next) {
+        (
+            Trajectory::Cartesian {
+                path: p1,
+                profile: s1,
+                ..
             },
-            None => (point_ns, 0.0),
-        };
-        // The next corner begins after this one has ended.
-        if let Some((_, _, point, _)) = corner {
-            end_ns = end_ns.max((point - start).min(point_ns));
-        }
-        Ok(Planned {
-            traj,
-            start,
-            end_ns,
-            point_ns,
-            zone: if end_ns < point_ns { zone } else { 0.0 },
-            programmed,
-            blend,
-            tool: self.tool,
-        })
-    }
-
-    /// A warning about the statement at `pc`, at `time`, once per statement (a loop
-    /// repeats it every round).
-    fn warn_once(&mut self, pc: u32, time: i64, kind: WarningKind, message: String) {
-        if self.zone_warned.contains(&pc) {
-            return;
-        }
-        self.zone_warned.push(pc);
-        self.warnings.push(Warning {
-            time,
-            pos: self.m.pos_of(pc),
-            kind,
-            message,
-        });
-    }
-
-    /// Where a motion of `point_ns` enters the zone of radius `r` around its point: the
-    /// time from its start, and the radius used. A Cartesian motion's zone is at most
-    /// half its path (`s = 1 − r/L` along it); a joint motion's begins where the TCP comes
-    /// within `r` of the point, and not before half its duration.
-    fn zone_entry(&self, traj: &Trajectory, point_ns: i64, r: f64) -> (i64, f64) {
-        let total = point_ns as f64 / NS;
-        let to_ns = |t: f64| ((t * NS).ceil() as i64).clamp(0, point_ns);
-        if let Trajectory::Cartesian { path, profile, .. } = traj {
-            let len = path.length();
-            if len <= 1e-7 || profile.dist <= 0.0 {
-                return (point_ns, 0.0);
-            }
-            let r1 = r.min(0.5 * len);
-            let t = profile.time_at(profile.dist * (1.0 - r1 / len));
-            return (to_ns(t), r1);
-        }
-        let n = self.model.dof();
-        let point = self.model.tcp(&traj.end_joints()[..n], &self.tool).t;
-        let dist = |t: f64| {
-            let q = self.eval_joints(traj, t).unwrap_or(self.rest);
-            vworks_model::math::norm(vworks_model::math::sub(
-                self.model.tcp(&q[..n], &self.tool).t,
-                point,
-            ))
-        };
-        const STEPS: usize = 32;
-        let at = |k: usize| 0.5 * total + 0.5 * total * k as f64 / STEPS as f64;
-        // The last sample still outside the zone, from the end back to the middle.
-        let Some(k) = (0..STEPS).rev().find(|&k| dist(at(k)) > r) else {
-            // The TCP is within `r` all through the second half, but its distance from
-            // the point need not fall all the way: the zone is the farthest it gets.
-            let farthest = (0..=STEPS).map(|k| dist(at(k))).fold(0.0, f64::max);
-            return (to_ns(0.5 * total), farthest);
-        };
-        let (mut lo, mut hi) = (at(k), at(k + 1));
-        for _ in 0..60 {
-            let mid = 0.5 * (lo + hi);
-            if dist(mid) > r {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        (to_ns(hi), r)
-    }
-
-    /// The earliest start of `next` (lasting `next_ns`, planned from the corner) within
-    /// the rest of `f` at which the corner is feasible, and the radius around the point
-    /// the corner stays within. Feasibility only gets easier as the start moves later
-    /// (less overlap), so a bisection over whole nanoseconds finds it; at `f.end()` there
-    /// is no overlap (a stop point).
-    fn blend_start(&self, f: &Fading, next: &Trajectory, next_ns: i64) -> (i64, f64) {
-        let lo = self.time.max(f.motion.start);
-        let hi = f.end();
-        if lo >= hi {
-            return (hi, 0.0);
-        }
-        let search = |ok: &dyn Fn(i64) -> Option<f64>, mut lo: i64| -> (i64, f64) {
-            if let Some(r) = ok(lo) {
-                return (lo, r);
-            }
-            let mut hi = hi;
-            let mut best = 0.0;
-            while hi - lo > 1 {
-                let mid = lo + (hi - lo) / 2;
-                match ok(mid) {
-                    Some(r) => {
-                        hi = mid;
-                        best = r;
-                    }
-                    None => lo = mid,
-                }
-            }
-            (hi, if hi >= f.end() { 0.0 } else { best })
-        };
-        let (ts, radius) = search(&|ts| self.corner_bounds(f, next, next_ns, ts), lo);
-        if ts >= f.end() {
-            return (f.end(), 0.0);
-        }
-        // The sampled checks (inverse kinematics, axis speeds, the zone of a joint-space
-        // corner) cost more: at the start found, and only if they fail, searched again.
-        if let Some(r) = self.corner_samples(f, next, ts) {
-            return (ts, radius.max(r));
-        }
-        search(
-            &|t| {
-                let a = self.corner_bounds(f, next, next_ns, t)?;
-                Some(a.max(self.corner_samples(f, next, t)?))
+            Trajectory::Cartesian {
+                path: p2,
+                profile: s2,
+                ..
             },
-            ts,
-        )
-    }
-
-    /// The exact conditions of a corner starting at `ts`; the radius it stays within (a
-    /// bound) if they hold.
-    ///
-    /// - Cartesian corners: the TCP is at most `A` from the point on the way in and `B`
-    ///   on the way out (`A` the path left of the first motion at `ts`, `B` the path the
-    ///   second has covered when the first ends); for two lines it stays within
-    ///   `max(A, B, |B·u₂ − A·u₁|)` (a norm is convex: its maximum over the box is at a
-    ///   corner), else within `A + B`. That must be at most the zone, itself at most half
-    ///   the second path. The path speed (the two speeds' sum bounds it) stays within the
-    ///   faster motion's cruise speed.
-    /// - Joint-space corners: every axis's summed speed and acceleration within its limits
-    ///   (exact: checked at every phase boundary of both profiles and where the summed
-    ///   acceleration crosses zero), and at most half the second motion's time overlaps.
-    fn corner_bounds(&self, f: &Fading, next: &Trajectory, next_ns: i64, ts: i64) -> Option<f64> {
-        let window = (f.end() - ts) as f64 / NS;
-        if window <= 0.0 {
-            return Some(0.0);
-        }
-        let off1 = (ts - f.motion.start) as f64 / NS;
-        match (&f.motion.traj, next) {
-            (
-                Trajectory::Cartesian {
-                    path: p1,
-                    profile: s1,
-                    ..
-                },
-                Trajectory::Cartesian {
-                    path: p2,
-                    profile: s2,
-                    ..
-                },
-            ) => {
-                let (l1, l2) = (p1.length(), p2.length());
-                let frac = |p: &Profile, t: f64| {
-                    if p.dist > 0.0 { p.at(t) / p.dist } else { 1.0 }
-                };
-                let a = l1 * (1.0 - frac(s1, off1));
-                let b = l2 * frac(s2, window);
-                let radius = match (p1, p2) {
-                    (Path::Line { from, to }, Path::Line { to: to2, .. })
-                        if l1 > 0.0 && l2 > 0.0 =>
-                    {
-                        use vworks_model::math::{norm, sub};
-                        let u1 = sub(*to, *from);
-                        let u2 = sub(*to2, *to);
-                        let v = [
-                            b * u2[0] / l2 - a * u1[0] / l1,
-                            b * u2[1] / l2 - a * u1[1] / l1,
-                            b * u2[2] / l2 - a * u1[2] / l1,
-                        ];
-                        a.max(b).max(norm(v))
-                    }
-                    _ => a + b,
-                };
-                if radius > f.motion.zone.min(0.5 * l2) + 1e-12 {
-                    return None;
+        ) => {
+            let (l1, l2) = (p1.length(), p2.length());
+            let frac = |p: &Profile, t: f64| {
+                if p.dist > 0.0 { p.at(t) / p.dist } else { 1.0 }
+            };
+            let a = l1 * (1.0 - frac(s1, off1));
+            let b = l2 * frac(s2, window);
+            let radius = match (p1, p2) {
+                (Path::Line { from, to }, Path::Line { to: to2, .. }) if l1 > 0.0 && l2 > 0.0 => {
+                    use vworks_model::math::{norm, sub};
+                    let u1 = sub(*to, *from);
+                    let u2 = sub(*to2, *to);
+                    let v = [
+                        b * u2[0] / l2 - a * u1[0] / l1,
+                        b * u2[1] / l2 - a * u1[1] / l1,
+                        b * u2[2] / l2 - a * u1[2] / l1,
+                    ];
+                    a.max(b).max(norm(v))
                 }
-                let k1 = if s1.dist > 0.0 { l1 / s1.dist } else { 0.0 };
-                let k2 = if s2.dist > 0.0 { l2 / s2.dist } else { 0.0 };
-                let vmax = (k1 * s1.v).max(k2 * s2.v);
-                let (speed, _) = window_extremes(window, [(s1, off1, k1), (s2, 0.0, k2)]);
-                (speed <= vmax * (1.0 + 1e-9)).then_some(radius)
-            }
-            _ => {
-                if 2.0 * window > next_ns as f64 / NS {
-                    return None;
-                }
-                // Between two joint motions (a mixed corner is checked by samples).
-                for i in 0..self.model.dof() {
-                    let (Some((p1, k1)), Some((p2, k2))) =
-                        (f.motion.traj.axis_profile(i), next.axis_profile(i))
-                    else {
-                        break;
-                    };
-                    let j = self.model.axis(i);
-                    let (speed, acc) = window_extremes(window, [(p1, off1, k1), (p2, 0.0, k2)]);
-                    if speed > j.max_velocity * (1.0 + 1e-9) || acc > j.max_accel * (1.0 + 1e-9) {
-                        return None;
-                    }
-                }
-                Some(0.0)
-            }
-        }
-    }
-
-    /// The corner starting at `ts`, sampled: every pose reachable (Cartesian corners), no
-    /// axis faster than its limit between samples, and for joint-space corners every axis
-    /// within its range and the TCP within the zone. The largest distance from the point
-    /// seen, if all hold.
-    fn corner_samples(&self, f: &Fading, next: &Trajectory, ts: i64) -> Option<f64> {
-        let n = self.model.dof();
-        let span = f.end() - ts;
-        if span <= 0 {
-            return Some(0.0);
-        }
-        let joint_space = !(f.motion.traj.is_cartesian() && next.is_cartesian());
-        let mut prev = self.blend_joints(f, next, ts, ts)?;
-        let mut prev_t = ts;
-        let mut farthest = 0.0f64;
-        for k in 1..=CORNER_SAMPLES {
-            let t = ts + span * k as i64 / CORNER_SAMPLES as i64;
-            if t <= prev_t {
-                continue;
-            }
-            let q = self.blend_joints(f, next, ts, t)?;
-            if joint_space && !self.model.within_limits(&q[..n]) {
+                _ => a + b,
+            };
+            if radius > f.motion.zone.min(0.5 * l2) + 1e-12 {
                 return None;
             }
-            let dt = (t - prev_t) as f64 / NS;
-            for i in 0..n {
-                if (q[i] - prev[i]).abs() / dt > self.model.axis(i).max_velocity * (1.0 + 1e-6) {
-                    return None;
-                }
-            }
-            if joint_space {
-                let p = self.model.tcp(&q[..n], &self.tool).t;
-                let d = vworks_model::math::norm(vworks_model::math::sub(p, f.corner_pose.t));
-                if d > f.motion.zone {
-                    return None;
-                }
-                farthest = farthest.max(d);
-            }
-            prev = q;
-            prev_t = t;
+            let k1 = if s1.dist > 0.0 { l1 / s1.dist } else { 0.0 };
+            let k2 = if s2.dist > 0.0 { l2 / s2.dist } else { 0.0 };
+            let vmax = (k1 * s1.v).max(k2 * s2.v);
+            let (speed, _) = window_extremes(window, [(s1, off1, k1), (s2, 0.0, k2)]);
+            (speed <= vmax * (1.0 + 1e-9)).then_some(radius)
         }
-        Some(farthest)
+        _ => {
+            if 2.0 * window > next_ns as f64 / NS {
+                return None;
+            }
+            // Between two joint motions (a mixed corner is checked by samples).
+            for i in 0..model.dof() {
+                let (Some((p1, k1)), Some((p2, k2))) =
+                    (f.motion.traj.axis_profile(i), next.axis_profile(i))
+                else {
+                    break;
+                };
+                let j = model.axis(i);
+                let (speed, acc) = window_extremes(window, [(p1, off1, k1), (p2, 0.0, k2)]);
+                if speed > j.max_velocity * (1.0 + 1e-9) || acc > j.max_accel * (1.0 + 1e-9) {
+                    return None;
+                }
+            }
+            Some(0.0)
+        }
     }
+}
 
-    /// The time of the main program's event at instruction `ins` (`None`: the program's
-    /// end) reached at `t`: a statement that takes time without moving, grips or releases,
-    /// or ends the program makes a zoned point still ahead a stop point, so its event comes
-    /// when the robot is there — with a warning, once per statement.
-    pub(super) fn stop_point(&mut self, ins: Option<Instr>, pc: u32, t: i64) -> i64 {
-        let what = match ins {
-            None | Some(Instr::Stop) if self.serving.is_some() => "the end of the remote procedure",
-            None | Some(Instr::Stop) => "the end of the program",
-            Some(Instr::Delay) => "`delay`",
-            Some(Instr::WaitUntil(..) | Instr::WaitPoll(..)) => "`wait_until`",
-            Some(Instr::WaitSignal(..)) => "`wait_signal`",
-            Some(Instr::WaitSync(..)) => "`sync`",
-            Some(Instr::ParJoin) => "the end of a `parallel` block",
-            Some(Instr::Grip(_)) => "`grip`",
-            Some(Instr::Release(_)) => "`release`",
-            _ => return t,
-        };
-        let Some(f) = self.fading_at(t) else {
-            return t;
-        };
-        let (end, at) = (f.end(), f.pos);
-        // Warned at the stop point's time, where the trace shows the statement's event.
-        self.warn_once(
-            pc,
-            end,
-            WarningKind::StopPoint,
-            format!(
-                "{what} makes the zoned point of the motion at line {} of {} a stop point: the robot reaches it first; make that motion stop at its point to say so (`zone fine`; in RAPID, `fine`)",
-                    at.line,
-                    self.m.file_name_of(at)
-            ),
-        );
-        end
+/// The corner starting at `ts`, sampled: every pose reachable (Cartesian corners), no
+/// axis faster than its limit between samples, and for joint-space corners every axis
+/// within its range and the TCP within the zone. The largest distance from the point
+/// seen, if all hold.
+fn corner_samples(
+    model: &RobotModel,
+    tool: &Iso,
+    f: &Fading,
+    next: &Trajectory,
+    ts: i64,
+) -> Option<f64> {
+    let n = model.dof();
+    let span = f.end() - ts;
+    if span <= 0 {
+        return Some(0.0);
     }
+    let joint_space = !(f.motion.traj.is_cartesian() && next.is_cartesian());
+    let mut prev = blend_joints(model, f, next, ts, ts)?;
+    let mut prev_t = ts;
+    let mut farthest = 0.0f64;
+    for k in 1..=CORNER_SAMPLES {
+        let t = ts + span * k as i64 / CORNER_SAMPLES as i64;
+        if t <= prev_t {
+            continue;
+        }
+        let q = blend_joints(model, f, next, ts, t)?;
+        if joint_space && !model.within_limits(&q[..n]) {
+            return None;
+        }
+        let dt = (t - prev_t) as f64 / NS;
+        for i in 0..n {
+            if (q[i] - prev[i]).abs() / dt
+                > model.axis(i).max_velocity * (1.0 + JOINT_SPEED_TOLERANCE)
+            {
+                return None;
+            }
+        }
+        if joint_space {
+            let p = model.tcp(&q[..n], tool).t;
+            let d = vworks_model::math::norm(vworks_model::math::sub(p, f.corner_pose.t));
+            if d > f.motion.zone {
+                return None;
+            }
+            farthest = farthest.max(d);
+        }
+        prev = q;
+        prev_t = t;
+    }
+    Some(farthest)
+}
+
+/// What makes a zoned point still ahead a stop point, named for the warning: the main
+/// program's statement at instruction `ins` (`None`: its end; `remote`: the program is
+/// remote work), if it takes time without moving, grips or releases, or ends the program.
+pub(super) fn stop_point_reason(ins: Option<Instr>, remote: bool) -> Option<&'static str> {
+    Some(match ins {
+        None | Some(Instr::Stop) if remote => "the end of the remote procedure",
+        None | Some(Instr::Stop) => "the end of the program",
+        Some(Instr::Delay) => "`delay`",
+        Some(Instr::WaitUntil(..) | Instr::WaitPoll(..)) => "`wait_until`",
+        Some(Instr::WaitSignal(..)) => "`wait_signal`",
+        Some(Instr::WaitSync(..)) => "`sync`",
+        Some(Instr::ParJoin) => "the end of a `parallel` block",
+        Some(Instr::Grip(_)) => "`grip`",
+        Some(Instr::Release(_)) => "`release`",
+        _ => return None,
+    })
 }
 
 /// The largest |summed speed| and |summed acceleration| over `[0, window]` of motions

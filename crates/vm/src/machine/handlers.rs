@@ -1,26 +1,114 @@
-//! `when` handlers: enabling (with their triggers checked), firing by cycles, time or a
-//! condition's rising edge, running a handler's zero-time body, disabling, and ending them
-//! with the activation that enabled them.
+//! `when` handlers ([`Handlers`]): the enabled ones (with their triggers checked), their
+//! firings by cycles, time or a condition's rising edge, the one running (its thread and
+//! state), disabling, and ending them with the activation that enabled them.
 
-use super::*;
+use super::state::State;
+use super::{TIME_LIMIT_NS, span_ns};
+use crate::bytecode::{Capture, Module, Trigger};
+use crate::exec::Thread;
+use crate::motion::NS;
+use crate::types::{Dim, fmt_quantity};
 
-impl Vm {
+/// When an enabled handler fires.
+#[derive(Clone, Debug)]
+enum Firing {
+    /// At `next`, then every `period` if any.
+    Timer { next: i64, period: Option<i64> },
+    /// On each false→true edge of its condition; `last` is the value last seen.
+    Edge { last: bool },
+}
+
+/// An enabled `when` handler.
+#[derive(Clone, Debug)]
+struct Enabled {
+    handler: u32,
+    target: u32,
+    /// Captured slots for the action and for the condition.
+    args: Vec<u64>,
+    cond_args: Vec<u64>,
+    firing: Firing,
+}
+
+/// The robot's `when` handlers.
+#[derive(Debug)]
+pub(super) struct Handlers {
+    /// The thread of the handler now running.
+    pub(super) thread: Thread,
+    /// Its state.
+    pub(super) state: State,
+    /// The running handler: (enabled index, firing time).
+    running: Option<(usize, i64)>,
+    /// The module handler index of the running handler.
+    running_handler: u32,
+    /// Enabled handlers, in enabling order.
+    enabled: Vec<Enabled>,
+    /// Condition handlers whose edge was seen: (time, enabled index).
+    fires: Vec<(i64, usize)>,
+}
+
+impl Default for Handlers {
+    fn default() -> Handlers {
+        Handlers {
+            thread: Thread::default(),
+            state: State::Done,
+            running: None,
+            running_handler: 0,
+            enabled: Vec::new(),
+            fires: Vec::new(),
+        }
+    }
+}
+
+impl Handlers {
+    /// The firing time of the handler running, if one is.
+    pub(super) fn running_since(&self) -> Option<i64> {
+        self.running.map(|(_, t)| t)
+    }
+
+    /// The module handler index of the handler running (or that ran last).
+    pub(super) fn running_handler(&self) -> u32 {
+        self.running_handler
+    }
+
+    /// Whether the running handler must run code to find its next event.
+    pub(super) fn needs_run(&self) -> bool {
+        self.running.is_some() && self.state == State::Run
+    }
+
+    /// The module handler index of enabled handler `i`.
+    pub(super) fn handler_of(&self, i: usize) -> u32 {
+        self.enabled[i].handler
+    }
+
     /// The globals (module indices) the enabled condition handlers read.
-    pub fn when_globals(&self) -> impl Iterator<Item = u32> + '_ {
+    pub(super) fn when_globals<'a>(&'a self, m: &'a Module) -> impl Iterator<Item = u32> + 'a {
         self.enabled
             .iter()
-            .filter_map(|e| match self.m.handlers[e.handler as usize].trigger {
-                crate::bytecode::Trigger::Condition(c) => Some(&self.m.conds[c as usize].globals),
+            .filter_map(|e| match m.handlers[e.handler as usize].trigger {
+                Trigger::Condition(c) => Some(&m.conds[c as usize].globals),
                 _ => None,
             })
             .flatten()
             .copied()
     }
 
-    /// The period of handler `handler` (its index in the module's table) as it is enabled
-    /// now, if it fires by time or by cycles (ns; `None` for a condition handler, an
-    /// `after` handler, or one not enabled).
-    pub fn handler_period_ns(&self, handler: u32) -> Option<i64> {
+    /// The enabled condition handlers: (handler procedure, the module globals the
+    /// condition reads).
+    pub(super) fn condition_handlers<'a>(
+        &'a self,
+        m: &'a Module,
+    ) -> impl Iterator<Item = (u32, &'a [u32])> + 'a {
+        self.enabled
+            .iter()
+            .filter_map(|e| match m.handlers[e.handler as usize].trigger {
+                Trigger::Condition(c) => Some((e.target, m.conds[c as usize].globals.as_slice())),
+                _ => None,
+            })
+    }
+
+    /// The period of handler `handler` as it is enabled now, if it fires by time or by
+    /// cycles.
+    pub(super) fn period_ns(&self, handler: u32) -> Option<i64> {
         self.enabled
             .iter()
             .filter(|e| e.handler == handler)
@@ -28,19 +116,6 @@ impl Vm {
                 Firing::Timer { period, .. } => period,
                 Firing::Edge { .. } => None,
             })
-    }
-
-    pub(super) fn fire_event(&mut self, t: i64, i: usize) -> Next {
-        self.source = Source::Fire(i);
-        let h = &self.m.handlers[self.enabled[i].handler as usize];
-        Next::Event(Event {
-            robot: self.cfg.robot,
-            time: t,
-            kind: EventKind::WhenFire {
-                handler: self.enabled[i].handler,
-            },
-            pos: h.pos,
-        })
     }
 
     /// The earliest handler firing: (time, enabled index).
@@ -56,135 +131,73 @@ impl Vm {
         timers.chain(self.fires.iter().copied()).min()
     }
 
-    /// Checks the operand of a `when` trigger before the handler is enabled at `t`: a
-    /// period of at least 1 ns (`every T`), a count of at least 1 (`every N cycles`), a
-    /// delay that is not negative (`after T`), all ending within the time limit.
-    pub(super) fn check_trigger(&self, h: u32, operand: u64, t: i64) -> Result<(), String> {
-        use crate::bytecode::Trigger;
-        match self.m.handlers[h as usize].trigger {
-            Trigger::EveryCycles => {
-                let n = operand as i64;
-                if n < 1 {
-                    return Err(format!(
-                        "`every {n} cycles` needs a count of at least 1; a handler every 0 or fewer cycles could never fire"
-                    ));
-                }
-                let c = self.cfg.cycle_ns.max(1);
-                if n > TIME_LIMIT_NS / c {
-                    return Err(format!(
-                        "`every {n} cycles` is longer than the simulator's time range (about 146 years)"
-                    ));
-                }
-            }
-            Trigger::Every => {
-                let p = f64::from_bits(operand);
-                if p.is_nan() || p * NS < 0.5 {
-                    return Err(format!(
-                        "`every {}` needs a period of at least 1 ns; a period of zero or less would fire without end",
-                        fmt_quantity(p, Dim::TIME)
-                    ));
-                }
-                span_ns(p, t, "the period")?;
-            }
-            Trigger::After => {
-                let p = f64::from_bits(operand);
-                if p.is_nan() || p < 0.0 {
-                    return Err(format!(
-                        "`after {}`: the delay cannot be negative",
-                        fmt_quantity(p, Dim::TIME)
-                    ));
-                }
-                span_ns(p, t, "the delay")?;
-            }
-            Trigger::Condition(_) => {}
-        }
-        Ok(())
-    }
-
-    pub(super) fn perform_fire(&mut self, i: usize) {
-        let Some((t, _)) = self.next_fire().filter(|(_, j)| *j == i) else {
-            return;
-        };
-        self.time = self.time.max(t);
+    /// Enabled handler `i` fires (it is the next firing): its action starts on the handler
+    /// thread. Returns the firing's time; `None` if it is not the next firing.
+    pub(super) fn fire(&mut self, m: &Module, i: usize) -> Option<i64> {
+        let (t, _) = self.next_fire().filter(|(_, j)| *j == i)?;
         self.fires.retain(|(_, j)| *j != i);
-        let Some(e) = self.enabled.get_mut(i) else {
-            return;
-        };
-        if let Firing::Timer { next, period } = &mut e.firing {
-            // Past the time limit a timer never fires again (see `next_fire`).
-            match period {
-                Some(p) => *next = next.saturating_add(*p),
-                None => *next = i64::MAX,
+        if let Some(e) = self.enabled.get_mut(i) {
+            if let Firing::Timer { next, period } = &mut e.firing {
+                // Past the time limit a timer never fires again (see `next_fire`).
+                match period {
+                    Some(p) => *next = next.saturating_add(*p),
+                    None => *next = i64::MAX,
+                }
             }
+            self.running_handler = e.handler;
+            self.thread
+                .start(m, m.handlers[e.handler as usize].action, &e.args);
+            self.state = State::Run;
+            self.running = Some((i, t));
         }
-        let (action, args) = (self.m.handlers[e.handler as usize].action, e.args.clone());
-        self.hrun_handler = e.handler;
-        self.handler.start(&self.m, action, &args);
-        self.hstate = State::Run;
-        self.hrun = Some((i, t));
+        Some(t)
     }
 
-    pub(super) fn perform_handler(&mut self) {
-        let State::At(e) = std::mem::replace(&mut self.hstate, State::Run) else {
-            return;
-        };
-        let pc = self.handler.pc;
-        let ins = self.m.code.get(pc as usize).copied().unwrap_or(Instr::Stop);
-        match e.kind {
-            EventKind::WhenEnd { .. } => {
-                // The handler stopped at `stop`: the program ends after it.
-                let stopping = !self.handler.frames.is_empty() && ins == Instr::Stop;
-                // An `after` handler is gone once it has run.
-                if let Some((i, _)) = self.hrun
-                    && matches!(
-                        self.enabled.get(i).map(|x| &x.firing),
-                        Some(Firing::Timer { period: None, .. })
-                    )
-                {
-                    self.remove_enabled(|k, _| k == i);
-                }
-                self.hrun = None;
-                self.hstate = State::Done;
-                if stopping {
-                    self.stop_program(e.time, e.pos);
-                }
-                return;
-            }
-            EventKind::Error { .. } => {
-                self.hrun = None;
-                self.hstate = State::Done;
-                self.state = State::Done;
-                return;
-            }
-            EventKind::End => {
-                // `stop` in a handler ends the robot's program.
-                self.hrun = None;
-                self.hstate = State::Done;
-                self.end_program();
-                return;
-            }
-            _ => {}
+    /// The running handler ended (`when_end`): an `after` handler is gone once it has run.
+    pub(super) fn end_running(&mut self) {
+        if let Some((i, _)) = self.running
+            && matches!(
+                self.enabled.get(i).map(|x| &x.firing),
+                Some(Firing::Timer { period: None, .. })
+            )
+        {
+            self.remove(|k, _| k == i);
         }
-        self.apply_zero_time(&e, ins, true);
-        self.handler.pc = pc + 1;
+        self.stop_running();
     }
 
-    /// Enables handler `h`: reads its trigger operand and copies its captured locals.
-    pub(super) fn enable(&mut self, h: u32, t: i64, in_handler: bool) {
-        let m = Arc::clone(&self.m);
+    /// The running handler stops (it ended or failed).
+    pub(super) fn stop_running(&mut self) {
+        self.running = None;
+        self.state = State::Done;
+    }
+
+    /// Every handler goes (the activation that enabled them ended).
+    pub(super) fn clear(&mut self) {
+        self.enabled.clear();
+        self.fires.clear();
+    }
+
+    /// Enables handler `h` at `t` from thread `th`: pops its trigger operand and copies
+    /// its captured locals; `eval(func, args)` evaluates a condition trigger's condition
+    /// now (its first value, from which edges count).
+    pub(super) fn enable(
+        &mut self,
+        m: &Module,
+        cycle_ns: i64,
+        h: u32,
+        th: &mut Thread,
+        t: i64,
+        eval: impl FnOnce(u32, &[u64]) -> bool,
+    ) {
         let info = &m.handlers[h as usize];
-        let th = if in_handler {
-            &mut self.handler
-        } else {
-            &mut self.main
-        };
         let operand = if info.trigger.has_operand() {
             th.stack.pop().unwrap_or(0)
         } else {
             0
         };
         let base = th.frames.last().map_or(0, |f| f.base as usize);
-        let grab = |caps: &[crate::bytecode::Capture]| -> Vec<u64> {
+        let grab = |caps: &[Capture]| -> Vec<u64> {
             caps.iter()
                 .flat_map(|c| (0..c.width as u32).map(move |k| base + (c.slot + k) as usize))
                 .map(|i| th.locals.get(i).copied().unwrap_or(0))
@@ -192,8 +205,8 @@ impl Vm {
         };
         let args = grab(&info.captures);
         let (firing, cond_args) = match info.trigger {
-            crate::bytecode::Trigger::EveryCycles => {
-                let c = self.cfg.cycle_ns.max(1);
+            Trigger::EveryCycles => {
+                let c = cycle_ns.max(1);
                 let n = (operand as i64).max(1);
                 (
                     Firing::Timer {
@@ -203,7 +216,7 @@ impl Vm {
                     Vec::new(),
                 )
             }
-            crate::bytecode::Trigger::Every => {
+            Trigger::Every => {
                 let p = ((f64::from_bits(operand) * NS).round() as i64).max(1);
                 (
                     Firing::Timer {
@@ -213,7 +226,7 @@ impl Vm {
                     Vec::new(),
                 )
             }
-            crate::bytecode::Trigger::After => {
+            Trigger::After => {
                 let p = ((f64::from_bits(operand) * NS).round() as i64).max(0);
                 (
                     Firing::Timer {
@@ -223,9 +236,9 @@ impl Vm {
                     Vec::new(),
                 )
             }
-            crate::bytecode::Trigger::Condition(c) => {
+            Trigger::Condition(c) => {
                 let cargs = grab(&m.conds[c as usize].captures);
-                let last = self.eval_cond_with(m.conds[c as usize].func, &cargs, t);
+                let last = eval(m.conds[c as usize].func, &cargs);
                 (Firing::Edge { last }, cargs)
             }
         };
@@ -238,9 +251,14 @@ impl Vm {
         });
     }
 
+    /// Disables the handlers calling procedure `proc`.
+    pub(super) fn disable(&mut self, proc: u32) {
+        self.remove(|_, x| x.target == proc);
+    }
+
     /// Removes the enabled handlers `gone(index, handler)` selects, keeping the indices of
     /// pending firings and of the running handler right.
-    pub(super) fn remove_enabled(&mut self, gone: impl Fn(usize, &Enabled) -> bool) {
+    fn remove(&mut self, gone: impl Fn(usize, &Enabled) -> bool) {
         let mut map = Vec::with_capacity(self.enabled.len());
         let mut kept = 0;
         for (k, e) in self.enabled.iter().enumerate() {
@@ -262,43 +280,30 @@ impl Vm {
             .iter()
             .filter_map(|(t, i)| map[*i].map(|j| (*t, j)))
             .collect();
-        if let Some((i, t)) = self.hrun {
+        if let Some((i, t)) = self.running {
             // A disabled running handler finishes; it just has no index any more.
-            self.hrun = Some((map[i].unwrap_or(usize::MAX), t));
+            self.running = Some((map[i].unwrap_or(usize::MAX), t));
         }
     }
 
-    /// The enabled condition handlers: (handler procedure, the module globals the
-    /// condition reads), for the SE's when list.
-    pub fn condition_handlers(&self) -> impl Iterator<Item = (u32, &[u32])> + '_ {
-        self.enabled
-            .iter()
-            .filter_map(|e| match self.m.handlers[e.handler as usize].trigger {
-                crate::bytecode::Trigger::Condition(c) => {
-                    Some((e.target, self.m.conds[c as usize].globals.as_slice()))
-                }
-                _ => None,
-            })
-    }
-
-    /// The SE's `check_when` at time `t`: re-tests every condition handler; each
-    /// false→true edge schedules a firing at `t`. Returns how many will fire.
-    pub fn check_when(&mut self, t: i64) -> usize {
-        let m = Arc::clone(&self.m);
+    /// The SE's `check_when` at time `t`: re-tests every condition handler with `eval`;
+    /// each false→true edge schedules a firing at `t`. Returns how many will fire.
+    pub(super) fn check_edges(
+        &mut self,
+        m: &Module,
+        t: i64,
+        mut eval: impl FnMut(u32, &[u64]) -> bool,
+    ) -> usize {
         let mut fired = 0;
-        for i in 0..self.enabled.len() {
-            let Firing::Edge { last } = self.enabled[i].firing else {
+        for (i, e) in self.enabled.iter_mut().enumerate() {
+            let Firing::Edge { last } = e.firing else {
                 continue;
             };
-            let crate::bytecode::Trigger::Condition(c) =
-                m.handlers[self.enabled[i].handler as usize].trigger
-            else {
+            let Trigger::Condition(c) = m.handlers[e.handler as usize].trigger else {
                 continue;
             };
-            let args = std::mem::take(&mut self.enabled[i].cond_args);
-            let now = self.eval_cond_with(m.conds[c as usize].func, &args, t);
-            self.enabled[i].cond_args = args;
-            self.enabled[i].firing = Firing::Edge { last: now };
+            let now = eval(m.conds[c as usize].func, &e.cond_args);
+            e.firing = Firing::Edge { last: now };
             if now && !last {
                 self.fires.push((t, i));
                 fired += 1;
@@ -306,4 +311,54 @@ impl Vm {
         }
         fired
     }
+}
+
+/// Checks the operand of a `when` trigger before handler `h` is enabled at `t`: a period
+/// of at least 1 ns (`every T`), a count of at least 1 (`every N cycles`), a delay that is
+/// not negative (`after T`), all ending within the time limit.
+pub(super) fn check_trigger(
+    m: &Module,
+    cycle_ns: i64,
+    h: u32,
+    operand: u64,
+    t: i64,
+) -> Result<(), String> {
+    match m.handlers[h as usize].trigger {
+        Trigger::EveryCycles => {
+            let n = operand as i64;
+            if n < 1 {
+                return Err(format!(
+                    "`every {n} cycles` needs a count of at least 1; a handler every 0 or fewer cycles could never fire"
+                ));
+            }
+            let c = cycle_ns.max(1);
+            if n > TIME_LIMIT_NS / c {
+                return Err(format!(
+                    "`every {n} cycles` is longer than the simulator's time range (about 146 years)"
+                ));
+            }
+        }
+        Trigger::Every => {
+            let p = f64::from_bits(operand);
+            if p.is_nan() || p * NS < 0.5 {
+                return Err(format!(
+                    "`every {}` needs a period of at least 1 ns; a period of zero or less would fire without end",
+                    fmt_quantity(p, Dim::TIME)
+                ));
+            }
+            span_ns(p, t, "the period")?;
+        }
+        Trigger::After => {
+            let p = f64::from_bits(operand);
+            if p.is_nan() || p < 0.0 {
+                return Err(format!(
+                    "`after {}`: the delay cannot be negative",
+                    fmt_quantity(p, Dim::TIME)
+                ));
+            }
+            span_ns(p, t, "the delay")?;
+        }
+        Trigger::Condition(_) => {}
+    }
+    Ok(())
 }
