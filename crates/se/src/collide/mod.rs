@@ -25,7 +25,6 @@ use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
 use parry3d::shape::SharedShape;
 use vworks_model::math::Iso;
-use vworks_vm::machine::Vm;
 
 use vworks_cell::Cell;
 use vworks_log::place::Contact;
@@ -33,11 +32,16 @@ use vworks_log::place::Contact;
 use crate::world::World;
 
 mod broadphase;
+mod horizon;
 mod narrow;
 mod pairs;
+mod robots;
 mod sweep;
 
+pub use robots::RobotPoses;
+
 use broadphase::SweepAndPrune;
+use horizon::Lookahead;
 use narrow::*;
 use pairs::{BodyKeys, PairFilter, Promises};
 use sweep::SweepScratch;
@@ -200,16 +204,8 @@ pub struct Collider {
     /// bring it within the clearance, so its query can be skipped. Withdrawn whenever a
     /// motion starts (its robot's pairs) or a part is gripped or released (all).
     promises: Promises,
-    /// No two bodies can come within the clearance before this time under the current
-    /// motions (`i64::MIN`: no such promise): the engine skips the sweeps and boundary
-    /// checks before it. See [`Collider::horizon`].
-    horizon: i64,
-    /// Scratch for the horizon: each body's speed bound, the boxes grown by the
-    /// look-ahead, their overlapping pairs.
-    body_speed: Vec<f64>,
-    ahead_boxes: Vec<Aabb>,
-    ahead: SweepAndPrune,
-    ahead_pairs: Vec<(usize, usize)>,
+    /// The horizon and the scratch that proves it (see [`Collider::horizon`]).
+    lookahead: Lookahead,
     /// Whether to skip queries by their promises (see [`Collider::set_adaptive`]).
     adaptive: bool,
     /// Each robot's link bodies (the links of every robot come first, robot by robot),
@@ -315,11 +311,7 @@ impl Collider {
             sweep_scratch: SweepScratch::default(),
             checked_at: None,
             promises: Promises::new(n),
-            horizon: i64::MIN,
-            body_speed: Vec::new(),
-            ahead_boxes: Vec::new(),
-            ahead: SweepAndPrune::default(),
-            ahead_pairs: Vec::new(),
+            lookahead: Lookahead::default(),
             adaptive: true,
             robot_bodies,
             links_end,
@@ -337,7 +329,7 @@ impl Collider {
     /// skipped queries no longer hold.
     pub fn motions_changed(&mut self) {
         self.promises.withdraw_all();
-        self.horizon = i64::MIN;
+        self.lookahead.horizon = i64::MIN;
     }
 
     /// Until when no two bodies can come within the clearance, as the last boundary check
@@ -354,13 +346,13 @@ impl Collider {
     /// reach closes at most at `v_i + v_j` from its boxes' distance; a pair farther apart
     /// than that cannot close before the look-ahead ([`HORIZON_NS`]) ends.
     pub fn horizon(&self) -> i64 {
-        self.horizon
+        self.lookahead.horizon
     }
 
     /// Robot `r` starts a motion: the promises of the pairs with one of its bodies (its
     /// links, a part it holds) no longer hold; the others' still do (see `Promises`).
     pub fn motion_started(&mut self, r: usize) {
-        self.horizon = i64::MIN;
+        self.lookahead.horizon = i64::MIN;
         self.promises.begin_withdrawal();
         if let Some(links) = self.robot_bodies.get(r) {
             for i in links.clone() {
@@ -387,7 +379,7 @@ impl Collider {
     }
 
     /// Robot `r`'s tool link in the cell at time `t` (the frames of the last check stay).
-    fn tool_world(cell: &Cell, vm: &Vm, r: usize, t: i64) -> Iso {
+    fn tool_world<R: RobotPoses>(cell: &Cell, vm: &R, r: usize, t: i64) -> Iso {
         let robot = &cell.robots[r];
         let q = vm.joints_at(t);
         robot.base.mul(&robot.model.flange(&q[..robot.model.dof()]))
@@ -404,7 +396,14 @@ impl Collider {
     /// The TCP counts because a gripper is often not modelled (a tool link without
     /// bodies, the `tool` offset standing for its fingers); the tool link's bodies count
     /// because a modelled gripper closes on the part with them. Allocates nothing.
-    pub fn grip_gap(&self, p: usize, r: usize, vms: &[Vm], cell: &Cell, t: i64) -> f64 {
+    pub fn grip_gap<R: RobotPoses>(
+        &self,
+        p: usize,
+        r: usize,
+        vms: &[R],
+        cell: &Cell,
+        t: i64,
+    ) -> f64 {
         let (robot, vm) = (&cell.robots[r], &vms[r]);
         let link = Collider::tool_world(cell, vm, r, t);
         let tcp = link.mul(&vm.tool_at(t)).to_pose().translation;
@@ -427,7 +426,7 @@ impl Collider {
 
     /// Robot `r` grips part `p` at time `t`: from now on the part moves with its tool link.
     /// Pairs of the part touching at that instant are exempt until they separate.
-    pub fn grip(&mut self, p: usize, r: usize, vms: &[Vm], cell: &Cell, t: i64) {
+    pub fn grip<R: RobotPoses>(&mut self, p: usize, r: usize, vms: &[R], cell: &Cell, t: i64) {
         let tool = Collider::tool_world(cell, &vms[r], r, t);
         let pose = self.world.part_pose[p];
         self.world.held[p] = Some((r, tool.inverse().mul(&pose)));
@@ -438,7 +437,7 @@ impl Collider {
 
     /// Part `p` is released at time `t` and stays where it is. Pairs of the part touching
     /// at that instant are exempt until they separate.
-    pub fn release(&mut self, p: usize, vms: &[Vm], cell: &Cell, t: i64) {
+    pub fn release<R: RobotPoses>(&mut self, p: usize, vms: &[R], cell: &Cell, t: i64) {
         if let Some((r, offset)) = self.world.held[p] {
             let tool = Collider::tool_world(cell, &vms[r], r, t);
             self.world.part_pose[p] = tool.mul(&offset);
@@ -450,7 +449,7 @@ impl Collider {
     }
 
     /// Exempts every checked pair of part `p`'s bodies that touches at time `t`.
-    fn exempt_touching(&mut self, p: usize, cell: &Cell, vms: &[Vm], t: i64) {
+    fn exempt_touching<R: RobotPoses>(&mut self, p: usize, cell: &Cell, vms: &[R], t: i64) {
         let mut frames = self.world.frames.clone();
         for (r, f) in frames.iter_mut().enumerate() {
             self.robot_frame_at(cell, vms, r, t, f);
@@ -490,11 +489,12 @@ impl Collider {
         &self.world
     }
 
-    /// Checks the cell at boundary time `t`; `moving[r]` says whether robot r moves.
-    pub fn check(
+    /// Checks the cell at boundary time `t`, its robots being `vms` (the VMs in a run);
+    /// `moving[r]` says whether robot r moves.
+    pub fn check<R: RobotPoses>(
         &mut self,
         cell: &Cell,
-        vms: &[Vm],
+        vms: &[R],
         t: i64,
         moving: &[bool],
     ) -> Vec<CollisionEvent> {
@@ -685,7 +685,7 @@ impl Collider {
         }
         self.touching = touching;
         self.near = near_now;
-        self.horizon = if self.adaptive {
+        self.lookahead.horizon = if self.adaptive {
             self.prove_horizon(cell, t, &joint_speed)
         } else {
             i64::MIN
@@ -694,84 +694,15 @@ impl Collider {
         events
     }
 
-    /// The horizon at a check at `t` (see [`Collider::horizon`]).
-    fn prove_horizon(&mut self, cell: &Cell, t: i64, joint_speed: &[Vec<f64>]) -> i64 {
-        if !self.touching.is_empty()
-            || !self.near.is_empty()
-            || !self.exempt.is_empty()
-            || self.world.held.iter().any(Option::is_some)
-        {
-            return i64::MIN;
-        }
-        self.body_speed.clear();
-        let mut fastest = 0.0f64;
-        for b in &self.bodies {
-            let v = match b.owner {
-                Owner::Link { robot, .. } => b
-                    .reach
-                    .iter()
-                    .map(|(j, arm)| joint_speed[robot][*j] * arm)
-                    .sum(),
-                _ => 0.0,
-            };
-            fastest = fastest.max(v);
-            self.body_speed.push(v);
-        }
-        if !fastest.is_finite() {
-            return i64::MIN;
-        }
-        let mut h = t.saturating_add(HORIZON_NS);
-        // The pairs the check's broadphase kept: their promises.
-        for &(i, j) in &self.pairs {
-            if self.never((i, j)) || self.static_pair((i, j)) {
-                continue;
-            }
-            h = h.min(self.promises.get(i, j));
-        }
-        if h <= t {
-            return i64::MIN;
-        }
-        if fastest <= 0.0 {
-            return h;
-        }
-        // Pairs apart but within reach of each other in the look-ahead: from their boxes.
-        let reach = fastest * HORIZON_NS as f64 / 1e9;
-        let margin = cell.clearance;
-        self.ahead_boxes.clear();
-        self.ahead_boxes
-            .extend(self.aabbs.iter().map(|b| b.loosened(reach)));
-        let mut pairs = std::mem::take(&mut self.ahead_pairs);
-        self.ahead.overlapping(&self.ahead_boxes, &mut pairs);
-        for &(i, j) in &pairs {
-            let (a, b) = (&self.aabbs[i], &self.aabbs[j]);
-            if self.never((i, j)) || self.static_pair((i, j)) || a.intersects(b) {
-                continue; // (boxes within the clearance: a pair the check kept, above)
-            }
-            let v = self.body_speed[i] + self.body_speed[j];
-            if v <= 0.0 {
-                continue;
-            }
-            // The distance of the boxes themselves (not grown by the clearance).
-            let mut d2 = 0.0;
-            for k in 0..3 {
-                let g = (b.mins[k] - a.maxs[k]).max(a.mins[k] - b.maxs[k]) + 2.0 * margin;
-                if g > 0.0 {
-                    d2 += g * g;
-                }
-            }
-            let gap = d2.sqrt() - cell.clearance;
-            if gap <= 0.0 {
-                h = i64::MIN;
-                break;
-            }
-            h = h.min(t.saturating_add((gap / v * 1e9) as i64));
-        }
-        self.ahead_pairs = pairs;
-        h
-    }
-
     /// Robot `r`'s link frames in the cell at time `t`, into `out`.
-    fn robot_frame_at(&self, cell: &Cell, vms: &[Vm], r: usize, t: i64, out: &mut [Iso]) {
+    fn robot_frame_at<R: RobotPoses>(
+        &self,
+        cell: &Cell,
+        vms: &[R],
+        r: usize,
+        t: i64,
+        out: &mut [Iso],
+    ) {
         let robot = &cell.robots[r];
         let q = vms[r].joints_at(t);
         robot

@@ -38,7 +38,13 @@ impl Collider {
     /// advancement the first time they touch, if they do. Pairs found are added to the
     /// touching set, so the next boundary check reports when they part. Returns the
     /// contacts found, in time order.
-    pub fn sweep(&mut self, cell: &Cell, vms: &[Vm], from: i64, to: i64) -> Vec<Contact> {
+    pub fn sweep<R: RobotPoses>(
+        &mut self,
+        cell: &Cell,
+        vms: &[R],
+        from: i64,
+        to: i64,
+    ) -> Vec<Contact> {
         let h = (to - from) as f64 / 1e9;
         if h <= 0.0 {
             return Vec::new();
@@ -49,10 +55,10 @@ impl Collider {
         found
     }
 
-    pub(super) fn sweep_with(
+    pub(super) fn sweep_with<R: RobotPoses>(
         &mut self,
         cell: &Cell,
-        vms: &[Vm],
+        vms: &[R],
         from: i64,
         to: i64,
         h: f64,
@@ -256,10 +262,10 @@ impl Collider {
     /// Conservative advancement of one pair over `[from, to)` with closing speed bound
     /// `speed` (m/s): the first time at which they intersect, if any (at most
     /// [`SWEEP_MIN_STEP_NS`] after the true first contact, up to rounding).
-    pub(super) fn advance(
+    pub(super) fn advance<R: RobotPoses>(
         &mut self,
         cell: &Cell,
-        vms: &[Vm],
+        vms: &[R],
         (i, j): (usize, usize),
         (from, to): (i64, i64),
         speed: f64,
