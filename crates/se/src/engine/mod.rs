@@ -13,141 +13,80 @@
 //! boundary, every robot's state at the boundary is sampled and collisions are checked
 //! ([`crate::collide`]). A VM's queued entry carries a generation number; when the VM's
 //! next event changes (a wait released, a request arrived), the old entry is skipped.
+//!
+//! [`Simulation`] is the loop and the dispatcher; its state lives in components that own
+//! it: the event queue (`queue`), the WAIT and WHEN lists (`lists`), the race detector
+//! (`races`), the cell globals (`globals`), the remote queues (`remote`), the sync points
+//! (`sync`), the run's recording (`record`: trace, fold, sinks), the boundary clock with
+//! the collider (`boundary`) and the run's limits (`limit`). `route` routes a performed
+//! event through them.
 
-use std::cmp::Reverse;
-use std::collections::{BTreeMap, BinaryHeap};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use vworks_model::math::Iso;
-use vworks_vm::Type;
 use vworks_vm::bytecode::SrcPos;
 use vworks_vm::machine::{Event, EventKind, Next, Vm, VmConfig};
 use vworks_vm::types::fmt_quantity;
 
-use crate::collide::Collider;
-use crate::describe::{CellNames, statement_at};
-use vworks_cell::Cell;
-use vworks_log::issue::{Issue, IssueKind};
-use vworks_log::mcaplog::McapLog;
-use vworks_log::place::{Contact, RobotMotion};
 use vworks_log::result::{Outcome, RunResult};
-use vworks_log::sink::{RunEnd, RunSink};
-use vworks_log::stats::{Ending, Fold};
-use vworks_log::trace::{Detail, Kind, TraceEvent, Value, format_value};
+use vworks_log::sink::RunSink;
+use vworks_log::stats::Ending;
+use vworks_log::trace::format_value;
+use vworks_log::issue::{Issue, IssueKind};
+use vworks_log::trace::{Detail, Kind, TraceEvent, Value};
+use vworks_cell::Cell;
 
+mod boundary;
+mod globals;
 mod limit;
+mod lists;
 mod queue;
 mod races;
+mod record;
+mod remote;
 mod route;
+mod sync;
 
-pub use limit::EVENT_LIMIT;
+pub use limit::{EVENT_LIMIT, INSTANT_LIMIT};
 
-use queue::{Entry, Queued, SortedSet};
-use races::Seen;
+use boundary::Boundaries;
+use globals::CellGlobals;
+use limit::InstantLimit;
+use lists::WaitLists;
+use queue::{Entry, EventQueue};
+use races::{RaceDetector, Seen};
+use record::Recording;
+use remote::RemoteQueues;
+use sync::SyncPoints;
 
 /// A running simulation of a cell.
 #[derive(Debug)]
 pub struct Simulation {
     cell: Arc<Cell>,
     vms: Vec<Vm>,
-    queue: BinaryHeap<Reverse<Queued>>,
-    seq: u64,
-    /// Tie-break rank per robot for same-time entries of different robots (all 0 normally:
-    /// first queued, first served). Tests permute it to prove the results do not depend on it.
-    rank: Vec<u64>,
-    generation: Vec<u64>,
-    queued_at: Vec<Option<i64>>,
-    /// Per robot: the event its queue entry stands for, as its VM gave it at the requeue
-    /// (so performing it does not ask the VM again).
-    pending: Vec<Option<Event>>,
-    /// Cell globals: value bits and type.
-    globals: Vec<(u64, Type)>,
-    /// Per robot: cell global index → module global index.
-    to_module: Vec<Vec<Option<u32>>>,
-    /// Per cell global: the last set and the last condition read at a wait start that
-    /// passed at once: (time, robot, pos, the robot's own clock entry at that action).
-    last_set: Vec<Option<(i64, usize, SrcPos, u64)>>,
-    last_read: Vec<Option<(i64, usize, SrcPos, u64)>>,
-    /// Happens-before, for race warnings: a vector clock per robot (`clock[r * n + q]`: how
-    /// many of robot q's actions robot r has seen, directly or through others). A robot
-    /// sees another's actions when that robot's set, signal or remote work releases it.
-    clock: Vec<u64>,
-    /// Per cell global: the setter's clock at the last set (what a robot it releases sees).
-    set_clock: Vec<u64>,
-    /// The paper's WAIT list: per cell global, the robots whose wait condition reads it.
-    wait_list: Vec<SortedSet<usize>>,
-    /// The paper's WHEN list: per cell global, the (robot, handler procedure) of each
-    /// enabled condition handler reading it.
-    when_list: Vec<SortedSet<(usize, u32)>>,
+    queue: EventQueue,
+    /// The paper's WAIT and WHEN lists.
+    lists: WaitLists,
+    races: RaceDetector,
+    globals: CellGlobals,
     /// Per robot and signal site: the receiving robot and the signal's index in its VM
     /// (`None`: the receiver never waits for it).
     signal_to: Vec<Vec<(usize, Option<u32>)>>,
-    /// Remote requests each robot serves, in order: (caller, request number).
-    serving: Vec<std::collections::VecDeque<(usize, u64)>>,
-    /// Time per robot, folded over the events as they are recorded.
-    fold: Fold,
-    collider: Collider,
-    next_boundary: i64,
+    remotes: RemoteQueues,
+    syncs: SyncPoints,
+    recording: Recording,
+    /// The cycle boundaries, the collision checks at them and the sweeps between them.
+    boundaries: Boundaries,
+    /// The queue entries handled at one instant, against the limit.
+    instants: InstantLimit,
     time: i64,
-    trace: Vec<TraceEvent>,
-    warnings: Vec<Issue>,
-    errors: Vec<Issue>,
-    collisions: Vec<Contact>,
     outcome: Option<Outcome>,
-    cycles: u64,
-    /// Consumers of the run (the MCAP log), and the first error one of them had (a sink
-    /// that fails is dropped).
-    sinks: Vec<Box<dyn RunSink>>,
-    log_error: Option<String>,
-    /// Whether each robot moves at the boundary being processed (reused).
-    moving: Vec<bool>,
-    /// Each robot's last `motion_start`: the statement a collision or near miss names.
-    last_motion: Vec<Option<SrcPos>>,
     /// Whether every robot has been queued (the first step does it).
     started: bool,
-    /// Time up to which contacts between boundaries have been swept for.
-    swept: i64,
-    /// Whether to sweep between boundaries at all (see [`Simulation::with_sweep`]).
-    sweep: bool,
-    /// The robot whose turn it is at `time`: the entries it queues for itself at that
-    /// instant go before every other (see `queue`).
-    turn: Option<usize>,
     /// Set from outside to stop the run between two events.
     stop: Option<Arc<AtomicBool>>,
-    /// The instant being simulated, the queue entries handled at it, and how many the
-    /// cell may handle at one instant ([`Simulation::with_instant_limit`]).
-    instant: i64,
-    instant_entries: u64,
-    instant_limit: u64,
-    /// How many events the trace may hold ([`Simulation::with_event_limit`]).
-    event_limit: u64,
-    /// Reads of globals a robot's segment made (reused; see [`Vm::take_reads`]).
-    reads: Vec<(u32, SrcPos)>,
-    /// Per robot: the last remote request made to it (time, caller, position, stamp).
-    last_request: Vec<Option<(i64, usize, SrcPos, u64)>>,
-    /// Per robot: the last signal sent to it (time, sender, position, stamp), and the
-    /// last time one of its signal waits timed out (time, position).
-    last_signal: Vec<Option<(i64, usize, SrcPos, u64)>>,
-    signal_timeout: Vec<Option<(i64, SrcPos)>>,
-    /// Per cell global: the last wait on it that timed out (time, robot, position).
-    last_timeout: Vec<Option<(i64, usize, SrcPos)>>,
-    /// Per sync point of the cell (`Linked::syncs`), per member: whether it has arrived
-    /// at the meeting under way; per robot, the sync point it waits at.
-    sync_arrived: Vec<Vec<bool>>,
-    at_sync: Vec<Option<usize>>,
-    /// Per robot: the instant of its `check_wait` and of its `check_when` still queued, if
-    /// any (a set at that instant needs no second one: the queued check comes after it and
-    /// tests the values it leaves).
-    check_pending: Vec<(Option<i64>, Option<i64>)>,
-    /// Per sync point: the last wait there that timed out (time, robot, position).
-    sync_timeout: Vec<Option<(i64, usize, SrcPos)>>,
 }
-
-/// How many queue entries the cell may handle at one simulated instant by default: far
-/// more than any program needs, few enough to stop a zero-time livelock of several
-/// robots in well under a second.
-pub const INSTANT_LIMIT: u64 = 1_000_000;
 
 /// A VM per robot of `cell`, in the workcell's order, each at its home with the cell's
 /// cycle and the robot's defaults and tool (none has run yet): what a simulation starts
@@ -175,22 +114,6 @@ impl Simulation {
     /// A simulation of `cell` at time 0, every VM created (none has run yet).
     pub fn new(cell: Arc<Cell>) -> Simulation {
         let n = cell.robots.len();
-        let globals = cell
-            .linked
-            .globals
-            .iter()
-            .map(|g| {
-                let mut s = [0u64];
-                g.init.write_slots(&mut s);
-                (s[0], g.ty)
-            })
-            .collect::<Vec<_>>();
-        let mut to_module = vec![vec![None; globals.len()]; n];
-        for (r, links) in cell.linked.robots.iter().enumerate() {
-            for (mg, cg) in links.globals.iter().enumerate() {
-                to_module[r][*cg as usize] = Some(mg as u32);
-            }
-        }
         let vms = robot_vms(&cell);
         let signal_to = (0..n)
             .map(|r| {
@@ -209,109 +132,55 @@ impl Simulation {
                     .collect()
             })
             .collect();
-        let fold = Fold::new(cell.robots.iter().map(|r| r.name.clone()).collect(), false);
-        let collider = Collider::new(&cell);
-        // The programs' compile and link warnings open the run's warnings (kind: the code).
-        let warnings = cell
-            .warnings
-            .iter()
-            .map(|d| Issue {
-                kind: IssueKind::Compiler(d.code.as_str().to_string()),
-                message: d.message.clone(),
-                robot: None,
-                file: Some(d.at.file.clone()),
-                line: d.at.line,
-                col: d.at.col,
-                distance_m: None,
-                motions: Vec::new(),
-            })
-            .collect();
+        let globals = cell.linked.globals.len();
         Simulation {
             vms,
             signal_to,
-            queue: BinaryHeap::new(),
-            seq: 0,
-            rank: vec![0; n],
-            generation: vec![0; n],
-            queued_at: vec![None; n],
-            pending: vec![None; n],
-            last_set: vec![None; globals.len()],
-            last_read: vec![None; globals.len()],
-            clock: vec![0; n * n],
-            set_clock: vec![0; globals.len() * n],
-            globals,
-            to_module,
-            wait_list: vec![Default::default(); cell.linked.globals.len()],
-            when_list: vec![Default::default(); cell.linked.globals.len()],
-            serving: vec![Default::default(); n],
-            fold,
-            collider,
-            next_boundary: 0,
+            queue: EventQueue::new(n),
+            lists: WaitLists::new(globals, n),
+            races: RaceDetector::new(n, globals, cell.linked.syncs.len()),
+            globals: CellGlobals::new(&cell),
+            remotes: RemoteQueues::new(n),
+            syncs: SyncPoints::new(&cell),
+            recording: Recording::new(&cell),
+            boundaries: Boundaries::new(&cell),
+            instants: InstantLimit::new(),
             time: 0,
-            trace: Vec::new(),
-            warnings,
-            errors: Vec::new(),
-            collisions: Vec::new(),
             outcome: None,
-            cycles: 0,
-            sinks: Vec::new(),
-            log_error: None,
-            moving: Vec::with_capacity(cell.robots.len()),
-            last_motion: vec![None; n],
             started: false,
-            swept: 0,
-            sweep: true,
             stop: None,
-            turn: None,
-            instant: -1,
-            instant_entries: 0,
-            instant_limit: INSTANT_LIMIT,
-            event_limit: EVENT_LIMIT,
-            reads: Vec::new(),
-            last_request: vec![None; n],
-            last_signal: vec![None; n],
-            signal_timeout: vec![None; n],
-            last_timeout: vec![None; cell.linked.globals.len()],
-            sync_arrived: cell
-                .linked
-                .syncs
-                .iter()
-                .map(|s| vec![false; s.members.len()])
-                .collect(),
-            at_sync: vec![None; n],
-            check_pending: vec![(None, None); n],
-            sync_timeout: vec![None; cell.linked.syncs.len()],
             cell,
         }
     }
 
     /// Writes the run to an MCAP log (see [`vworks_log::mcaplog`]).
-    pub fn with_log(self, log: McapLog) -> Simulation {
+    pub fn with_log(self, log: vworks_log::mcaplog::McapLog) -> Simulation {
         self.with_sink(Box::new(log))
     }
 
     /// Hands every event and cycle boundary of the run to `sink` as well (see
     /// [`RunSink`]); sinks are called in the order they were attached.
     pub fn with_sink(mut self, sink: Box<dyn RunSink>) -> Simulation {
-        self.sinks.push(sink);
+        self.recording.add_sink(sink);
         self
     }
 
     /// With `false`, collisions are checked at cycle boundaries only, as in the paper: a
     /// body that passes through another between two boundaries goes unnoticed. The default
-    /// (`true`) also sweeps the time between boundaries ([`Collider::sweep`]). For
-    /// comparison and testing.
+    /// (`true`) also sweeps the time between boundaries ([`crate::collide::Collider::sweep`]).
+    /// For comparison and testing.
     pub fn with_sweep(mut self, sweep: bool) -> Simulation {
-        self.sweep = sweep;
+        self.boundaries.set_sweep(sweep);
         self
     }
 
     /// With `false`, every pair near enough to be checked is queried at every boundary;
     /// the default (`true`) skips a pair's queries while the current motions' speed bounds
-    /// prove it cannot come within the clearance ([`Collider::set_adaptive`]). The results
-    /// are the same (tested); for comparison and testing.
+    /// prove it cannot come within the clearance
+    /// ([`crate::collide::Collider::set_adaptive`]). The results are the same (tested);
+    /// for comparison and testing.
     pub fn with_adaptive(mut self, adaptive: bool) -> Simulation {
-        self.collider.set_adaptive(adaptive);
+        self.boundaries.collider_mut().set_adaptive(adaptive);
         self
     }
 
@@ -320,7 +189,7 @@ impl Simulation {
     /// [`INSTANT_LIMIT`]). Each robot is bounded on its own too
     /// ([`VmConfig::instant_events`]).
     pub fn with_instant_limit(mut self, limit: u64) -> Simulation {
-        self.instant_limit = limit.max(1);
+        self.instants.set_limit(limit);
         self
     }
 
@@ -337,7 +206,7 @@ impl Simulation {
     /// memory, so a run that would record more stops with an error naming what records
     /// them (a handler firing every nanosecond, a loop of short delays).
     pub fn with_event_limit(mut self, limit: u64) -> Simulation {
-        self.event_limit = limit.max(1);
+        self.recording.set_event_limit(limit);
         self
     }
 
@@ -364,7 +233,7 @@ impl Simulation {
 
     /// The trace so far.
     pub fn trace(&self) -> &[TraceEvent] {
-        &self.trace
+        self.recording.trace()
     }
 
     /// Handles every queue entry and cycle boundary at or before `t` and moves the clock to
@@ -376,20 +245,19 @@ impl Simulation {
             if self.outcome.is_some() {
                 return false;
             }
-            match self.queue.peek() {
+            match self.queue.next_time() {
                 // Nothing left to do: the step ends the run (completed or deadlock).
                 None => {
                     self.step(None);
                     return self.outcome.is_none();
                 }
-                Some(Reverse(q)) if q.time <= t => {
+                Some(time) if time <= t => {
                     self.step(None);
                 }
                 Some(_) => break,
             }
         }
-        self.advance_cycles(t);
-        if self.outcome.is_some() || self.sweep_until(t) {
+        if self.advance_cycles(t) || self.sweep_until(t) {
             return false;
         }
         self.time = self.time.max(t);
@@ -398,7 +266,7 @@ impl Simulation {
 
     /// The time of the next cycle boundary still to be processed.
     pub fn next_boundary(&self) -> i64 {
-        self.next_boundary
+        self.boundaries.next()
     }
 
     /// How the run ended, once it has.
@@ -412,7 +280,7 @@ impl Simulation {
             .linked
             .globals
             .iter()
-            .zip(&self.globals)
+            .zip(self.globals.values())
             .map(|(g, (v, ty))| (g.name.as_str(), Value::of(*v, *ty)))
             .collect()
     }
@@ -444,12 +312,12 @@ impl Simulation {
 
     /// The warnings so far.
     pub fn warnings(&self) -> &[Issue] {
-        &self.warnings
+        self.recording.warnings()
     }
 
     /// The errors so far (runtime errors, a deadlock).
     pub fn errors(&self) -> &[Issue] {
-        &self.errors
+        self.recording.errors()
     }
 
     /// Ends the run where it is and gives its result (statistics up to now; the log, if
@@ -462,102 +330,6 @@ impl Simulation {
     /// name).
     fn short(&self, r: usize, pos: SrcPos) -> &str {
         self.cell.robots[r].module.file_name_of(pos)
-    }
-
-    fn record(
-        &mut self,
-        time: i64,
-        robot: Option<usize>,
-        kind: Kind,
-        detail: Detail,
-        pos: Option<SrcPos>,
-    ) {
-        let pos = match (robot, pos) {
-            (Some(_), Some(p)) if p.line > 0 => Some(p),
-            _ => None,
-        };
-        self.trace.push(TraceEvent {
-            time,
-            robot,
-            kind,
-            detail,
-            pos,
-        });
-        if !self.sinks.is_empty()
-            && let Some(e) = self.trace.last()
-        {
-            let failed = &mut self.log_error;
-            self.sinks.retain_mut(|s| match s.event(e) {
-                Ok(()) => true,
-                Err(err) => {
-                    failed.get_or_insert(err);
-                    false
-                }
-            });
-        }
-    }
-
-    /// Logs the state at boundary `b` (only when a log is written); runs after the
-    /// collision check at `b`, whose link frames it reuses.
-    fn log_cycle(&mut self, b: i64) {
-        if self.sinks.is_empty() {
-            return;
-        }
-        let world = self.collider.world();
-        let failed = &mut self.log_error;
-        self.sinks.retain_mut(|s| match s.cycle(b, world) {
-            Ok(()) => true,
-            Err(err) => {
-                failed.get_or_insert(err);
-                false
-            }
-        });
-    }
-
-    fn issue(
-        &self,
-        kind: IssueKind,
-        message: String,
-        robot: Option<usize>,
-        pos: Option<SrcPos>,
-    ) -> Issue {
-        Issue {
-            kind,
-            message,
-            robot: robot.map(|r| self.cell.robots[r].name.clone()),
-            file: robot
-                .zip(pos)
-                .map(|(r, p)| self.cell.robots[r].module.file_of(p).to_string()),
-            line: pos.map_or(0, |p| p.line),
-            col: pos.map_or(0, |p| p.col),
-            distance_m: None,
-            motions: Vec::new(),
-        }
-    }
-
-    /// The robots that move bodies `a` and `b` (each once, in that order), and the motion
-    /// each was making at `t`, or last made.
-    fn motions_of(&self, a: &str, b: &str, t: i64) -> Vec<RobotMotion> {
-        let ra = self.collider.robot_moving(a);
-        let rb = self.collider.robot_moving(b).filter(|r| Some(*r) != ra);
-        [ra, rb]
-            .into_iter()
-            .flatten()
-            .map(|r| {
-                let robot = self.cell.robots[r].name.clone();
-                match self.last_motion[r] {
-                    Some(pos) => RobotMotion {
-                        robot,
-                        moving: self.vms[r].moving_at(t),
-                        file: Some(self.cell.robots[r].module.file_of(pos).to_string()),
-                        line: pos.line,
-                        col: pos.col,
-                        statement: statement_at(&self.cell, r, pos),
-                    },
-                    None => RobotMotion::not_moved(robot),
-                }
-            })
-            .collect()
     }
 
     /// Runs to the end (or to `until` ns).
@@ -573,6 +345,32 @@ impl Simulation {
             for r in 0..self.vms.len() {
                 self.requeue(r);
             }
+        }
+    }
+
+    /// Breaks ties between robots' same-time entries by `rank` (a permutation) instead of
+    /// queueing order. Each robot's own entries keep their order. For testing that no
+    /// result depends on tie order.
+    pub fn set_tie_ranks(&mut self, rank: Vec<u64>) {
+        self.queue.set_tie_ranks(rank);
+    }
+
+    /// (Re)queues robot `r`'s next event; the previous entry becomes stale.
+    fn requeue(&mut self, r: usize) {
+        let g = self.queue.renew(r);
+        if self.queue.turn() != Some(r) && self.vms[r].needs_turn() {
+            // Its code reads the cell's globals: it runs in the robot's own turn.
+            self.queue.queue_robot(r, g, None, self.time);
+            return;
+        }
+        let next = self.vms[r].next_event();
+        let to_cell = &self.cell.linked.robots[r].globals;
+        self.races
+            .note_reads(r, self.time, &mut self.vms[r], to_cell);
+        self.report_races();
+        if let Next::Event(e) = next {
+            // Kept for `perform`: the VM's next event cannot change without a requeue.
+            self.queue.queue_robot(r, g, Some(e), self.time);
         }
     }
 
@@ -592,69 +390,65 @@ impl Simulation {
             self.outcome = Some(Outcome::Interrupted);
             return false;
         }
-        let Some(Reverse(Queued { time: t, entry, .. })) = self.queue.pop() else {
+        let Some((t, entry)) = self.queue.pop() else {
             self.end_without_events();
             return false;
         };
         // A stale entry (the robot's next event changed since) is dropped unseen: it must
         // not move the clock (a wait released early leaves its deadline behind).
-        if let Entry::Vm(r, g) | Entry::Resume(r, g) = Entry::unpack(entry)
-            && g != self.generation[r]
-        {
+        if self.queue.is_stale(entry) {
             return true;
         }
         // The turn ends with the entry before: the boundaries before this one belong to
         // no robot.
-        self.turn = None;
+        self.queue.set_turn(None);
         if let Some(u) = until
             && t > u
         {
-            self.advance_cycles(u);
-            if self.outcome.is_some() || self.sweep_until(u) {
+            if self.advance_cycles(u) || self.sweep_until(u) {
                 return false;
             }
             self.time = u;
             self.outcome = Some(Outcome::Until);
             return false;
         }
-        self.advance_cycles(t);
-        if self.outcome.is_some() || self.sweep_until(t) {
+        if self.advance_cycles(t) || self.sweep_until(t) {
             return false;
         }
         self.time = t;
-        if t != self.instant {
-            self.instant = t;
-            self.instant_entries = 0;
-        }
-        self.instant_entries += 1;
-        if self.instant_entries > self.instant_limit {
+        if !self.instants.handle(t) {
             self.livelock(t);
             return false;
         }
-        if self.trace.len() as u64 >= self.event_limit {
+        if self.recording.is_full() {
             self.too_many_events(t);
             return false;
         }
-        let entry = Entry::unpack(entry);
-        self.turn = Some(entry.robot());
+        self.queue.set_turn(Some(entry.robot()));
         match entry {
             Entry::Resume(r, _) => {
                 // The robot's code runs now, in its turn; the event it stops before is
                 // the next entry if it is due at once, and this step handles it too (a
                 // step is never only a resume, which records nothing).
-                self.queued_at[r] = None;
+                self.queue.taken(r);
                 self.requeue(r);
-                if self.queued_at[r] == Some(t) {
+                if self.queue.queued_at(r) == Some(t) {
                     return self.outcome.is_none() && self.step(until);
                 }
             }
             Entry::Vm(r, _) => {
-                self.queued_at[r] = None;
+                self.queue.taken(r);
                 self.perform(r);
             }
             Entry::CheckWait(r, cg) => {
-                self.check_pending[r].0 = None;
-                self.record(t, Some(r), Kind::CheckWait, Detail::Global(cg), None);
+                self.lists.wait_checked(r);
+                self.recording.record(
+                    t,
+                    Some(r),
+                    Kind::CheckWait,
+                    Detail::Global(cg),
+                    None,
+                );
                 let cond = self.vms[r].waiting_cond();
                 if self.vms[r].check_wait(t) {
                     // What r does next follows the sets whose values released it: the
@@ -666,18 +460,24 @@ impl Simulation {
                 } else if let Some(poll) = self.vms[r].take_poll_check() {
                     // A polled wait whose condition holds between polls: tested again at
                     // the next poll.
-                    self.push(poll, Entry::CheckWait(r, cg));
+                    self.queue.push(poll, Entry::CheckWait(r, cg), self.time);
                 }
             }
             Entry::CheckWhen(r, cg) => {
-                self.check_pending[r].1 = None;
-                self.record(t, Some(r), Kind::CheckWhen, Detail::Global(cg), None);
+                self.lists.when_checked(r);
+                self.recording.record(
+                    t,
+                    Some(r),
+                    Kind::CheckWhen,
+                    Detail::Global(cg),
+                    None,
+                );
                 if self.vms[r].check_when(t) > 0 {
                     // The handlers it fires follow the sets of every global their
                     // conditions read (all of r's condition handlers were tested).
-                    for g in 0..self.when_list.len() {
-                        if self.when_list[g].0.iter().any(|(q, _)| *q == r) {
-                            self.merge_clock(r, Seen::Set(g));
+                    for g in 0..self.lists.globals() {
+                        if self.lists.when_reads(g, r) {
+                            self.races.merge(r, Seen::Set(g));
                         }
                     }
                     self.requeue(r);
@@ -687,131 +487,61 @@ impl Simulation {
         self.outcome.is_none()
     }
 
-    /// Records a collision that started; true if the run stops on it.
-    fn collision_started(&mut self, mut contact: Contact) -> bool {
-        let t = contact.time_ns;
-        contact.motions = self.motions_of(&contact.a, &contact.b, t);
-        let detail = Detail::Collision(Box::new(contact.clone()));
-        self.record(t, None, Kind::CollisionStart, detail, None);
-        self.collisions.push(contact);
-        if self.cell.stop_on_collision {
-            self.time = t;
-            self.outcome = Some(Outcome::Collision);
-            return true;
+    /// Robot `r` tested condition `c` of its module: it has seen the last set of every
+    /// global the condition reads.
+    fn seen_condition(&mut self, r: usize, c: u32) {
+        let to_cell = &self.cell.linked.robots[r].globals;
+        for g in &self.cell.robots[r].module.conds[c as usize].globals {
+            self.races
+                .merge(r, Seen::Set(to_cell[*g as usize] as usize));
         }
-        false
     }
 
-    /// Sweeps the time since the last sweep up to (not including) `t` for contacts
-    /// between boundaries (see [`Collider::sweep`]); runs before every boundary and
-    /// before every event, so motions do not change within a swept stretch. True if the
-    /// run stopped on a contact.
+    /// Stops the run on a collision at `t`.
+    fn stop_on_collision(&mut self, t: i64) {
+        self.time = t;
+        self.outcome = Some(Outcome::Collision);
+    }
+
+    /// Sweeps for contacts up to `t` (see [`Boundaries::sweep_until`]); true if the run
+    /// stopped on one.
     fn sweep_until(&mut self, t: i64) -> bool {
-        if !self.sweep || t <= self.swept {
-            return false;
+        let stop = self
+            .boundaries
+            .sweep_until(&self.cell, &self.vms, &mut self.recording, t);
+        if let Some(at) = stop {
+            self.stop_on_collision(at);
         }
-        // Nothing can touch before the collider's horizon: no sweep to do.
-        if t <= self.collider.horizon() {
-            self.swept = t;
-            return false;
-        }
-        let contacts = self.collider.sweep(&self.cell, &self.vms, self.swept, t);
-        self.swept = t;
-        for contact in contacts {
-            if self.collision_started(contact) {
-                return true;
-            }
-        }
-        false
+        stop.is_some()
     }
 
-    /// Processes every cycle boundary up to and including `t`.
-    fn advance_cycles(&mut self, t: i64) {
-        let c = self.cell.cycle_ns;
-        while self.next_boundary <= t {
-            let b = self.next_boundary;
-            // Before the collider's horizon no pair can come within the clearance: the
-            // boundary has nothing to check (unless a log records every boundary's state).
-            if b < self.collider.horizon() && self.sinks.is_empty() {
-                self.swept = self.swept.max(b);
-                self.next_boundary += c;
-                self.cycles += 1;
-                continue;
-            }
-            // A contact before the boundary may end the run before it is reached.
-            if self.sweep_until(b) {
-                return;
-            }
-            self.next_boundary += c;
-            self.cycles += 1;
-            self.moving.clear();
-            self.moving.extend(self.vms.iter().map(|v| v.moving_at(b)));
-            let events = self.collider.check(&self.cell, &self.vms, b, &self.moving);
-            self.log_cycle(b);
-            for ev in events {
-                match ev {
-                    crate::collide::CollisionEvent::Start(contact) => {
-                        if self.collision_started(contact) {
-                            return;
-                        }
-                    }
-                    crate::collide::CollisionEvent::End(a, bname) => {
-                        let detail = Detail::CollisionEnd(Box::new((a, bname)));
-                        self.record(b, None, Kind::CollisionEnd, detail, None)
-                    }
-                    crate::collide::CollisionEvent::NearMiss(a, bname, dist) => {
-                        // Hundredths of a millimetre in words; the exact distance in
-                        // `Issue::distance_m` (JSON, Python).
-                        let m = format!(
-                            "near miss: {a} and {bname} come within {:.2} mm",
-                            dist * 1e3
-                        );
-                        let mut issue = self.issue(IssueKind::NearMiss, m, None, None);
-                        issue.distance_m = Some(dist);
-                        issue.motions = self.motions_of(&a, &bname, b);
-                        // The warning's own place: the first robot moving (else the
-                        // first robot's last motion).
-                        let main = issue.motions.iter().find(|m| m.moving);
-                        if let Some(first) = main.or(issue.motions.first()) {
-                            issue.robot = Some(first.robot.clone());
-                            issue.file.clone_from(&first.file);
-                            (issue.line, issue.col) = (first.line, first.col);
-                        }
-                        self.add_issue(b, None, None, Kind::Warning, issue);
-                    }
-                }
-            }
-            // With nothing queued before the next boundary and nothing moving, skip ahead.
-            // (Not when a sink records every boundary.)
-            if !self.sinks.iter().any(|s| s.records_cycles()) && !self.moving.iter().any(|m| *m) {
-                let next_event = self.queue.peek().map_or(t, |Reverse(q)| q.time).min(t);
-                if next_event > self.next_boundary {
-                    let skip = (next_event - self.next_boundary) / c;
-                    self.next_boundary += skip * c;
-                    self.cycles += skip as u64;
-                }
-            }
+    /// Processes every cycle boundary up to and including `t`; true if the run stopped on
+    /// a collision.
+    fn advance_cycles(&mut self, t: i64) -> bool {
+        let next_event = self.queue.next_time();
+        let stop =
+            self.boundaries
+                .advance(&self.cell, &self.vms, &mut self.recording, t, next_event);
+        if let Some(at) = stop {
+            self.stop_on_collision(at);
         }
+        stop.is_some()
     }
 
     fn perform(&mut self, r: usize) {
-        let Some(e) = self.pending[r].take() else {
+        let Some(mut e) = self.queue.take_pending(r) else {
             return;
         };
         self.vms[r].perform();
         let kind = Kind::of(&e.kind);
         self.account(r, &e, kind);
-        self.route(r, &e, kind);
+        self.route(r, &mut e, kind);
         // Found while the VM described this event (or planned it): at its time at the
         // earliest, so the trace stays in time order.
         for w in self.vms[r].take_warnings() {
-            self.warning(
-                w.time.max(e.time),
-                Some(r),
-                Some(w.pos),
-                w.kind.into(),
-                w.message,
-            );
+            let t = w.time.max(e.time);
+            self.recording
+                .warning(&self.cell, t, Some(r), Some(w.pos), w.kind.into(), w.message);
         }
         if self.outcome.is_none() {
             self.requeue(r);
@@ -820,8 +550,8 @@ impl Simulation {
 
     fn account(&mut self, r: usize, e: &Event, kind: Kind) {
         // Time per robot: the fold sees every event that can count — the robots' own (here)
-        // and the errors the engine finds in them (`error`); check_wait, check_when,
-        // collisions and warnings never change it.
+        // and the errors the engine finds in them (`Recording::error`); check_wait,
+        // check_when, collisions and warnings never change it.
         // (Not a zoned motion's `motion_end`: the robot moves on; see `Fold::event`.)
         if !matches!(
             e.kind,
@@ -830,62 +560,28 @@ impl Simulation {
                 ..
             }
         ) {
-            self.fold.event(e.time, Some(r), kind);
+            self.recording.count(e.time, Some(r), kind);
         }
         if let EventKind::MotionStart { .. } = e.kind {
-            self.last_motion[r] = Some(e.pos);
-            // Speed bounds behind skipped collision queries change with the motion.
-            self.collider.motion_started(r);
+            self.boundaries.motion_started(r, e.pos);
         }
     }
 
-    /// A `warning` trace event and the run's warning of `kind`.
-    fn warning(
-        &mut self,
-        t: i64,
-        robot: Option<usize>,
-        pos: Option<SrcPos>,
-        kind: IssueKind,
-        message: String,
-    ) {
-        let issue = self.issue(kind, message, robot, pos);
-        self.add_issue(t, robot, pos, Kind::Warning, issue);
+    /// The trace holds as many events as it may at `t`: stops the run with an error naming
+    /// what records them (see [`limit::too_many_events`]).
+    fn too_many_events(&mut self, t: i64) {
+        let (robot, pos, m) = limit::too_many_events(
+            self.recording.trace(),
+            self.recording.event_limit(),
+            &self.cell,
+            &self.vms,
+        );
+        self.recording
+            .error(&self.cell, t, robot, pos, IssueKind::Runtime, m);
+        self.outcome = Some(Outcome::Error);
     }
 
-    /// A `warning` or `error` trace event (`severity`) and the run's warning or error
-    /// `issue`. An error counts in its robot's statistics (it ends the robot).
-    fn add_issue(
-        &mut self,
-        t: i64,
-        robot: Option<usize>,
-        pos: Option<SrcPos>,
-        severity: Kind,
-        issue: Issue,
-    ) {
-        if severity == Kind::Error {
-            self.errors.push(issue.clone());
-            self.fold.event(t, robot, Kind::Error);
-        } else {
-            self.warnings.push(issue.clone());
-        }
-        self.record(t, robot, severity, Detail::Issue(Box::new(issue)), pos);
-    }
-
-    /// An `error` trace event (the message quoted) and the run's error of `kind`. The
-    /// caller sets the outcome.
-    fn error(
-        &mut self,
-        t: i64,
-        robot: Option<usize>,
-        pos: Option<SrcPos>,
-        kind: IssueKind,
-        message: String,
-    ) {
-        let issue = self.issue(kind, message, robot, pos);
-        self.add_issue(t, robot, pos, Kind::Error, issue);
-    }
-
-    /// The cell handled more than `instant_limit` entries at instant `t`: robots that
+    /// The cell handled more than its instant limit of entries at instant `t`: robots that
     /// keep waking each other without time passing. Stops the run with an error naming
     /// the busiest robots and their loops.
     fn livelock(&mut self, t: i64) {
@@ -908,13 +604,14 @@ impl Simulation {
             .collect();
         let m = format!(
             "zero-time livelock: the cell handled {} events at {} without time passing: {}; add a motion, a delay or a wait that blocks inside these loops",
-            self.instant_limit,
+            self.instants.limit(),
             fmt_quantity(t as f64 / 1e9, vworks_vm::Dim::TIME),
             parts.join(", ")
         );
         let robot = busy.first().map(|&(_, r)| r);
         let pos = robot.map(|r| self.vms[r].loop_position());
-        self.error(t, robot, pos, IssueKind::Runtime, m);
+        self.recording
+            .error(&self.cell, t, robot, pos, IssueKind::Runtime, m);
         self.outcome = Some(Outcome::Error);
     }
 
@@ -936,8 +633,8 @@ impl Simulation {
                 let globals = &self.cell.robots[*r].module.conds[c as usize].globals;
                 what = format!("a condition on {}", self.names_in_program(*r, globals));
             }
-            if let Some(cs) = self.at_sync[*r] {
-                what = self.sync_missing(cs);
+            if let Some(cs) = self.syncs.waiting_at(*r) {
+                what = self.syncs.missing(&self.cell, cs);
             }
             parts.push(format!(
                 "{} waits for {what} ({}:{pos})",
@@ -946,32 +643,9 @@ impl Simulation {
             ));
         }
         let m = format!("deadlock: {}", parts.join("; "));
-        self.error(self.time, None, None, IssueKind::Deadlock, m);
+        self.recording
+            .error(&self.cell, self.time, None, None, IssueKind::Deadlock, m);
         self.outcome = Some(Outcome::Deadlock);
-    }
-
-    /// A sync point and the tasks of its list that have not arrived at its meeting.
-    fn sync_missing(&self, cs: usize) -> String {
-        let sync = &self.cell.linked.syncs[cs];
-        let missing: Vec<String> = sync
-            .members
-            .iter()
-            .zip(&self.sync_arrived[cs])
-            .filter(|(_, arrived)| !**arrived)
-            .map(|(q, _)| {
-                let robot = &self.cell.robots[*q as usize];
-                if robot.task == robot.name {
-                    format!("`{}`", robot.name)
-                } else {
-                    format!("`{}` (robot {})", robot.task, robot.name)
-                }
-            })
-            .collect();
-        format!(
-            "the other tasks at sync point `{}`; never arrived: {}",
-            sync.name,
-            missing.join(", ")
-        )
     }
 
     /// Module globals of robot `r` as its program names them: a RAPID robot's wired
@@ -1016,44 +690,34 @@ impl Simulation {
             .linked
             .globals
             .iter()
-            .zip(&self.globals)
+            .zip(self.globals.values())
             .map(|(g, (v, ty))| (g.name.clone(), format_value(*v, *ty)))
             .collect();
-        let (robots, _) = self.fold.finish(end, &|r| endings.get(r).copied());
         let outcome = self.outcome.unwrap_or(Outcome::Completed);
-        let run_end = RunEnd {
-            outcome,
-            end_time_ns: end,
-            robots: &robots,
-        };
-        let mut log_counts = BTreeMap::new();
-        for mut sink in self.sinks {
-            match sink.finish(&run_end) {
-                Ok(c) => log_counts.extend(c),
-                Err(e) => {
-                    self.log_error.get_or_insert(e);
-                }
-            }
-        }
+        let cycles = self.boundaries.cycles();
+        let queries = self.boundaries.collider().queries;
+        let recorded = self
+            .recording
+            .finish(end, outcome, &|r| endings.get(r).copied());
         RunResult {
-            log_counts,
-            log_error: self.log_error,
+            log_counts: recorded.log_counts,
+            log_error: recorded.log_error,
             outcome,
             end_time_ns: end,
-            robots,
-            collisions: self.collisions,
-            warnings: self.warnings,
-            errors: self.errors,
+            robots: recorded.robots,
+            collisions: recorded.collisions,
+            warnings: recorded.warnings,
+            errors: recorded.errors,
             global_values,
             globals,
-            logs: self
+            logs: recorded
                 .trace
                 .iter()
-                .filter_map(|e| e.log_line(&CellNames(&self.cell)))
+                .filter_map(|e| e.log_line(&crate::describe::CellNames(&self.cell)))
                 .collect(),
-            trace: self.trace,
-            cycles: self.cycles,
-            queries: self.collider.queries,
+            trace: recorded.trace,
+            cycles,
+            queries,
         }
     }
 }

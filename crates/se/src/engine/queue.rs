@@ -1,20 +1,19 @@
-//! The event queue: 24-byte entries ordered by (time, turn, tie rank, sequence), a robot's
-//! entry made stale by a generation number when its next event changes, and the small
-//! sorted sets behind the WAIT and WHEN lists.
+//! The event queue ([`EventQueue`]): 24-byte entries ordered by (time, turn, tie rank,
+//! sequence), a robot's entry made stale by a generation number when its next event
+//! changes.
 //!
 //! **Turns.** The zero-time work robots do at one instant runs as one serial order of the
 //! robots, never interleaved (docs/engine.md, "One instant, one serial order"): the robot
 //! whose entry the engine took last has the *turn*, and whatever it queues for itself at
 //! that instant (its next event, its own `check_wait`/`check_when`) goes before every other
 //! entry of the instant. A robot that must run code before it knows its next event (at the
-//! start; see [`Vm::needs_turn`]) and is queued by another robot's turn gets a `Resume`
+//! start; see `Vm::needs_turn`) and is queued by another robot's turn gets a `Resume`
 //! entry instead: its code runs when that entry comes up, in its own turn.
 
 use std::cmp::Reverse;
+use std::collections::BinaryHeap;
 
-use vworks_vm::machine::Next;
-
-use super::Simulation;
+use vworks_vm::machine::Event;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Entry {
@@ -72,83 +71,128 @@ pub(super) struct Queued {
     pub(super) entry: u64,
 }
 
-/// A small ordered set kept as a sorted `Vec`: iterated by index while the simulation
-/// queues entries, in the same (ascending) order a `BTreeSet` would give.
-#[derive(Clone, Debug)]
-pub(super) struct SortedSet<T>(pub(super) Vec<T>);
-
-impl<T> Default for SortedSet<T> {
-    fn default() -> Self {
-        SortedSet(Vec::new())
-    }
+/// The event queue: the entries in order, and per robot what its queue entry stands for.
+/// A robot's entry becomes stale when its next event changes: it carries the robot's
+/// generation at the time it was queued, and a requeue starts a new generation.
+#[derive(Debug)]
+pub(super) struct EventQueue {
+    heap: BinaryHeap<Reverse<Queued>>,
+    /// Sequence number of the last entry queued.
+    seq: u64,
+    /// Tie-break rank per robot for same-time entries of different robots (all 0 normally:
+    /// first queued, first served). Tests permute it to prove the results do not depend on it.
+    rank: Vec<u64>,
+    generation: Vec<u64>,
+    /// Per robot: the time of its `Vm` or `Resume` entry, while one is queued.
+    queued_at: Vec<Option<i64>>,
+    /// Per robot: the event its queue entry stands for, as its VM gave it at the requeue
+    /// (so performing it does not ask the VM again).
+    pending: Vec<Option<Event>>,
+    /// The robot whose turn it is at the current instant: the entries it queues for itself
+    /// at that instant go before every other (see the module docs).
+    turn: Option<usize>,
 }
 
-impl<T: Ord + Copy> SortedSet<T> {
-    pub(super) fn insert(&mut self, x: T) {
-        if let Err(i) = self.0.binary_search(&x) {
-            self.0.insert(i, x);
+impl EventQueue {
+    /// An empty queue for `robots` robots.
+    pub(super) fn new(robots: usize) -> EventQueue {
+        EventQueue {
+            heap: BinaryHeap::new(),
+            seq: 0,
+            rank: vec![0; robots],
+            generation: vec![0; robots],
+            queued_at: vec![None; robots],
+            pending: vec![None; robots],
+            turn: None,
         }
     }
 
-    pub(super) fn remove(&mut self, x: &T) {
-        if let Ok(i) = self.0.binary_search(x) {
-            self.0.remove(i);
-        }
-    }
-
-    pub(super) fn retain(&mut self, keep: impl FnMut(&T) -> bool) {
-        self.0.retain(keep);
-    }
-
-    pub(super) fn len(&self) -> usize {
-        self.0.len()
-    }
-}
-
-impl Simulation {
-    pub(super) fn push(&mut self, time: i64, entry: Entry) {
+    /// Queues `entry` at `time`; `now` is the simulated time (an entry of the robot whose
+    /// turn it is, at `now`, goes first).
+    pub(super) fn push(&mut self, time: i64, entry: Entry, now: i64) {
         self.seq += 1;
         let robot = entry.robot();
-        let others = u64::from(!(self.turn == Some(robot) && time == self.time));
-        self.queue.push(Reverse(Queued {
+        let others = u64::from(!(self.turn == Some(robot) && time == now));
+        self.heap.push(Reverse(Queued {
             time,
             key: (others << 63) | (self.rank[robot] << 44) | (self.seq & ((1 << 44) - 1)),
             entry: entry.pack(),
         }));
     }
 
-    /// Breaks ties between robots' same-time entries by `rank` (a permutation) instead of
-    /// queueing order. Each robot's own entries keep their order. For testing that no
-    /// result depends on tie order.
-    pub fn set_tie_ranks(&mut self, rank: Vec<u64>) {
+    /// The time of the earliest entry, stale or not.
+    pub(super) fn next_time(&self) -> Option<i64> {
+        self.heap.peek().map(|Reverse(q)| q.time)
+    }
+
+    /// Takes the earliest entry: its time and the entry.
+    pub(super) fn pop(&mut self) -> Option<(i64, Entry)> {
+        self.heap
+            .pop()
+            .map(|Reverse(q)| (q.time, Entry::unpack(q.entry)))
+    }
+
+    /// Whether `entry` stands for an event its robot no longer has next.
+    pub(super) fn is_stale(&self, entry: Entry) -> bool {
+        matches!(entry, Entry::Vm(r, g) | Entry::Resume(r, g) if g != self.generation[r])
+    }
+
+    /// Breaks ties between robots' same-time entries by `rank` (a permutation, each below
+    /// 2^19) instead of queueing order; anything else is ignored.
+    pub(super) fn set_tie_ranks(&mut self, rank: Vec<u64>) {
         if rank.len() == self.rank.len() && rank.iter().all(|r| *r < 1 << 19) {
             self.rank = rank;
         }
     }
 
-    /// (Re)queues robot `r`'s next event; the previous entry becomes stale.
-    pub(super) fn requeue(&mut self, r: usize) {
+    /// The robot whose turn it is.
+    pub(super) fn turn(&self) -> Option<usize> {
+        self.turn
+    }
+
+    /// Gives the turn to `robot` (`None`: to no robot).
+    pub(super) fn set_turn(&mut self, robot: Option<usize>) {
+        self.turn = robot;
+    }
+
+    /// When robot `r`'s entry is due, while one is queued.
+    pub(super) fn queued_at(&self, r: usize) -> Option<i64> {
+        self.queued_at[r]
+    }
+
+    /// Robot `r`'s entry came up (or was dropped): none is queued.
+    pub(super) fn taken(&mut self, r: usize) {
+        self.queued_at[r] = None;
+    }
+
+    /// Starts robot `r`'s new generation: its queued entry, if any, becomes stale.
+    /// Returns the generation.
+    pub(super) fn renew(&mut self, r: usize) -> u64 {
         self.generation[r] += 1;
         self.queued_at[r] = None;
-        if self.turn != Some(r) && self.vms[r].needs_turn() {
-            // Its code reads the cell's globals: it runs in the robot's own turn.
-            let g = self.generation[r];
-            self.queued_at[r] = Some(self.time);
-            self.pending[r] = None;
-            self.push(self.time, Entry::Resume(r, g));
-            return;
+        self.pending[r] = None;
+        self.generation[r]
+    }
+
+    /// Queues robot `r`'s entry of generation `g` for `event` (kept for `take_pending`), or,
+    /// without an event, a `Resume` at `now`.
+    pub(super) fn queue_robot(&mut self, r: usize, g: u64, event: Option<Event>, now: i64) {
+        match event {
+            Some(e) => {
+                self.queued_at[r] = Some(e.time);
+                self.push(e.time, Entry::Vm(r, g), now);
+                self.pending[r] = Some(e);
+            }
+            None => {
+                self.queued_at[r] = Some(now);
+                self.push(now, Entry::Resume(r, g), now);
+            }
         }
-        let next = self.vms[r].next_event();
-        self.note_reads(r);
-        if let Next::Event(e) = next {
-            self.queued_at[r] = Some(e.time);
-            let g = self.generation[r];
-            self.push(e.time, Entry::Vm(r, g));
-            // Kept for `perform`: the VM's next event cannot change without a requeue.
-            self.pending[r] = Some(e);
-        } else {
-            self.pending[r] = None;
-        }
+    }
+
+    /// The event robot `r`'s entry stands for (taken: performed once).
+    pub(super) fn take_pending(&mut self, r: usize) -> Option<Event> {
+        self.pending[r].take()
     }
 }
 

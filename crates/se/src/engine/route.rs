@@ -1,24 +1,31 @@
-//! Routing a robot's event to the rest of the cell: a `set` updates every robot's copy of
-//! the global and queues `check_wait`/`check_when` for exactly the robots on its WAIT and
-//! WHEN lists; signals are delivered, remote requests queued and answered, parts gripped
-//! and released; runtime errors stop the run.
+//! Routing a robot's event to the rest of the cell (the `Simulation`'s dispatcher, no
+//! state of its own): a `set` updates every robot's copy of the global and queues
+//! `check_wait`/`check_when` for exactly the robots on its WAIT and WHEN lists
+//! ([`super::lists`]); signals are delivered, remote requests queued and answered
+//! ([`super::remote`]), sync points met ([`super::sync`]), parts gripped and released
+//! ([`crate::collide`]); runtime errors stop the run. What the events tell the race
+//! detector ([`super::races`]) becomes race warnings here.
 
-use std::sync::Arc;
-
+use vworks_log::issue::IssueKind;
 use vworks_vm::Dim;
-use vworks_vm::bytecode::SrcPos;
+use vworks_vm::bytecode::{SrcPos, Trigger};
 use vworks_vm::machine::{Event, EventKind};
 use vworks_vm::types::fmt_quantity;
 
-use super::queue::Entry;
-use super::races::Seen;
-use vworks_log::issue::IssueKind;
-
+use super::races::{Seen, Subject};
+use super::record::Recording;
 use super::{Detail, Kind, Outcome, Simulation};
 
 impl Simulation {
-    pub(super) fn route(&mut self, r: usize, e: &Event, kind: Kind) {
+    /// Records robot `r`'s event `e` (performed) and routes it. A remote call's argument
+    /// slots move to the serving robot's request: the recorded `remote_call` keeps its
+    /// site and request number, its `args` empty (no consumer of the trace reads them).
+    pub(super) fn route(&mut self, r: usize, e: &mut Event, kind: Kind) {
         let t = e.time;
+        let args = match &mut e.kind {
+            EventKind::RemoteCall { args, .. } => std::mem::take(args),
+            _ => Vec::new(),
+        };
         // A set is recorded with the cell's global and the value it replaces.
         let set = match e.kind {
             EventKind::Set { global, value, .. } => {
@@ -29,278 +36,183 @@ impl Simulation {
         let detail = match set {
             Some((cg, new)) => Detail::Set {
                 global: cg,
-                old: self.globals[cg as usize].0,
+                old: self.globals.value(cg as usize),
                 new,
             },
             None => Detail::Vm(e.kind.clone()),
         };
-        self.record(t, Some(r), kind, detail, Some(e.pos));
+        self.recording
+            .record(t, Some(r), kind, detail, Some(e.pos));
         if let Some((cg, value)) = set {
             self.on_set(r, cg as usize, value, t, e.pos);
             return;
         }
+        let cell = &*self.cell;
         match &e.kind {
             EventKind::WaitUntil { cond, .. } => {
-                let cell = Arc::clone(&self.cell);
                 // A later set at this instant races with this read only if the wait passed
                 // at once: a wait that blocks is re-tested by that set's check_wait at the
                 // same instant, so either order releases it at the same time.
                 let passed = !self.vms[r].waits();
-                let stamp = self.tick(r);
+                let stamp = self.races.tick(r);
+                let to_cell = &cell.linked.robots[r].globals;
+                let globals = &cell.robots[r].module.conds[*cond as usize].globals;
                 if passed {
                     // A wait that passes on a value set earlier at this instant would, in
                     // the other order, have blocked and been released by that set's
                     // check_wait at the same instant: it follows the set either way.
-                    self.seen_condition(r, *cond);
-                }
-                for g in &cell.robots[r].module.conds[*cond as usize].globals {
-                    let cg = cell.linked.robots[r].globals[*g as usize] as usize;
-                    self.check_race(cg, r, t, e.pos, false);
-                    if passed {
-                        self.last_read[cg] = Some((t, r, e.pos, stamp));
+                    for g in globals {
+                        self.races
+                            .merge(r, Seen::Set(to_cell[*g as usize] as usize));
                     }
-                    self.wait_list[cg].insert(r);
+                }
+                for g in globals {
+                    let cg = to_cell[*g as usize] as usize;
+                    self.races.check(cg, r, t, e.pos, false);
+                    if passed {
+                        self.races.passed_read(cg, r, t, e.pos, stamp);
+                    }
+                    self.lists.add_wait(cg, r);
                 }
             }
             EventKind::WaitEnd { timed_out } => {
                 if *timed_out {
-                    self.timed_out_race(r, t, e.pos);
+                    self.races.timed_out(r, t, e.pos, &self.lists);
                 }
-                self.clear_waits(r);
+                self.lists.clear_waits(r);
                 // A wait at a sync point that timed out: the task leaves the meeting.
-                if *timed_out && let Some(cs) = self.at_sync[r] {
-                    self.sync_timeout[cs] = Some((t, r, e.pos));
+                if *timed_out && let Some(cs) = self.syncs.waiting_at(r) {
+                    self.races.sync_timed_out(cs, r, t, e.pos);
                 }
-                self.leave_sync(r);
+                self.syncs.leave(cell, r);
             }
             EventKind::WaitSync { site, .. } => self.arrive(r, *site as usize, t, e.pos),
             EventKind::EnableWhen { handler } => {
-                let m = self.vms[r].module();
-                let h = &m.handlers[*handler as usize];
-                if let vworks_vm::bytecode::Trigger::Condition(c) = h.trigger {
-                    let target = h.target;
-                    let cell = Arc::clone(&self.cell);
+                let h = &cell.robots[r].module.handlers[*handler as usize];
+                if let Trigger::Condition(c) = h.trigger {
                     for g in &cell.robots[r].module.conds[c as usize].globals {
                         let cg = cell.linked.robots[r].globals[*g as usize] as usize;
-                        self.when_list[cg].insert((r, target));
+                        self.lists.add_when(cg, r, h.target);
                     }
                 }
             }
-            EventKind::DisableWhen { proc } => {
-                for w in &mut self.when_list {
-                    w.remove(&(r, *proc));
-                }
-            }
+            EventKind::DisableWhen { proc } => self.lists.remove_when(r, *proc),
             EventKind::End => {
-                for w in &mut self.when_list {
-                    w.retain(|(q, _)| *q != r);
-                }
+                self.lists.clear_whens(r);
                 // (`stop` in a handler may end a wait, a wait at a sync point too.)
-                self.clear_waits(r);
-                self.leave_sync(r);
+                self.lists.clear_waits(r);
+                self.syncs.leave(cell, r);
             }
             EventKind::Signal { site } => {
                 let (target, idx) = self.signal_to[r][*site as usize];
-                let stamp = self.tick(r);
-                let timing_out = self.vms[target].wait_deadline() == Some(t)
-                    && idx.is_some()
-                    && self.vms[target].waited_signal() == idx;
-                let timed_out = self.signal_timeout[target]
-                    .filter(|(ot, _)| *ot == t)
-                    .map(|(_, p)| p);
+                let to = &self.vms[target];
+                let timing_out =
+                    to.wait_deadline() == Some(t) && idx.is_some() && to.waited_signal() == idx;
                 let waiting = timing_out
-                    .then(|| self.vms[target].waiting_for().map(|(_, p)| p))
+                    .then(|| to.waiting_for().map(|(_, p)| p))
                     .flatten();
-                if let Some(wpos) = timed_out.or(waiting) {
-                    self.race(t, (target, wpos), (r, e.pos), "on a signal", "time out a wait for it and send it at the same instant; whether the signal releases the wait depends on their order");
-                }
-                self.last_signal[target] = Some((t, r, e.pos, stamp));
+                self.races.signal(r, target, t, e.pos, waiting);
                 if let Some(idx) = idx
                     && self.vms[target].deliver_signal_index(idx, t)
                 {
                     // The receiver, released, has seen what the sender had.
-                    self.merge_clock(target, Seen::Robot(r));
+                    self.races.merge(target, Seen::Robot(r));
                     self.requeue(target);
                 }
             }
-            EventKind::RemoteCall { site, req, args } => {
-                let (target, proc) = self.cell.linked.robots[r].remotes[*site as usize];
+            EventKind::RemoteCall { site, req, .. } => {
+                let (target, proc) = cell.linked.robots[r].remotes[*site as usize];
                 let target = target as usize;
-                // Two requests to one robot at one instant: which it serves first is only
-                // the queue's tie order (a request made after seeing the other's is not).
-                let stamp = self.tick(r);
-                let n = self.vms.len();
-                if let Some((ot, or, opos, ostamp)) = self.last_request[target]
-                    && ot == t
-                    && or != r
-                    && self.clock[r * n + or] < ostamp
-                {
-                    let subject = format!("for {}'s remote work", self.cell.robots[target].name);
-                    self.race(t, (or, opos), (r, e.pos), &subject, "ask for it at the same instant; which request it serves first depends on their order");
-                }
-                self.last_request[target] = Some((t, r, e.pos, stamp));
-                self.vms[target].request_remote(proc, args.clone(), t);
-                self.serving[target].push_back((r, *req));
-                if self.queued_at[target].is_none() {
+                self.races.request(r, target, t, e.pos);
+                self.vms[target].request_remote(proc, args, t);
+                self.remotes.request(target, r, *req);
+                if self.queue.queued_at(target).is_none() {
                     self.requeue(target);
                 }
             }
             EventKind::RemoteEnd { .. } => {
                 // The handlers the remote work enabled ended with it.
-                self.sync_when_list(r);
-                self.clear_waits(r);
-                self.leave_sync(r);
-                if let Some((caller, req)) = self.serving[r].pop_front() {
-                    self.tick(r);
-                    self.merge_clock(caller, Seen::Robot(r));
+                self.lists.clear_whens(r);
+                let to_cell = &cell.linked.robots[r].globals;
+                for (target, globals) in self.vms[r].condition_handlers() {
+                    for g in globals {
+                        self.lists
+                            .add_when(to_cell[*g as usize] as usize, r, target);
+                    }
+                }
+                self.lists.clear_waits(r);
+                self.syncs.leave(cell, r);
+                if let Some((caller, req)) = self.remotes.served(r) {
+                    self.races.tick(r);
+                    self.races.merge(caller, Seen::Robot(r));
                     self.vms[caller].remote_done(req, t);
                     self.requeue(caller);
                 }
             }
-            EventKind::Grip { site } => {
-                let part = self.cell.linked.robots[r].parts[*site as usize] as usize;
-                let name = &self.cell.parts[part].name;
-                match self.collider.holder(part) {
-                    None => {
-                        let gap = self.collider.grip_gap(part, r, &self.vms, &self.cell, t);
-                        let robot = &self.cell.robots[r];
-                        if gap <= robot.grip_distance {
-                            self.collider.grip(part, r, &self.vms, &self.cell, t);
-                        } else {
-                            let m = format!(
-                                "cannot grip `{name}`: it is {:.2} mm from {}'s gripper (its TCP and its tool link's collision bodies), farther than grip_distance {}; move the tool to the part first, or set a larger `grip_distance` in the workcell",
-                                gap * 1e3,
-                                robot.name,
-                                fmt_quantity(robot.grip_distance, Dim::LENGTH)
-                            );
-                            self.runtime_error(r, t, e.pos, m);
-                        }
-                    }
-                    Some(h) if h == r => {
-                        let m = format!(
-                            "`{name}` is already in this robot's gripper; release it before gripping it again"
-                        );
-                        self.runtime_error(r, t, e.pos, m);
-                    }
-                    Some(h) => {
-                        let m = format!(
-                            "`{name}` is held by {}; it must release the part before this robot can grip it",
-                            self.cell.robots[h].name
-                        );
-                        self.runtime_error(r, t, e.pos, m);
-                    }
-                }
-            }
-            EventKind::Release { site } => {
-                let part = self.cell.linked.robots[r].parts[*site as usize] as usize;
-                let name = &self.cell.parts[part].name;
-                match self.collider.holder(part) {
-                    Some(h) if h == r => self.collider.release(part, &self.vms, &self.cell, t),
-                    Some(h) => {
-                        let m = format!(
-                            "this robot does not hold `{name}`: {} does; only the robot holding a part can release it",
-                            self.cell.robots[h].name
-                        );
-                        self.runtime_error(r, t, e.pos, m);
-                    }
-                    None => {
-                        let m = format!(
-                            "this robot does not hold `{name}` (no robot does); grip it before releasing it"
-                        );
-                        self.runtime_error(r, t, e.pos, m);
-                    }
-                }
-            }
+            EventKind::Grip { site } => self.grip(r, *site as usize, t, e.pos),
+            EventKind::Release { site } => self.release(r, *site as usize, t, e.pos),
             EventKind::Error { message } => {
-                let issue = self.issue(IssueKind::Runtime, message.clone(), Some(r), Some(e.pos));
-                self.errors.push(issue);
+                let issue =
+                    Recording::issue(cell, IssueKind::Runtime, message.clone(), Some(r), Some(e.pos));
+                self.recording.vm_error(issue);
                 self.outcome = Some(Outcome::Error);
             }
             _ => {}
+        }
+        self.report_races();
+    }
+
+    /// The races the detector found since, as warnings (in the order found).
+    pub(super) fn report_races(&mut self) {
+        if !self.races.has_races() {
+            return;
+        }
+        let cell = &*self.cell;
+        for race in self.races.take_races() {
+            let subject = match race.subject {
+                Subject::Global(cg) => format!("on `{}`", cell.linked.globals[cg].name),
+                Subject::Signal => "on a signal".to_string(),
+                Subject::RemoteWork(target) => {
+                    format!("for {}'s remote work", cell.robots[target].name)
+                }
+                Subject::SyncPoint(cs) => format!("at sync point `{}`", cell.linked.syncs[cs].name),
+            };
+            let ((or, opos), (r, pos)) = (race.first, race.second);
+            let short = |r: usize, pos: SrcPos| cell.robots[r].module.file_name_of(pos);
+            let m = format!(
+                "race {subject} at {}: {} ({}:{}) and {} ({}:{}) {}",
+                fmt_quantity(race.time as f64 / 1e9, Dim::TIME),
+                cell.robots[or].name,
+                short(or, opos),
+                opos,
+                cell.robots[r].name,
+                short(r, pos),
+                pos,
+                race.what
+            );
+            self.recording
+                .warning(cell, race.time, Some(r), Some(pos), IssueKind::Race, m);
         }
     }
 
     /// Robot `r` sets cell global `cg` to `value` at `t`.
     pub(super) fn on_set(&mut self, r: usize, cg: usize, value: u64, t: i64, pos: SrcPos) {
-        self.check_race(cg, r, t, pos, true);
-        if let Some((ot, q, qpos)) = self.last_timeout[cg]
-            && ot == t
-            && q != r
-        {
-            let name = &self.cell.linked.globals[cg].name;
-            let subject = format!("on `{name}`");
-            self.race(t, (q, qpos), (r, pos), &subject, "time out a wait and set it at the same instant; whether the set releases the wait depends on their order");
-        }
-        let stamp = self.tick(r);
-        self.last_set[cg] = Some((t, r, pos, stamp));
-        let n = self.vms.len();
-        self.set_clock[cg * n..(cg + 1) * n].copy_from_slice(&self.clock[r * n..(r + 1) * n]);
-        self.globals[cg].0 = value;
-        for q in 0..self.vms.len() {
-            if let Some(mg) = self.to_module[q][cg] {
-                self.vms[q].set_global(mg, value);
-            }
-        }
-        // check_wait / check_when for exactly the robots on this global's wait and when
-        // lists, queued behind what is already due (in robot order, for determinism).
-        // A robot whose check of this instant is still queued gets no second one: that
-        // check comes after this set and tests the values it leaves (without this, checks
-        // of robots taking turns piled up: 1,000 queued in a ring of 32).
-        for i in 0..self.wait_list[cg].len() {
-            let q = self.wait_list[cg].0[i];
-            if self.check_pending[q].0 != Some(t) {
-                self.check_pending[q].0 = Some(t);
-                self.push(t, Entry::CheckWait(q, cg as u32));
-            }
-        }
-        let mut last = None;
-        for i in 0..self.when_list[cg].len() {
-            let q = self.when_list[cg].0[i].0;
-            if last != Some(q) {
-                last = Some(q);
-                if self.check_pending[q].1 != Some(t) {
-                    self.check_pending[q].1 = Some(t);
-                    self.push(t, Entry::CheckWhen(q, cg as u32));
-                }
-            }
-        }
-    }
-
-    /// Robot `r` leaves the meeting it waits at, if any (its wait timed out, or its
-    /// program or remote work ended while it waited): its arrival no longer counts.
-    fn leave_sync(&mut self, r: usize) {
-        if let Some(cs) = self.at_sync[r].take() {
-            self.mark_arrived(cs, r, false);
-        }
-    }
-
-    /// Whether member `r` of sync point `cs` has arrived at the meeting under way.
-    fn mark_arrived(&mut self, cs: usize, r: usize, arrived: bool) {
-        let members = &self.cell.linked.syncs[cs].members;
-        if let Ok(k) = members.binary_search(&(r as u32)) {
-            self.sync_arrived[cs][k] = arrived;
-        }
+        self.races.set(cg, r, t, pos);
+        self.report_races();
+        self.globals.set(cg, value, &mut self.vms);
+        self.lists.queue_checks(cg, t, self.time, &mut self.queue);
     }
 
     /// Robot `r` arrives at the sync point of its sync site `site`: when every task of the
     /// list has arrived, the meeting is complete and all of them go on at `t` (each has
     /// seen every other's arrival).
     fn arrive(&mut self, r: usize, site: usize, t: i64, pos: SrcPos) {
-        let cs = self.cell.linked.robots[r].syncs[site] as usize;
-        let cell = Arc::clone(&self.cell);
+        let cell = &*self.cell;
+        let cs = cell.linked.robots[r].syncs[site] as usize;
         let members = &cell.linked.syncs[cs].members;
-        self.mark_arrived(cs, r, true);
-        self.at_sync[r] = Some(cs);
-        self.tick(r);
-        let name = || format!("at sync point `{}`", cell.linked.syncs[cs].name);
-        const TIED: &str = "time out there and arrive at the same instant; whether they meet depends on their order";
-        if let Some((ot, q, qpos)) = self.sync_timeout[cs]
-            && ot == t
-            && q != r
-        {
-            self.race(t, (q, qpos), (r, pos), &name(), TIED);
-        }
-        if !self.sync_arrived[cs].iter().all(|a| *a) {
+        let complete = self.syncs.arrive(cell, cs, r);
+        self.races.arrive(cs, r, t, pos);
+        if !complete {
             return;
         }
         // A task whose wait would time out at this very instant meets the others only
@@ -311,55 +223,92 @@ impl Simulation {
                 && self.vms[q].wait_deadline() == Some(t)
                 && let Some((_, qpos)) = self.vms[q].waiting_for()
             {
-                self.race(t, (q, qpos), (r, pos), &name(), TIED);
+                self.races.met_at_deadline(cs, (q, qpos), (r, pos), t);
             }
         }
-        self.sync_arrived[cs].iter_mut().for_each(|a| *a = false);
+        self.report_races();
+        let cell = &*self.cell;
+        let members = &cell.linked.syncs[cs].members;
+        self.syncs.release(cell, cs);
         // Every member has seen every arrival: the first gathers them all, the others
         // take its clock.
         let (first, rest) = members
             .split_first()
             .map_or((0, &[][..]), |(f, rest)| (*f as usize, rest));
         for p in rest {
-            self.merge_clock(first, Seen::Robot(*p as usize));
+            self.races.merge(first, Seen::Robot(*p as usize));
         }
         for q in rest {
-            self.merge_clock(*q as usize, Seen::Robot(first));
+            self.races.merge(*q as usize, Seen::Robot(first));
         }
-        for q in members {
-            let q = *q as usize;
-            self.at_sync[q] = None;
+        for k in 0..members.len() {
+            let q = self.cell.linked.syncs[cs].members[k] as usize;
             if self.vms[q].release_sync(t) {
                 self.requeue(q);
             }
         }
     }
 
-    /// Robot `r`'s entries in the WHEN list, made anew from its VM's enabled handlers.
-    pub(super) fn sync_when_list(&mut self, r: usize) {
-        for w in &mut self.when_list {
-            w.retain(|(q, _)| *q != r);
-        }
-        let cell = Arc::clone(&self.cell);
-        for (target, globals) in self.vms[r].condition_handlers() {
-            for g in globals {
-                let cg = cell.linked.robots[r].globals[*g as usize] as usize;
-                self.when_list[cg].insert((r, target));
+    /// Robot `r` grips the part of its grip site `site` at `t` (the statement at `pos`).
+    fn grip(&mut self, r: usize, site: usize, t: i64, pos: SrcPos) {
+        let cell = &*self.cell;
+        let part = cell.linked.robots[r].parts[site] as usize;
+        let name = &cell.parts[part].name;
+        let collider = self.boundaries.collider_mut();
+        let m = match collider.holder(part) {
+            None => {
+                let gap = collider.grip_gap(part, r, &self.vms, cell, t);
+                let robot = &cell.robots[r];
+                if gap <= robot.grip_distance {
+                    collider.grip(part, r, &self.vms, cell, t);
+                    return;
+                }
+                format!(
+                    "cannot grip `{name}`: it is {:.2} mm from {}'s gripper (its TCP and its tool link's collision bodies), farther than grip_distance {}; move the tool to the part first, or set a larger `grip_distance` in the workcell",
+                    gap * 1e3,
+                    robot.name,
+                    fmt_quantity(robot.grip_distance, Dim::LENGTH)
+                )
             }
-        }
+            Some(h) if h == r => format!(
+                "`{name}` is already in this robot's gripper; release it before gripping it again"
+            ),
+            Some(h) => format!(
+                "`{name}` is held by {}; it must release the part before this robot can grip it",
+                cell.robots[h].name
+            ),
+        };
+        self.runtime_error(r, t, pos, m);
     }
 
-    /// Robot `r` no longer waits: off the WAIT list.
-    pub(super) fn clear_waits(&mut self, r: usize) {
-        for w in &mut self.wait_list {
-            w.remove(&r);
-        }
+    /// Robot `r` releases the part of its release site `site` at `t` (the statement at
+    /// `pos`).
+    fn release(&mut self, r: usize, site: usize, t: i64, pos: SrcPos) {
+        let cell = &*self.cell;
+        let part = cell.linked.robots[r].parts[site] as usize;
+        let name = &cell.parts[part].name;
+        let collider = self.boundaries.collider_mut();
+        let m = match collider.holder(part) {
+            Some(h) if h == r => {
+                collider.release(part, &self.vms, cell, t);
+                return;
+            }
+            Some(h) => format!(
+                "this robot does not hold `{name}`: {} does; only the robot holding a part can release it",
+                cell.robots[h].name
+            ),
+            None => format!(
+                "this robot does not hold `{name}` (no robot does); grip it before releasing it"
+            ),
+        };
+        self.runtime_error(r, t, pos, m);
     }
 
     /// A runtime error the SE finds in robot `r`'s event at `t` (a part gripped twice):
     /// an `error` event at the statement, and the run stops.
-    pub(super) fn runtime_error(&mut self, r: usize, t: i64, pos: SrcPos, message: String) {
-        self.error(t, Some(r), Some(pos), IssueKind::Runtime, message);
+    fn runtime_error(&mut self, r: usize, t: i64, pos: SrcPos, message: String) {
+        self.recording
+            .error(&self.cell, t, Some(r), Some(pos), IssueKind::Runtime, message);
         self.vms[r].halt();
         self.outcome = Some(Outcome::Error);
     }
