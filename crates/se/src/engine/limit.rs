@@ -58,7 +58,7 @@ impl InstantLimit {
 }
 
 /// How many events a run records at most by default (see
-/// [`Simulation::with_event_limit`]): far more than real cells record (the handoff
+/// [`super::Simulation::with_event_limit`]): far more than real cells record (the handoff
 /// example, 3 a second: 38 days; 64 robots with an event every 100 ms each: 4 hours),
 /// few enough to bound the trace's memory (an event is 104 bytes: about 1 GB).
 pub const EVENT_LIMIT: u64 = 10_000_000;
