@@ -4,7 +4,9 @@
 //! - crates depend on each other only down the run's data flow, and the named rules hold
 //!   ("`se` never depends on `report`", "only `cell` calls the compiler" among the crates
 //!   that simulate, "`log` depends on no engine crate and the report on no engine");
-//! - no two top-level modules of one crate import each other, directly or around a loop;
+//! - no two top-level modules of one crate import each other, directly or around a loop,
+//!   the crate's root (`lib.rs`, `main.rs`) counted as a module;
+//! - no struct has more than 20 fields (split it into components that own their state);
 //! - no source file is over 1,200 lines;
 //! - every path ARCHITECTURE.md's code map names exists, and every source file is on the
 //!   map (itself or a folder above it).
@@ -134,9 +136,61 @@ fn crates_depend_only_down_the_data_flow() {
     );
 }
 
-/// The top-level modules of `src` (`engine` for `engine.rs` or `engine/`), and which of
-/// them each one refers to through `crate::` paths (`use crate::trace::Kind`,
-/// `crate::mcaplog::McapLog`).
+/// A source text without what is not code for the import graph: unit tests (at the end of
+/// a file, they may use any module) and comments (doc links are not imports).
+fn code_of(whole: &str) -> String {
+    whole
+        .split("#[cfg(test)]")
+        .next()
+        .unwrap_or("")
+        .lines()
+        .filter(|l| !l.trim_start().starts_with("//"))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// The first segment of each path a `crate::` at `rest` names: `trace` for
+/// `crate::trace::Kind`, `trace` and `Compiled` for `crate::{trace::Kind, Compiled}`.
+fn first_segments(rest: &str) -> Vec<String> {
+    let word = |t: &str| -> String {
+        t.trim_start()
+            .chars()
+            .take_while(|c| c.is_alphanumeric() || *c == '_')
+            .collect()
+    };
+    let Some(group) = rest.strip_prefix('{') else {
+        return vec![word(rest)];
+    };
+    // The group's top-level items, up to its closing brace.
+    let (mut depth, mut items, mut start) = (0usize, Vec::new(), 0usize);
+    for (i, c) in group.char_indices() {
+        match c {
+            '{' => depth += 1,
+            '}' if depth == 0 => {
+                items.push(word(&group[start..i]));
+                break;
+            }
+            '}' => depth -= 1,
+            ',' if depth == 0 => {
+                items.push(word(&group[start..i]));
+                start = i + 1;
+            }
+            _ => {}
+        }
+    }
+    items
+}
+
+/// The module graph of one crate's `src`: its top-level modules (`engine` for `engine.rs`
+/// or `engine/`) and its root (`lib` or `main`), and which of them each one uses.
+///
+/// - A module uses another through `crate::` paths (`use crate::trace::Kind`, grouped
+///   `use crate::{trace::Kind, stats}`, `crate::mcaplog::McapLog`).
+/// - A module uses the root when it names an item the root defines itself
+///   (`crate::Compiled`, a struct in lib.rs); an item the root re-exports
+///   (`pub use diag::Code`) is a use of the module it comes from.
+/// - The root uses a module when its code names it (`rapid::compile_files(…)`); declaring
+///   it (`pub mod rapid;`) or re-exporting its items (`pub use`) is not a use.
 fn module_graph(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
     let top = |p: &Path| -> Option<String> {
         let rel = p.strip_prefix(src).ok()?;
@@ -146,44 +200,99 @@ fn module_graph(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
             .as_os_str()
             .to_string_lossy()
             .into_owned();
-        let name = first.strip_suffix(".rs").unwrap_or(&first).to_string();
-        (name != "lib" && name != "main").then_some(name)
+        Some(first.strip_suffix(".rs").unwrap_or(&first).to_string())
     };
+    let is_root = |m: &str| m == "lib" || m == "main";
+    let files = rust_files(src);
+    let modules: BTreeSet<String> = files.iter().filter_map(|f| top(f)).collect();
+    // What the root defines, and what it re-exports from which module.
+    let mut root_items = BTreeSet::new();
+    let mut reexported: BTreeMap<String, String> = BTreeMap::new();
+    let mut root_uses = BTreeSet::new();
+    for file in files.iter().filter(|f| top(f).is_some_and(|m| is_root(&m))) {
+        let text = code_of(&std::fs::read_to_string(file).unwrap());
+        for statement in text.split(';') {
+            let st = statement.trim();
+            if let Some(path) = st.strip_prefix("pub use ") {
+                let Some((module, items)) = path.split_once("::") else {
+                    continue;
+                };
+                let items = items.trim_start_matches('{').trim_end_matches('}');
+                for item in items.split(',') {
+                    let item = item.split(" as ").last().unwrap_or("").trim();
+                    let name = item.rsplit("::").next().unwrap_or("").to_string();
+                    if !name.is_empty() && modules.contains(module) {
+                        reexported.insert(name, module.to_string());
+                    }
+                }
+            }
+        }
+        for line in text.lines() {
+            let t = line.trim_start();
+            if t.starts_with("pub mod ")
+                || t.starts_with("mod ")
+                || t.starts_with("pub use ")
+                || t.starts_with("pub(crate) mod ")
+            {
+                continue;
+            }
+            let words: Vec<&str> = t
+                .split(|c: char| !(c.is_alphanumeric() || c == '_'))
+                .collect();
+            for kw in ["struct", "enum", "fn", "const", "static", "type", "trait"] {
+                if let Some(i) = words.iter().position(|w| *w == kw)
+                    && let Some(name) = words.get(i + 1).filter(|n| !n.is_empty())
+                {
+                    root_items.insert((*name).to_string());
+                }
+            }
+            for m in &modules {
+                let pat = format!("{m}::");
+                for (i, _) in line.match_indices(&pat) {
+                    let before = &line[..i];
+                    let is_path_start = before
+                        .chars()
+                        .next_back()
+                        .is_none_or(|c| !(c.is_alphanumeric() || c == '_' || c == ':'))
+                        || before.ends_with("crate::")
+                        || before.ends_with("self::");
+                    if is_path_start && !is_root(m) {
+                        root_uses.insert(m.clone());
+                    }
+                }
+            }
+        }
+    }
     let mut graph: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
-    for file in rust_files(src) {
-        let Some(from) = top(&file) else { continue };
-        let whole = std::fs::read_to_string(&file).unwrap();
-        // Unit tests (at the end of a file) may use any module.
-        // Comments (doc links) are not imports.
-        let text: String = whole
-            .split("#[cfg(test)]")
-            .next()
-            .unwrap_or("")
-            .lines()
-            .filter(|l| !l.trim_start().starts_with("//"))
-            .collect::<Vec<_>>()
-            .join("\n");
+    for file in &files {
+        let Some(from) = top(file) else { continue };
         let entry = graph.entry(from.clone()).or_default();
+        if is_root(&from) {
+            entry.extend(root_uses.iter().cloned());
+            continue;
+        }
+        let text = code_of(&std::fs::read_to_string(file).unwrap());
         for (i, _) in text.match_indices("crate::") {
             // `vworks_se::…` is another crate; `crate::` starts a path in this one.
             let before = text[..i].chars().next_back();
             if before.is_some_and(|c| c.is_alphanumeric() || c == '_') {
                 continue;
             }
-            let rest = &text[i + "crate::".len()..];
-            let name: String = rest
-                .chars()
-                .take_while(|c| c.is_alphanumeric() || *c == '_')
-                .collect();
-            if !name.is_empty() && name != from {
-                entry.insert(name);
+            for name in first_segments(&text[i + "crate::".len()..]) {
+                let to = if modules.contains(&name) {
+                    Some(name)
+                } else if let Some(m) = reexported.get(&name) {
+                    Some(m.clone())
+                } else if root_items.contains(&name) {
+                    modules.iter().find(|m| is_root(m)).cloned()
+                } else {
+                    None
+                };
+                if let Some(to) = to.filter(|t| *t != from) {
+                    entry.insert(to);
+                }
             }
         }
-    }
-    // Only edges between modules (not to items of the crate root).
-    let modules: BTreeSet<String> = graph.keys().cloned().collect();
-    for deps in graph.values_mut() {
-        deps.retain(|d| modules.contains(d));
     }
     graph
 }
@@ -232,17 +341,16 @@ fn find_cycle(graph: &BTreeMap<String, BTreeSet<String>>) -> Option<Vec<String>>
 #[test]
 fn no_import_loops_between_the_modules_of_a_crate() {
     let mut checked = 0;
+    let mut loops = Vec::new();
     for c in LAYERS {
         let src = root().join("crates").join(c).join("src");
         let graph = module_graph(&src);
         if let Some(cycle) = find_cycle(&graph) {
-            panic!(
-                "crates/{c}: modules import each other: {}",
-                cycle.join(" → ")
-            );
+            loops.push(format!("crates/{c}: {}", cycle.join(" → ")));
         }
         checked += graph.len();
     }
+    assert!(loops.is_empty(), "modules import each other: {loops:#?}");
     assert!(checked > 20, "only {checked} modules found");
     // The check finds a loop where there is one.
     let looped = BTreeMap::from([
@@ -250,6 +358,11 @@ fn no_import_loops_between_the_modules_of_a_crate() {
         ("b".to_string(), BTreeSet::from(["a".to_string()])),
     ]);
     assert_eq!(find_cycle(&looped).map(|c| c.len()), Some(3));
+    // Grouped imports and the crate root's own items are seen.
+    assert_eq!(
+        first_segments("{trace::Kind, Compiled, stats::{Fold, X}};"),
+        ["trace", "Compiled", "stats"]
+    );
 }
 
 /// The longest a source file may be.
@@ -321,4 +434,86 @@ fn the_code_map_matches_the_tree() {
         unmapped.is_empty(),
         "source files missing from ARCHITECTURE.md's code map: {unmapped:?}"
     );
+}
+
+/// The most fields a struct may have: past it, a struct is several things, each better a
+/// component owning its own state behind a narrow interface.
+const MAX_FIELDS: usize = 20;
+
+/// Each `struct NAME { … }` of `text` with braces: its name, line and number of fields.
+fn structs_of(text: &str) -> Vec<(String, usize, usize)> {
+    let lines: Vec<&str> = text.lines().collect();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < lines.len() {
+        let t = lines[i].trim_start();
+        let t = t.strip_prefix("pub ").unwrap_or(t);
+        let t = t
+            .strip_prefix("pub(crate) ")
+            .or_else(|| t.strip_prefix("pub(super) "))
+            .unwrap_or(t);
+        let Some(rest) = t.strip_prefix("struct ") else {
+            i += 1;
+            continue;
+        };
+        if !lines[i].trim_end().ends_with('{') {
+            i += 1;
+            continue;
+        }
+        let name: String = rest
+            .chars()
+            .take_while(|c| c.is_alphanumeric() || *c == '_')
+            .collect();
+        let (start, mut depth, mut fields) = (i, 1i32, 0usize);
+        i += 1;
+        while i < lines.len() && depth > 0 {
+            let l = lines[i].trim_start();
+            if depth == 1 && !l.starts_with("//") && !l.starts_with('#') {
+                let l = l.strip_prefix("pub ").unwrap_or(l);
+                let l = l
+                    .strip_prefix("pub(crate) ")
+                    .or_else(|| l.strip_prefix("pub(super) "))
+                    .unwrap_or(l);
+                let field: String = l
+                    .chars()
+                    .take_while(|c| c.is_alphanumeric() || *c == '_')
+                    .collect();
+                if !field.is_empty() && l[field.len()..].trim_start().starts_with(':') {
+                    fields += 1;
+                }
+            }
+            depth += lines[i].matches('{').count() as i32 - lines[i].matches('}').count() as i32;
+            i += 1;
+        }
+        out.push((name, start + 1, fields));
+    }
+    out
+}
+
+#[test]
+fn no_struct_has_over_20_fields() {
+    let mut big = Vec::new();
+    let mut seen = 0;
+    for file in rust_files(&root().join("crates")) {
+        if !file.components().any(|c| c.as_os_str() == "src") {
+            continue;
+        }
+        for (name, line, fields) in structs_of(&std::fs::read_to_string(&file).unwrap()) {
+            seen += 1;
+            if fields > MAX_FIELDS {
+                big.push(format!(
+                    "{name} ({}:{line}, {fields} fields)",
+                    file.display()
+                ));
+            }
+        }
+    }
+    assert!(seen > 100, "only {seen} structs found");
+    assert!(
+        big.is_empty(),
+        "split these structs into components: {big:?}"
+    );
+    // The count sees fields, with attributes, comments and nested braces.
+    let sample = "pub struct A {\n    /// doc\n    pub a: u8,\n    #[x]\n    pub(crate) b: Vec<u8>,\n    c: fn() -> u8,\n    d: [u8; 2],\n}\nstruct B { }\n";
+    assert_eq!(structs_of(sample), [("A".to_string(), 1, 4)]);
 }
