@@ -213,5 +213,5 @@ pub fn statement_in(text: &str, pos: SrcPos) -> String {
     }
 }
 
-/// How many lines [`statement_at`] follows a statement over before it stops.
+/// How many lines [`statement_in`] follows a statement over before it stops.
 pub const STATEMENT_LINES: usize = 8;
