@@ -185,9 +185,13 @@ pub fn start(request: RunRequest<'_>) -> Result<Run, RunError> {
         let created = vworks_model::output::temp_beside(path, &inputs_of(&cell))
             .map_err(|e| e.to_string())
             .and_then(|temp| {
-                McapLog::create(&temp, &Arc::new(vworks_se::describe::describe(&cell)), every)
-                    .map_err(|e| named(&e.to_string(), &temp, path))
-                    .map(|l| (temp, l))
+                McapLog::create(
+                    &temp,
+                    &Arc::new(vworks_se::describe::describe(&cell)),
+                    every,
+                )
+                .map_err(|e| named(&e.to_string(), &temp, path))
+                .map(|l| (temp, l))
             });
         match created {
             Ok((temp, l)) => {

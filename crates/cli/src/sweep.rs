@@ -21,8 +21,8 @@ use std::time::Duration;
 
 use vworks_app::inputs_of;
 use vworks_cell::{Cell, Disk, Loader};
-use vworks_model::output::{Output, OutputError};
 use vworks_log::result::Outcome;
+use vworks_model::output::{Output, OutputError};
 use vworks_sweep::run::{RunOptions, VariantSet};
 use vworks_sweep::stream::{Format, TableFile, TableWriter};
 use vworks_sweep::table::{self, Best, Value};

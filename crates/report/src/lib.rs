@@ -31,6 +31,7 @@ pub use vworks_log::stats::Activity;
 
 pub mod playback;
 pub mod viewer;
+use viewer::esc;
 
 /// The README's Rust example, compiled by `cargo test --doc` so that it stays true (this
 /// crate sits at the end of the run's data flow, so it can see every crate the example
@@ -296,22 +297,6 @@ pub fn write_report(log: &std::path::Path, out: &std::path::Path) -> Result<Writ
         has_view: viewer::missing(&contents).is_none(),
         damage: contents.damage,
     })
-}
-
-/// Escapes text for HTML.
-fn esc(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&#39;"),
-            c => out.push(c),
-        }
-    }
-    out
 }
 
 fn secs(ns: i64) -> String {

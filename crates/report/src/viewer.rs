@@ -22,7 +22,6 @@ use std::fmt::Write as _;
 use serde_json::{Value, json};
 use vworks_log::mcaplog::LogContents;
 
-use crate::esc;
 use crate::playback::{Playback, f32_base64};
 
 /// three.js (with its `OrbitControls`), minified, inlined into every report with a 3D view.
@@ -360,3 +359,19 @@ pub const STYLE: &str = r#"
 #play { min-width: 70px; }
 #gantt { cursor: pointer; } tr[data-t] { cursor: pointer; } tr[data-t]:hover { background: #f2f6fc; }
 "#;
+
+/// Escapes text for HTML.
+pub(crate) fn esc(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&#39;"),
+            c => out.push(c),
+        }
+    }
+    out
+}

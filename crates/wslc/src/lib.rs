@@ -30,8 +30,10 @@ mod language;
 pub mod lexer;
 pub mod link;
 mod lower;
+mod output;
 pub mod parser;
 pub mod rapid;
+mod suggest;
 pub mod syntax;
 pub mod units;
 
@@ -39,6 +41,8 @@ use frontend::program::ProgramText;
 
 pub use diag::{Code, Diagnostic, Severity, Sources, Stage, render};
 pub use language::Language;
+pub use output::{CompileError, Compiled};
+pub use suggest::nearest;
 
 /// Every built-in function as (name, signature, result), in the order of
 /// docs/language.md's table: for editors, completions and documentation tools.
@@ -48,45 +52,6 @@ pub fn builtin_functions() -> impl Iterator<Item = (&'static str, &'static str, 
         .map(|b| (b.name, b.signature, b.returns))
 }
 pub use vworks_vm::Module;
-
-/// A successful compilation.
-#[derive(Debug, Clone)]
-pub struct Compiled {
-    /// The verified bytecode module.
-    pub module: Module,
-    /// Warnings (never errors).
-    pub warnings: Vec<Diagnostic>,
-}
-
-/// A failed compilation: every diagnostic found, errors and warnings, in source order.
-#[derive(Debug, Clone, thiserror::Error)]
-#[error("{}", summary(.diagnostics))]
-pub struct CompileError {
-    /// All diagnostics, sorted by position.
-    pub diagnostics: Vec<Diagnostic>,
-}
-
-fn summary(d: &[Diagnostic]) -> String {
-    let errors: Vec<String> = d
-        .iter()
-        .filter(|d| d.is_error())
-        .map(Diagnostic::short)
-        .collect();
-    errors.join("\n")
-}
-
-/// The candidate nearest to `name` by edit distance, if one is near enough to be a
-/// likely misspelling (at most 2 edits, and fewer than its length; the first by name on a
-/// tie): for "did you mean" hints in programs (E0010, E0011) and workcell files alike.
-pub fn nearest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
-    candidates
-        .into_iter()
-        .filter(|c| !c.is_empty())
-        .map(|c| (lower::edit_distance(name, c), c))
-        .filter(|(d, c)| *d <= 2 && *d < c.len())
-        .min()
-        .map(|(_, c)| c)
-}
 
 /// A program file's bytes that are not UTF-8 text: where the first bad byte is.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -140,7 +105,7 @@ pub fn compile_files(files: &[(&str, &str)]) -> Result<Compiled, CompileError> {
         ast.items.extend(file.items);
     }
     let syntax_ok = !diags.iter().any(Diagnostic::is_error);
-    finish(&program, syntax_ok.then_some(&ast), diags)
+    lower::finish(&program, syntax_ok.then_some(&ast), diags)
 }
 
 /// Compiles a program in the given language.
@@ -161,47 +126,5 @@ pub fn compile_program(
     match language {
         Language::Wsl => compile_files(files),
         Language::Rapid => rapid::compile_files(files, io),
-    }
-}
-
-/// Checks and generates code for a syntax tree (if the front-end produced one), verifies
-/// the module, and resolves and sorts the diagnostics.
-pub(crate) fn finish(
-    program: &ProgramText,
-    ast: Option<&syntax::SourceModule>,
-    mut diags: Vec<Diagnostic>,
-) -> Result<Compiled, CompileError> {
-    let mut module = if !diags.iter().any(Diagnostic::is_error)
-        && let Some(ast) = ast
-    {
-        Some(lower::lower(program, ast, &mut diags))
-    } else {
-        None
-    };
-    if let Some(m) = module.as_mut()
-        && !diags.iter().any(Diagnostic::is_error)
-        && let Err(e) = m.verify()
-    {
-        diags.push(
-            Diagnostic::error(
-                Code::E0900,
-                format!("the compiler produced invalid bytecode: {e}"),
-                syntax::Span::default(),
-            )
-            .with_help(
-                "this is a bug in vworks; please report it with the program that triggers it",
-            ),
-        );
-    }
-    for d in &mut diags {
-        program.resolve(d);
-    }
-    diags.sort_by_key(|d| (program.order_of(&d.at.file), d.at.line, d.at.col));
-    match module {
-        Some(module) if !diags.iter().any(Diagnostic::is_error) => Ok(Compiled {
-            module,
-            warnings: diags,
-        }),
-        _ => Err(CompileError { diagnostics: diags }),
     }
 }

@@ -29,13 +29,13 @@ use vworks_vm::bytecode::SrcPos;
 use vworks_vm::machine::{Event, EventKind, Next, Vm, VmConfig};
 use vworks_vm::types::fmt_quantity;
 
+use vworks_cell::Cell;
+use vworks_log::issue::{Issue, IssueKind};
 use vworks_log::result::{Outcome, RunResult};
 use vworks_log::sink::RunSink;
 use vworks_log::stats::Ending;
 use vworks_log::trace::format_value;
-use vworks_log::issue::{Issue, IssueKind};
 use vworks_log::trace::{Detail, Kind, TraceEvent, Value};
-use vworks_cell::Cell;
 
 mod boundary;
 mod globals;
@@ -442,13 +442,8 @@ impl Simulation {
             }
             Entry::CheckWait(r, cg) => {
                 self.lists.wait_checked(r);
-                self.recording.record(
-                    t,
-                    Some(r),
-                    Kind::CheckWait,
-                    Detail::Global(cg),
-                    None,
-                );
+                self.recording
+                    .record(t, Some(r), Kind::CheckWait, Detail::Global(cg), None);
                 let cond = self.vms[r].waiting_cond();
                 if self.vms[r].check_wait(t) {
                     // What r does next follows the sets whose values released it: the
@@ -465,13 +460,8 @@ impl Simulation {
             }
             Entry::CheckWhen(r, cg) => {
                 self.lists.when_checked(r);
-                self.recording.record(
-                    t,
-                    Some(r),
-                    Kind::CheckWhen,
-                    Detail::Global(cg),
-                    None,
-                );
+                self.recording
+                    .record(t, Some(r), Kind::CheckWhen, Detail::Global(cg), None);
                 if self.vms[r].check_when(t) > 0 {
                     // The handlers it fires follow the sets of every global their
                     // conditions read (all of r's condition handlers were tested).
@@ -540,8 +530,14 @@ impl Simulation {
         // earliest, so the trace stays in time order.
         for w in self.vms[r].take_warnings() {
             let t = w.time.max(e.time);
-            self.recording
-                .warning(&self.cell, t, Some(r), Some(w.pos), w.kind.into(), w.message);
+            self.recording.warning(
+                &self.cell,
+                t,
+                Some(r),
+                Some(w.pos),
+                w.kind.into(),
+                w.message,
+            );
         }
         if self.outcome.is_none() {
             self.requeue(r);

@@ -7,12 +7,12 @@ use std::collections::BTreeMap;
 use vworks_cell::Cell;
 use vworks_vm::bytecode::SrcPos;
 
+use crate::world::World;
+use vworks_log::issue::{Issue, IssueKind};
 use vworks_log::place::Contact;
 use vworks_log::sink::{RunEnd, RunSink};
 use vworks_log::stats::{Fold, RobotStats};
-use vworks_log::issue::{Issue, IssueKind};
 use vworks_log::trace::{Detail, Kind, TraceEvent};
-use crate::world::World;
 
 use super::limit::EVENT_LIMIT;
 
@@ -193,7 +193,7 @@ impl Recording {
         pos: Option<SrcPos>,
     ) -> Issue {
         Issue {
-            kind: kind.into(),
+            kind,
             message,
             robot: robot.map(|r| cell.robots[r].name.clone()),
             file: robot
@@ -222,13 +222,7 @@ impl Recording {
         } else {
             self.warnings.push(issue.clone());
         }
-        self.record(
-            t,
-            robot,
-            severity,
-            Detail::Issue(Box::new(issue)),
-            pos,
-        );
+        self.record(t, robot, severity, Detail::Issue(Box::new(issue)), pos);
     }
 
     /// A `warning` trace event and the run's warning of `kind`.
@@ -268,13 +262,7 @@ impl Recording {
     /// A collision started: a `collision_start` event and the run's collision.
     pub(super) fn collision(&mut self, contact: Contact) {
         let detail = Detail::Collision(Box::new(contact.clone()));
-        self.record(
-            contact.time_ns,
-            None,
-            Kind::CollisionStart,
-            detail,
-            None,
-        );
+        self.record(contact.time_ns, None, Kind::CollisionStart, detail, None);
         self.collisions.push(contact);
     }
 

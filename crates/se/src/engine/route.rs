@@ -41,8 +41,7 @@ impl Simulation {
             },
             None => Detail::Vm(e.kind.clone()),
         };
-        self.recording
-            .record(t, Some(r), kind, detail, Some(e.pos));
+        self.recording.record(t, Some(r), kind, detail, Some(e.pos));
         if let Some((cg, value)) = set {
             self.on_set(r, cg as usize, value, t, e.pos);
             return;
@@ -152,8 +151,13 @@ impl Simulation {
             EventKind::Grip { site } => self.grip(r, *site as usize, t, e.pos),
             EventKind::Release { site } => self.release(r, *site as usize, t, e.pos),
             EventKind::Error { message } => {
-                let issue =
-                    Recording::issue(cell, IssueKind::Runtime, message.clone(), Some(r), Some(e.pos));
+                let issue = Recording::issue(
+                    cell,
+                    IssueKind::Runtime,
+                    message.clone(),
+                    Some(r),
+                    Some(e.pos),
+                );
                 self.recording.vm_error(issue);
                 self.outcome = Some(Outcome::Error);
             }
@@ -307,8 +311,14 @@ impl Simulation {
     /// A runtime error the SE finds in robot `r`'s event at `t` (a part gripped twice):
     /// an `error` event at the statement, and the run stops.
     fn runtime_error(&mut self, r: usize, t: i64, pos: SrcPos, message: String) {
-        self.recording
-            .error(&self.cell, t, Some(r), Some(pos), IssueKind::Runtime, message);
+        self.recording.error(
+            &self.cell,
+            t,
+            Some(r),
+            Some(pos),
+            IssueKind::Runtime,
+            message,
+        );
         self.vms[r].halt();
         self.outcome = Some(Outcome::Error);
     }

@@ -100,7 +100,7 @@ impl Compiler<'_> {
         if let Some(f) = self.fns.last() {
             candidates.extend(f.scopes.iter().flatten().map(|l| l.name.clone()));
         }
-        let best = crate::nearest(name, candidates.iter().map(String::as_str));
+        let best = crate::suggest::nearest(name, candidates.iter().map(String::as_str));
         let mut d = Diagnostic::error(Code::E0010, format!("unknown name `{name}`"), span)
             .with_label("not declared");
         d = match best {
@@ -116,7 +116,7 @@ impl Compiler<'_> {
             .iter()
             .map(|s| s.name.as_str())
             .chain(BUILTINS.iter().map(|b| b.name));
-        let best = crate::nearest(name, names);
+        let best = crate::suggest::nearest(name, names);
         let mut d = Diagnostic::error(
             Code::E0011,
             format!("unknown procedure or function `{name}`"),

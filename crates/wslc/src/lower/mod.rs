@@ -289,20 +289,6 @@ struct Compiler<'d> {
 const TYPE_NAMES: &str =
     "bool, int, num, length, angle, time, speed, angspeed, accel, angaccel, joints, pose";
 
-pub(crate) fn edit_distance(a: &str, b: &str) -> usize {
-    let b: Vec<char> = b.chars().collect();
-    let mut prev: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut cur = vec![i + 1];
-        for (j, cb) in b.iter().enumerate() {
-            let sub = prev[j] + usize::from(ca != *cb);
-            cur.push(sub.min(prev[j + 1] + 1).min(cur[j] + 1));
-        }
-        prev = cur;
-    }
-    prev[b.len()]
-}
-
 impl Compiler<'_> {
     // ---- infrastructure ------------------------------------------------------------------
 
@@ -368,5 +354,47 @@ fn cmp_of(op: BinOp) -> Cmp {
         BinOp::Le => Cmp::Le,
         BinOp::Gt => Cmp::Gt,
         _ => Cmp::Ge,
+    }
+}
+
+/// Checks and generates code for a syntax tree (if the front-end produced one), verifies
+/// the module, and resolves and sorts the diagnostics.
+pub(crate) fn finish(
+    program: &ProgramText,
+    ast: Option<&SourceModule>,
+    mut diags: Vec<Diagnostic>,
+) -> Result<crate::output::Compiled, crate::output::CompileError> {
+    let mut module = if !diags.iter().any(Diagnostic::is_error)
+        && let Some(ast) = ast
+    {
+        Some(lower(program, ast, &mut diags))
+    } else {
+        None
+    };
+    if let Some(m) = module.as_mut()
+        && !diags.iter().any(Diagnostic::is_error)
+        && let Err(e) = m.verify()
+    {
+        diags.push(
+            Diagnostic::error(
+                Code::E0900,
+                format!("the compiler produced invalid bytecode: {e}"),
+                Span::default(),
+            )
+            .with_help(
+                "this is a bug in vworks; please report it with the program that triggers it",
+            ),
+        );
+    }
+    for d in &mut diags {
+        program.resolve(d);
+    }
+    diags.sort_by_key(|d| (program.order_of(&d.at.file), d.at.line, d.at.col));
+    match module {
+        Some(module) if !diags.iter().any(Diagnostic::is_error) => Ok(crate::output::Compiled {
+            module,
+            warnings: diags,
+        }),
+        _ => Err(crate::output::CompileError { diagnostics: diags }),
     }
 }

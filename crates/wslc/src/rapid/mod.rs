@@ -19,7 +19,7 @@ pub mod parser;
 pub mod syntax;
 
 use crate::diag::Diagnostic;
-use crate::{CompileError, Compiled};
+use crate::output::{CompileError, Compiled};
 
 /// File extensions of RAPID modules: `.mod`, `.modx`, `.sys`, `.sysx`, `.prg`
 /// ([`crate::Language::of_source_file`] reads them).
@@ -149,5 +149,5 @@ pub fn compile_files(
         }
         Some(lower::translate(&modules, io, &mut diags))
     };
-    crate::finish(&program, ast.as_ref(), diags)
+    crate::lower::finish(&program, ast.as_ref(), diags)
 }

@@ -129,7 +129,7 @@ impl Tr<'_> {
             )
             .chain(self.scope.keys().cloned())
             .collect();
-        let near = crate::nearest(&key, names.iter().map(String::as_str)).map(|m| {
+        let near = crate::suggest::nearest(&key, names.iter().map(String::as_str)).map(|m| {
             self.spelled
                 .get(m)
                 .cloned()

@@ -201,7 +201,7 @@ impl Tr<'_> {
                     } else {
                         names.join(", ")
                     };
-                    let near = crate::nearest(&n.text, io.iter().map(|s| s.name.as_str()))
+                    let near = crate::suggest::nearest(&n.text, io.iter().map(|s| s.name.as_str()))
                         .map(|m| format!("did you mean `{m}`? "))
                         .unwrap_or_default();
                     self.error(

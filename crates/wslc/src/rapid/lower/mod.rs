@@ -187,7 +187,7 @@ pub(crate) struct Tr<'d> {
 pub(crate) fn wsl_name(n: &r::Name) -> String {
     let k = n.key();
     // Names WSL's own built-in functions take get a `'`.
-    if crate::builtin_functions().any(|(b, _, _)| b == k) {
+    if crate::lower::BUILTINS.iter().any(|b| b.name == k) {
         format!("{k}'")
     } else {
         k

@@ -602,12 +602,13 @@ impl Tr<'_> {
                     .filter(|(_, s)| matches!(s, Sym::Routine(_)))
                     .map(|(k, _)| k.clone())
                     .collect();
-                let near = crate::nearest(&key, names.iter().map(String::as_str)).map(|m| {
-                    self.spelled
-                        .get(m)
-                        .cloned()
-                        .unwrap_or_else(|| m.to_string())
-                });
+                let near =
+                    crate::suggest::nearest(&key, names.iter().map(String::as_str)).map(|m| {
+                        self.spelled
+                            .get(m)
+                            .cloned()
+                            .unwrap_or_else(|| m.to_string())
+                    });
                 let elsewhere = self.local_elsewhere(&key);
                 let d = self.error(
                     Code::E0011,
