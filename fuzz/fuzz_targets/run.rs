@@ -8,7 +8,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use libfuzzer_sys::fuzz_target;
-use vworks_se::describe::CellNames;
+use vworks_se::CellNames;
 
 #[path = "cellfiles.rs"]
 mod cellfiles;
@@ -25,9 +25,9 @@ fuzz_target!(|data: &[u8]| {
     }
     let cell = Arc::new(cell);
     let log_path = std::env::temp_dir().join(format!("vworks-fuzz-run-{}.mcap", std::process::id()));
-    let log = vworks_log::mcaplog::McapLog::create(&log_path, &Arc::new(vworks_se::describe::describe(&cell)), 1).expect("a log file in the temp folder");
+    let log = vworks_log::mcaplog::McapLog::create(&log_path, &Arc::new(vworks_se::describe(&cell)), 1).expect("a log file in the temp folder");
     // Zero-time loops end at a tenth of the default bounds: the point is that they end.
-    let mut sim = vworks_se::engine::Simulation::new(Arc::clone(&cell))
+    let mut sim = vworks_se::Simulation::new(Arc::clone(&cell))
         .with_log(log)
         .with_robot_instant_limit(10_000)
         .with_instant_limit(100_000);

@@ -26,7 +26,7 @@ use std::sync::atomic::AtomicBool;
 use vworks_cell::{Cell, CellError, Disk, Loader, Override};
 use vworks_log::mcaplog::McapLog;
 use vworks_log::result::RunResult;
-use vworks_se::engine::Simulation;
+use vworks_se::Simulation;
 
 /// The latest time a run may be asked to stop at (ns): the engine's clock range.
 pub const UNTIL_LIMIT_NS: i64 = 1 << 62;
@@ -185,13 +185,9 @@ pub fn start(request: RunRequest<'_>) -> Result<Run, RunError> {
         let created = vworks_model::output::temp_beside(path, &inputs_of(&cell))
             .map_err(|e| e.to_string())
             .and_then(|temp| {
-                McapLog::create(
-                    &temp,
-                    &Arc::new(vworks_se::describe::describe(&cell)),
-                    every,
-                )
-                .map_err(|e| named(&e.to_string(), &temp, path))
-                .map(|l| (temp, l))
+                McapLog::create(&temp, &Arc::new(vworks_se::describe(&cell)), every)
+                    .map_err(|e| named(&e.to_string(), &temp, path))
+                    .map(|l| (temp, l))
             });
         match created {
             Ok((temp, l)) => {

@@ -30,7 +30,7 @@ use std::process::ExitCode;
 use vworks_cell::{Cell, CellError};
 use vworks_log::issue::issue_json;
 use vworks_model::math::Iso;
-use vworks_se::collide::{Collider, CollisionEvent};
+use vworks_se::{Collider, CollisionEvent};
 use vworks_vm::bytecode::{MoveFlags, ProcInfo};
 use vworks_vm::{ConstValue, Instr, Module};
 
@@ -609,7 +609,7 @@ fn constant_operand(
 /// The bodies at the start (every robot at its home): collisions and near misses, as the
 /// run's first collision check finds them.
 fn at_the_start(cell: &Cell, text: &str, problems: &mut Vec<Problem>) {
-    let vms = vworks_se::engine::robot_vms(cell);
+    let vms = vworks_se::robot_vms(cell);
     let mut collider = Collider::new(cell);
     let moving = vec![false; vms.len()];
     let file = cell.file.display().to_string();

@@ -17,7 +17,7 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use vworks_se::describe::CellNames;
+use vworks_se::CellNames;
 
 use clap::{Parser, Subcommand};
 
@@ -629,7 +629,7 @@ fn log_line(l: &vworks_log::place::LogLine) -> String {
 /// With `print_logs`, the programs' `log` lines print on stdout as they happen (above the
 /// bar).
 fn simulate(
-    mut sim: vworks_se::engine::Simulation,
+    mut sim: vworks_se::Simulation,
     until: Option<i64>,
     progress: Option<std::time::Instant>,
     print_logs: bool,

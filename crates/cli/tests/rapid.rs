@@ -18,8 +18,8 @@ use std::sync::Arc;
 use common::{parse, test_every_case};
 use expect_test::expect_file;
 use vworks_cell::MemoryFiles;
-use vworks_se::describe::CellNames;
-use vworks_se::engine::Simulation;
+use vworks_se::CellNames;
+use vworks_se::Simulation;
 
 /// Runs the cell in `files` (with `cell.toml` edited by `edit`): the trace lines, each
 /// with and without its source position, and the outcome.

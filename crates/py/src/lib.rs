@@ -223,8 +223,7 @@ impl Cell {
         Simulation {
             cell: Arc::clone(&self.cell),
             sim: Some(
-                vworks_se::engine::Simulation::new(Arc::clone(&self.cell))
-                    .with_stop(Arc::clone(&stop)),
+                vworks_se::Simulation::new(Arc::clone(&self.cell)).with_stop(Arc::clone(&stop)),
             ),
             result: None,
             stop,
@@ -323,7 +322,7 @@ fn json_object(py: Python<'_>, json: &str) -> PyResult<Py<PyAny>> {
 
 fn event(cell: &vworks_cell::Cell, e: &TraceEvent) -> Event {
     Event {
-        e: e.resolve(&vworks_se::describe::CellNames(cell)),
+        e: e.resolve(&vworks_se::CellNames(cell)),
     }
 }
 
@@ -739,14 +738,14 @@ const INLINE_SPAN_NS: i64 = 100_000_000;
 struct Simulation {
     cell: Arc<vworks_cell::Cell>,
     /// `None` once `result()` ended it.
-    sim: Option<vworks_se::engine::Simulation>,
+    sim: Option<vworks_se::Simulation>,
     result: Option<Py<RunReport>>,
     /// Set by Ctrl-C during `run_until` or `run`: the run ends, outcome `interrupted`.
     stop: Arc<AtomicBool>,
 }
 
 impl Simulation {
-    fn running(&self) -> PyResult<&vworks_se::engine::Simulation> {
+    fn running(&self) -> PyResult<&vworks_se::Simulation> {
         self.sim
             .as_ref()
             .ok_or_else(|| Error::new_err("this simulation has ended: result() was called"))
@@ -760,7 +759,7 @@ impl Simulation {
         &mut self,
         py: Python<'_>,
         interruptible: bool,
-        f: impl FnOnce(&mut vworks_se::engine::Simulation) -> bool + Send,
+        f: impl FnOnce(&mut vworks_se::Simulation) -> bool + Send,
     ) -> PyResult<bool> {
         let sim = self
             .sim

@@ -10,7 +10,7 @@ use std::sync::Arc;
 
 use vworks_log::mcaplog::{McapLog, read_log};
 use vworks_report::Report;
-use vworks_se::engine::Simulation;
+use vworks_se::Simulation;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -39,8 +39,7 @@ fn the_report_gives_the_runs_own_statistics() {
             until.unwrap_or(0),
             std::process::id()
         ));
-        let log =
-            McapLog::create(&path, &Arc::new(vworks_se::describe::describe(&c)), every).unwrap();
+        let log = McapLog::create(&path, &Arc::new(vworks_se::describe(&c)), every).unwrap();
         let r = Simulation::new(Arc::clone(&c)).with_log(log).run(until);
         assert!(r.log_error.is_none(), "{cell}: {:?}", r.log_error);
         let contents = read_log(&path).unwrap();
@@ -69,7 +68,7 @@ fn the_report_gives_the_runs_own_statistics() {
 fn handoff_idle_time_is_one_number() {
     let c = Arc::new(vworks_cell::load(&root().join("workcells/handoff/cell.toml")).unwrap());
     let path = std::env::temp_dir().join(format!("vworks-agree-idle-{}.mcap", std::process::id()));
-    let log = McapLog::create(&path, &Arc::new(vworks_se::describe::describe(&c)), 1).unwrap();
+    let log = McapLog::create(&path, &Arc::new(vworks_se::describe(&c)), 1).unwrap();
     let r = Simulation::new(Arc::clone(&c)).with_log(log).run(None);
     let contents = read_log(&path).unwrap();
     let _ = std::fs::remove_file(&path);

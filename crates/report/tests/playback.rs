@@ -11,7 +11,7 @@ use std::sync::Arc;
 use vworks_log::mcaplog::{McapLog, ReadOptions, read_log_with};
 use vworks_log::trace::Kind;
 use vworks_report::playback::{FRAMES_PER_SECOND, Joint, Playback};
-use vworks_se::engine::Simulation;
+use vworks_se::Simulation;
 
 fn log_of(cell: &str) -> vworks_log::mcaplog::LogContents {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
@@ -24,7 +24,7 @@ fn log_of_cell(cell: &str, file: &std::path::Path) -> vworks_log::mcaplog::LogCo
         "vworks-playback-{cell}-{}.mcap",
         std::process::id()
     ));
-    let log = McapLog::create(&path, &Arc::new(vworks_se::describe::describe(&c)), 1).unwrap();
+    let log = McapLog::create(&path, &Arc::new(vworks_se::describe(&c)), 1).unwrap();
     Simulation::new(Arc::clone(&c)).with_log(log).run(None);
     let contents = read_log_with(&path, ReadOptions { poses: true }).unwrap();
     let _ = std::fs::remove_file(&path);

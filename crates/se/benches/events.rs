@@ -15,7 +15,7 @@ use std::time::Instant;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use vworks_cell::{Cell, load};
-use vworks_se::engine::Simulation;
+use vworks_se::Simulation;
 
 fn cell(dir: &Path, robots: &[(&str, String)]) -> Arc<Cell> {
     std::fs::create_dir_all(dir).unwrap();

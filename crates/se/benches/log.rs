@@ -21,12 +21,12 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use vworks_cell::{Cell, load};
 use vworks_log::mcaplog::{Encoding, LogOptions, McapLog};
 use vworks_log::result::RunResult;
-use vworks_se::engine::Simulation;
+use vworks_se::Simulation;
 
 fn logged(cell: &Arc<Cell>, path: &Path, encoding: Encoding) -> RunResult {
     let log = McapLog::create_with(
         path,
-        &Arc::new(vworks_se::describe::describe(cell)),
+        &Arc::new(vworks_se::describe(cell)),
         LogOptions::new(1, encoding),
     )
     .unwrap();

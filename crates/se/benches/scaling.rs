@@ -21,7 +21,7 @@ use std::time::Instant;
 use criterion::{Criterion, criterion_group, criterion_main};
 use vworks_cell::{Cell, load};
 use vworks_log::mcaplog::McapLog;
-use vworks_se::engine::Simulation;
+use vworks_se::Simulation;
 
 /// A cell of `n` arms 1.2 m apart on a square grid; each moves back and forth `rounds`
 /// times (about 2.9 s per round).
@@ -93,12 +93,7 @@ fn scaling(c: &mut Criterion) {
     let log_path: PathBuf = tmp.join("minute.mcap");
     let logged = seconds(runs, || {
         let _ = std::fs::remove_file(&log_path);
-        let log = McapLog::create(
-            &log_path,
-            &Arc::new(vworks_se::describe::describe(&minute)),
-            1,
-        )
-        .unwrap();
+        let log = McapLog::create(&log_path, &Arc::new(vworks_se::describe(&minute)), 1).unwrap();
         std::hint::black_box(Simulation::new(Arc::clone(&minute)).with_log(log).run(None));
     });
     println!(

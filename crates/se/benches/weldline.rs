@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use vworks_se::engine::Simulation;
+use vworks_se::Simulation;
 
 fn weldline(c: &mut Criterion) {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../workcells/weldline/cell.toml");

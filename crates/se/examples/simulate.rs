@@ -18,7 +18,7 @@ fn main() {
     let t0 = std::time::Instant::now();
     let mut end = 0;
     for _ in 0..runs {
-        end = vworks_se::engine::Simulation::new(std::sync::Arc::clone(&cell))
+        end = vworks_se::Simulation::new(std::sync::Arc::clone(&cell))
             .run(None)
             .end_time_ns;
     }

@@ -8,7 +8,7 @@ fn main() {
     let cell = std::sync::Arc::new(vworks_cell::load(std::path::Path::new(&path)).unwrap());
     for _ in 0..5 {
         let t = std::time::Instant::now();
-        let r = vworks_se::engine::Simulation::new(std::sync::Arc::clone(&cell)).run(None);
+        let r = vworks_se::Simulation::new(std::sync::Arc::clone(&cell)).run(None);
         let s = t.elapsed().as_secs_f64();
         println!(
             "{:.1} ms, {:.0}x real time",

@@ -10,7 +10,7 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use vworks_se::engine::Simulation;
+use vworks_se::Simulation;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../workcells");

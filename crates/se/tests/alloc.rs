@@ -27,7 +27,7 @@ fn the_hot_loops_allocate_nothing_in_steady_state() {
 fn four_arms_run_for_thousands_of_cycles_without_allocating() {
     let cell = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../bench/cells/grid4/cell.toml");
     let cell = Arc::new(vworks_cell::load(&cell).unwrap());
-    let mut sim = vworks_se::engine::Simulation::new(cell);
+    let mut sim = vworks_se::Simulation::new(cell);
     // Warm up: the first motions, scratch buffers sized.
     sim.advance_to(3_000_000_000);
     let events_before = sim.trace().len();
@@ -68,7 +68,7 @@ fn a_ring_of_robots_handing_a_global_round_allocates_nothing_per_event() {
     std::fs::write(dir.join("cell.toml"), toml).unwrap();
     let cell = Arc::new(vworks_cell::load(&dir.join("cell.toml")).unwrap());
     let _ = std::fs::remove_dir_all(&dir);
-    let mut sim = vworks_se::engine::Simulation::new(cell);
+    let mut sim = vworks_se::Simulation::new(cell);
     for _ in 0..5_000 {
         sim.step(None);
     }
@@ -104,7 +104,7 @@ fn two_robots(name: &str, caller_program: &str, server_program: &str) -> vworks_
 /// Steps `cell` past its start, then counts the allocations of the next `steps` steps and
 /// the remote calls among them: (allocations, remote calls).
 fn remote_calls_counted(cell: vworks_cell::Cell, steps: usize) -> (u64, usize) {
-    let mut sim = vworks_se::engine::Simulation::new(Arc::new(cell));
+    let mut sim = vworks_se::Simulation::new(Arc::new(cell));
     for _ in 0..2_000 {
         sim.step(None);
     }

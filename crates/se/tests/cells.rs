@@ -11,8 +11,8 @@ use vworks_log::issue::IssueKind;
 use vworks_log::result::{Outcome, RunResult};
 use vworks_log::stats::Ending;
 use vworks_log::trace::Kind;
-use vworks_se::describe::CellNames;
-use vworks_se::engine::Simulation;
+use vworks_se::CellNames;
+use vworks_se::Simulation;
 
 /// Writes the files into a fresh directory and returns the path of `cell.toml`.
 fn write_cell(name: &str, files: &[(&str, &str)]) -> PathBuf {

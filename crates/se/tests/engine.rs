@@ -13,8 +13,8 @@ use vworks_cell::{Cell, load};
 use vworks_log::issue::IssueKind;
 use vworks_log::result::{Outcome, RunResult};
 use vworks_log::trace::Kind;
-use vworks_se::describe::CellNames;
-use vworks_se::engine::Simulation;
+use vworks_se::CellNames;
+use vworks_se::Simulation;
 
 const EXAMPLES: &[(&str, Outcome)] = &[
     ("handoff", Outcome::Completed),

@@ -14,8 +14,8 @@ use proptest::prelude::*;
 use vworks_cell::{MemoryFiles, load_with};
 use vworks_log::result::Outcome;
 use vworks_log::trace::Kind;
-use vworks_se::describe::CellNames;
-use vworks_se::engine::Simulation;
+use vworks_se::CellNames;
+use vworks_se::Simulation;
 
 const GLOBALS: [&str; 2] = ["a", "b"];
 

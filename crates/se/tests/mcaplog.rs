@@ -16,8 +16,8 @@ use vworks_log::mcaplog::{
 use vworks_log::result::{Outcome, RunResult};
 use vworks_log::trace::Kind;
 use vworks_model::math::Iso;
-use vworks_se::describe::CellNames;
-use vworks_se::engine::Simulation;
+use vworks_se::CellNames;
+use vworks_se::Simulation;
 
 /// `vworks.CycleState` as the log's descriptor defines it (the descriptor itself is checked
 /// in the unit tests and, independently, by the Python tests).
@@ -52,8 +52,7 @@ fn run_logged(
     name: &str,
 ) -> (RunResult, Vec<u8>) {
     let path = std::env::temp_dir().join(format!("vworks-log-{name}-{}.mcap", std::process::id()));
-    let log =
-        McapLog::create(&path, &Arc::new(vworks_se::describe::describe(cell)), every).unwrap();
+    let log = McapLog::create(&path, &Arc::new(vworks_se::describe(cell)), every).unwrap();
     let r = Simulation::new(Arc::clone(cell)).with_log(log).run(until);
     assert!(r.log_error.is_none(), "{:?}", r.log_error);
     let bytes = std::fs::read(&path).unwrap();
@@ -435,7 +434,7 @@ fn protobuf_and_json_logs_carry_the_same_states_and_poses() {
             std::env::temp_dir().join(format!("vworks-log-{name}-{}.mcap", std::process::id()));
         let log = McapLog::create_with(
             &path,
-            &Arc::new(vworks_se::describe::describe(&cell)),
+            &Arc::new(vworks_se::describe(&cell)),
             LogOptions::new(1, encoding),
         )
         .unwrap();
@@ -591,7 +590,7 @@ fn a_log_that_cannot_be_written_is_reported_and_the_run_goes_on() {
     let plain = Simulation::new(Arc::clone(&cell)).run(None);
     let log = McapLog::create(
         Path::new("/dev/full"),
-        &Arc::new(vworks_se::describe::describe(&cell)),
+        &Arc::new(vworks_se::describe(&cell)),
         1,
     )
     .unwrap();
@@ -615,7 +614,7 @@ fn a_log_that_cannot_be_written_is_reported_and_the_run_goes_on() {
     assert!(r.log_counts.is_empty());
     // A file that cannot be created is an error at once, naming it.
     let missing = root().join("no such dir").join("run.mcap");
-    let err = McapLog::create(&missing, &Arc::new(vworks_se::describe::describe(&cell)), 1)
+    let err = McapLog::create(&missing, &Arc::new(vworks_se::describe(&cell)), 1)
         .unwrap_err()
         .to_string();
     assert!(

@@ -11,7 +11,7 @@ use std::path::Path;
 
 use stats_alloc::{INSTRUMENTED_SYSTEM, Region, StatsAlloc};
 use vworks_cell::MemoryFiles;
-use vworks_se::collide::Collider;
+use vworks_se::Collider;
 
 #[global_allocator]
 static GLOBAL: &StatsAlloc<System> = &INSTRUMENTED_SYSTEM;

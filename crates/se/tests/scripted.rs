@@ -8,7 +8,7 @@
 use std::path::Path;
 
 use vworks_model::math::Iso;
-use vworks_se::collide::{Collider, CollisionEvent, RobotPoses, SWEEP_MIN_STEP_NS};
+use vworks_se::{Collider, CollisionEvent, RobotPoses, SWEEP_MIN_STEP_NS};
 use vworks_vm::MAX_AXES;
 
 /// A robot moving its joints from `from` to `to` at constant speed over `[start, end]`

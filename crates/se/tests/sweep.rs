@@ -12,8 +12,8 @@ use vworks_cell::load;
 use vworks_log::issue::IssueKind;
 use vworks_log::result::{Outcome, RunResult};
 use vworks_log::trace::Kind;
-use vworks_se::describe::CellNames;
-use vworks_se::engine::Simulation;
+use vworks_se::CellNames;
+use vworks_se::Simulation;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")

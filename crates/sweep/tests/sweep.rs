@@ -165,7 +165,7 @@ fn a_row_is_the_run_of_the_workcell_written_with_its_values() {
     assert_ne!(edited, text);
     std::fs::write(dir.join("cell.toml"), edited).unwrap();
     let cell = Arc::new(vworks_cell::load(&dir.join("cell.toml")).unwrap());
-    let plain = vworks_se::engine::Simulation::new(cell).run(None);
+    let plain = vworks_se::Simulation::new(cell).run(None);
     let _ = std::fs::remove_dir_all(&dir);
     assert_eq!(row.outcome, RowOutcome::Run(plain.outcome));
     assert_eq!(row.end_time, plain.end_time_ns as f64 / 1e9);

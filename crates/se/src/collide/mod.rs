@@ -344,7 +344,7 @@ impl Collider {
     /// bounds × their lever arms); the pairs the check's broadphase kept have their
     /// promises (`safe_until`); a pair whose boxes are apart but within the look-ahead's
     /// reach closes at most at `v_i + v_j` from its boxes' distance; a pair farther apart
-    /// than that cannot close before the look-ahead ([`HORIZON_NS`]) ends.
+    /// than that cannot close before the look-ahead (`HORIZON_NS`) ends.
     pub fn horizon(&self) -> i64 {
         self.lookahead.horizon
     }
