@@ -9,30 +9,11 @@
 //! signals (`vworks_wslc::rapid::compile_with_io`); a signal a program names that its
 //! robot does not have is error E0302 at the program's line.
 
-use serde::Deserialize;
 use vworks_wslc::rapid::{IoSignal, SignalKind};
 
-use crate::{CellError, Ctx};
-
-/// One `[[io]]` table.
-#[derive(Deserialize, Debug, Clone)]
-#[serde(deny_unknown_fields)]
-pub(crate) struct IoFile {
-    name: String,
-    kind: String,
-    robot: String,
-    #[serde(default)]
-    inputs: Vec<IoInputFile>,
-    value: Option<i64>,
-}
-
-/// An input a wire drives.
-#[derive(Deserialize, Debug, Clone)]
-#[serde(deny_unknown_fields)]
-pub(crate) struct IoInputFile {
-    robot: String,
-    name: String,
-}
+use crate::context::Ctx;
+use crate::error::CellError;
+use crate::file::IoFile;
 
 /// Each robot's signals (in robot order), from the `[[io]]` tables; `None` when the cell
 /// has none (then a RAPID program's signals are globals of their own names).

@@ -9,7 +9,8 @@ use std::sync::Arc;
 
 use vworks_vm::{ConstValue, Module, Type};
 
-use crate::{CellError, Ctx};
+use crate::context::Ctx;
+use crate::error::CellError;
 
 /// The `param`s `module` declares: name, type and default value, in declaration order.
 pub fn declared(module: &Module) -> Vec<(String, Type, ConstValue)> {

@@ -3,7 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::{CellError, Ctx};
+use crate::context::Ctx;
+use crate::error::CellError;
 
 /// Where ROS keeps packages, searched for `package://` meshes after the workcell's
 /// `package_path`: each folder of `ROS_PACKAGE_PATH` (ROS 1), and `PREFIX/share` for each
@@ -100,17 +101,6 @@ pub(crate) fn program_files(
         ));
     }
     Ok(paths)
-}
-
-/// What to do about a file that cannot be read.
-pub(crate) fn read_hint(e: &std::io::Error) -> &'static str {
-    match e.kind() {
-        std::io::ErrorKind::NotFound => {
-            "; check the path: it is relative to the workcell file's folder"
-        }
-        std::io::ErrorKind::PermissionDenied => "; check the file's permissions",
-        _ => "",
-    }
 }
 
 /// A TOML or schema error of the workcell file's text, at its line and column.

@@ -34,20 +34,8 @@ use vworks_se::{Collider, CollisionEvent};
 use vworks_vm::bytecode::{MoveFlags, ProcInfo};
 use vworks_vm::{ConstValue, Instr, Module};
 
-/// True for a program file (by its extension): WSL, RAPID, or bytecode.
-pub(crate) fn is_program(path: &Path) -> bool {
-    let text = path.to_string_lossy();
-    let ext = path.extension().map(|e| e.to_string_lossy().to_lowercase());
-    ext.as_deref() == Some("wslb") || vworks_wslc::Language::of_source_file(&text).is_some()
-}
-
-/// True for what `check` takes as a workcell: a `.toml` file, or a folder.
-pub(crate) fn is_cell(path: &Path) -> bool {
-    path.is_dir()
-        || path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
-}
+use crate::files::{self, is_cell, is_program};
+use crate::output::{out, plural};
 
 /// One problem found, at a place in a file (line 0: the file as a whole).
 struct Problem {
@@ -96,7 +84,7 @@ pub(crate) fn check_cells(
     let mut out = Vec::new();
     for f in files {
         programs_without_cell(f)?;
-        let path = crate::cell_file(f, "check")?;
+        let path = files::cell_file(f, "check")?;
         let r = check_cell(&path, color);
         let errors = r.problems.iter().filter(|p| p.error).count()
             + r.diagnostics.iter().filter(|(e, _)| *e).count();
@@ -143,9 +131,9 @@ pub(crate) fn check_cells(
         eprintln!(
             "checked cell {}: {}, {}, {}",
             vworks_log::trace::escape_controls(&r.name),
-            crate::plural(r.programs, "program"),
-            crate::plural(errors, "error"),
-            crate::plural(warnings, "warning")
+            plural(r.programs, "program"),
+            plural(errors, "error"),
+            plural(warnings, "warning")
         );
     }
     if json {
@@ -153,7 +141,7 @@ pub(crate) fn check_cells(
             1 => out.swap_remove(0),
             _ => serde_json::Value::Array(out),
         };
-        crate::out!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+        out!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
     }
     Ok(if failed {
         ExitCode::FAILURE
@@ -181,15 +169,15 @@ fn programs_without_cell(dir: &Path) -> Result<(), String> {
     let programs: Vec<String> = names
         .iter()
         .filter(|p| p.is_file() && is_program(p))
-        .map(|p| format!("`vworks check {}`", crate::display(p)))
+        .map(|p| format!("`vworks check {}`", files::display(p)))
         .collect();
     if programs.is_empty() {
         return Ok(());
     }
     Err(format!(
         "`{}` is a folder without a cell.toml, but it holds {}: check each on its own ({}), or write a cell.toml naming the robots and their programs (`vworks new NAME` creates a workcell folder to start from)",
-        crate::display(dir),
-        crate::plural(programs.len(), "program"),
+        files::display(dir),
+        plural(programs.len(), "program"),
         programs.join(", ")
     ))
 }
@@ -223,7 +211,7 @@ fn robots_of(text: &str, dir: &Path) -> Vec<(String, Vec<String>)> {
 /// Checks the workcell file `path`.
 fn check_cell(path: &Path, color: bool) -> Report {
     let file = path.display().to_string();
-    let text = crate::read(path).unwrap_or_default();
+    let text = files::read(path).unwrap_or_default();
     let stem = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())

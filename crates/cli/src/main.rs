@@ -22,8 +22,14 @@ use vworks_se::CellNames;
 use clap::{Parser, Subcommand};
 
 mod check;
+mod files;
+mod output;
+mod report;
 mod sweep;
 mod view;
+use files::{cell_file, display, is_cell, read, read_bytes};
+use output::{out, plural, secs};
+use report::write_report;
 use view::view;
 use vworks_log::issue::issue_json as json_issue;
 use vworks_vm::Module;
@@ -186,18 +192,6 @@ fn every_nth(s: &str) -> Result<u64, String> {
     }
 }
 
-/// `println!` that ends the process quietly when stdout is gone (`vworks log events … | head`)
-/// instead of panicking.
-#[macro_export]
-macro_rules! out {
-    ($($arg:tt)*) => {{
-        use std::io::Write as _;
-        if writeln!(std::io::stdout(), $($arg)*).is_err() {
-            std::process::exit(141); // as a shell reports SIGPIPE
-        }
-    }};
-}
-
 fn main() -> ExitCode {
     let cli = Cli::try_parse().unwrap_or_else(|e| with_suggestion(e).exit());
     let color =
@@ -233,94 +227,6 @@ fn with_suggestion(mut e: clap::Error) -> clap::Error {
         );
     }
     e
-}
-
-/// The workcell file that `command` was given as `path`: the path itself, or the
-/// `cell.toml` of a folder. A program file, a sweep file, or a folder without a
-/// `cell.toml`, is an error saying what to give instead.
-fn cell_file(path: &Path, command: &str) -> Result<PathBuf, String> {
-    if path.is_dir() {
-        let file = path.join("cell.toml");
-        if file.is_file() {
-            return Ok(file);
-        }
-        let mut tomls: Vec<String> = std::fs::read_dir(path)
-            .map(|entries| {
-                entries
-                    .filter_map(Result::ok)
-                    .map(|e| e.file_name().to_string_lossy().into_owned())
-                    .filter(|n| n.ends_with(".toml"))
-                    .collect()
-            })
-            .unwrap_or_default();
-        tomls.sort();
-        let there = if tomls.is_empty() {
-            "; `vworks new NAME` creates a workcell folder".to_string()
-        } else {
-            let named: Vec<String> = tomls
-                .iter()
-                .map(|n| format!("`{}`", path.join(n).display()))
-                .collect();
-            format!("; name the workcell file: {}", named.join(", "))
-        };
-        return Err(format!(
-            "`{}` is a folder without a cell.toml: `vworks {command}` takes a workcell file{there}",
-            path.display()
-        ));
-    }
-    if check::is_program(path) {
-        let name = path
-            .file_name()
-            .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-        let cell = path
-            .parent()
-            .map_or_else(|| PathBuf::from("cell.toml"), |d| d.join("cell.toml"));
-        let what = format!(
-            "`{}` is a program, but `vworks {command}` takes a workcell: a cell.toml naming the robots, their models and their programs",
-            path.display()
-        );
-        if cell.is_file() {
-            return Err(format!(
-                "{what}; the one beside it: `vworks {command} {}`",
-                cell.display()
-            ));
-        }
-        return Err(format!(
-            "{what}. Write one beside the program:\n\n    [[robot]]\n    name = \"r1\"\n    model = \"irb120\"\n    program = \"{name}\"\n\nthen `vworks {command} {}`; or `vworks new NAME` creates a workcell folder ready to run (`vworks check {}` compiles the program alone)",
-            cell.display(),
-            path.display()
-        ));
-    }
-    sweep::not_a_sweep_file(path, command)?;
-    Ok(path.to_path_buf())
-}
-
-/// A file named on the command line: a regular file within the size limit
-/// (`vworks_cell::Disk`, as the workcell's files are read).
-fn read_bytes(path: &Path) -> Result<Vec<u8>, String> {
-    use vworks_cell::Files as _;
-    vworks_cell::Disk
-        .read(path)
-        .map_err(|e| cannot_read(path, &e))
-}
-
-fn read(path: &Path) -> Result<String, String> {
-    let bytes = read_bytes(path)?;
-    vworks_wslc::source_text(bytes).map_err(|e| format!("{}: {e}", path.display()))
-}
-
-/// "cannot read FILE: why; what to do" for a file named on the command line.
-fn cannot_read(path: &Path, e: &std::io::Error) -> String {
-    let hint = match e.kind() {
-        std::io::ErrorKind::NotFound => "; check the path (relative to the current folder)",
-        std::io::ErrorKind::PermissionDenied => "; check the file's permissions",
-        _ => "",
-    };
-    format!("cannot read `{}`: {e}{hint}", path.display())
-}
-
-fn display(path: &Path) -> String {
-    path.display().to_string()
 }
 
 /// Compiles one file, printing its diagnostics; `None` if it had errors.
@@ -378,10 +284,6 @@ fn parse_time(s: &str) -> Result<i64, String> {
             format!("--until `{s}` is past the simulation's clock range (146 years); give e.g. 10s")
         }
     })
-}
-
-fn secs(ns: i64) -> String {
-    format!("{:.3} s", ns as f64 / 1e9)
 }
 
 fn read_log(what: LogCommand) -> Result<ExitCode, String> {
@@ -583,38 +485,6 @@ fn new_cell(dir: &Path, model: &str) -> Result<ExitCode, String> {
         dir.display()
     );
     Ok(ExitCode::SUCCESS)
-}
-
-fn write_report(log: &Path, output: Option<PathBuf>) -> Result<ExitCode, String> {
-    let out = output.unwrap_or_else(|| log.with_extension("html"));
-    let (_, code) = report_to(log, &out)?;
-    Ok(code)
-}
-
-/// Writes the report of `log` to `out` and says so on stderr; the exit code is a failure
-/// if the log is damaged (the report shows what was read).
-fn report_to(log: &Path, out: &Path) -> Result<(vworks_report::Written, ExitCode), String> {
-    let written = vworks_report::write_report(log, out).map_err(|e| e.to_string())?;
-    eprintln!(
-        "wrote {} ({}, {}, {}{})",
-        out.display(),
-        plural(written.report.timelines.len(), "robot"),
-        plural(written.events, "event"),
-        plural(written.report.collisions.len(), "collision"),
-        if written.has_view {
-            ""
-        } else {
-            "; no 3D view: the log has no poses"
-        }
-    );
-    if let Some((read, e)) = &written.damage {
-        eprintln!(
-            "warning: {} is unfinished or damaged after {read} messages ({e}); the report shows what was read",
-            log.display()
-        );
-        return Ok((written, ExitCode::FAILURE));
-    }
-    Ok((written, ExitCode::SUCCESS))
 }
 
 /// A program's `log` line as a plain run prints it: `[11.156 s] r1: done`.
@@ -967,14 +837,10 @@ fn summary(
     lines
 }
 
-fn plural(n: usize, word: &str) -> String {
-    format!("{n} {word}{}", if n == 1 { "" } else { "s" })
-}
-
 fn run(cmd: Command, color: bool) -> Result<ExitCode, String> {
     match cmd {
         Command::Check { files, task, json } => {
-            if files.iter().any(|f| check::is_cell(f)) {
+            if files.iter().any(|f| is_cell(f)) {
                 return check::check_cells(&files, task, json, color);
             }
             if json {

@@ -28,6 +28,9 @@ use vworks_sweep::stream::{Format, TableFile, TableWriter};
 use vworks_sweep::table::{self, Best, Value};
 use vworks_sweep::{Row, RowOutcome, Sweep, Unit, per_second, run_streamed};
 
+use crate::files::{self, Kind, kind_of};
+use crate::output::out;
+
 /// What `vworks sweep` was asked.
 #[derive(clap::Args, Debug)]
 pub(crate) struct Args {
@@ -98,8 +101,8 @@ fn list_variables(cell: &Path) -> Result<ExitCode, String> {
         .map_err(|e: toml::de::Error| format!("{}: {}", cell.display(), e.message()))?;
     for v in loader.variables() {
         match written_at(&file, v) {
-            Some(x) => crate::out!("{v} = {}", as_written(x)),
-            None => crate::out!("{v} = {}  (not in the file)", default_of(loader.base(), v)),
+            Some(x) => out!("{v} = {}", as_written(x)),
+            None => out!("{v} = {}  (not in the file)", default_of(loader.base(), v)),
         }
     }
     Ok(ExitCode::SUCCESS)
@@ -239,7 +242,7 @@ impl Tally {
 
 pub(crate) fn sweep(mut a: Args) -> Result<ExitCode, String> {
     if a.variables {
-        return list_variables(&crate::cell_file(&a.file, "sweep --variables")?);
+        return list_variables(&files::cell_file(&a.file, "sweep --variables")?);
     }
     // A folder: its sweep file, as `run` takes a cell's folder.
     a.file = sweep_file(&a.file)?;
@@ -673,7 +676,7 @@ fn print_best(
     let column = |n: &str| columns.iter().position(|c| c == n);
     let best = best.rows();
     if best.is_empty() {
-        crate::out!("{none}");
+        out!("{none}");
         return;
     }
     let k = column(objective).unwrap_or(0);
@@ -684,7 +687,7 @@ fn print_best(
             let v = names.iter().position(|n| n == objective)?;
             units.get(v)?.as_ref().map(|u| u.name.clone())
         });
-    crate::out!("best by {objective} (completed, no collision):");
+    out!("best by {objective} (completed, no collision):");
     for row in best {
         let values: Vec<String> = names
             .iter()
@@ -705,7 +708,7 @@ fn print_best(
             (Value::Num(_) | Value::Int(_), Some(u)) => u.clone(),
             _ => String::new(),
         };
-        crate::out!(
+        out!(
             "  variant {}: {objective} {}{objective_unit}  ({})",
             cell(&row[0]),
             cell(&row[k]),
@@ -721,83 +724,6 @@ fn cell(v: &Value) -> String {
         Value::Text(s) => s.clone(),
         Value::Empty => "–".into(),
     }
-}
-
-/// What a TOML file given on the command line is, by its top-level keys: a sweep file
-/// (`cell = "…"` and `[[variable]]`s) and the workcell it names, a workcell (its robots'
-/// names), or something else (not readable, not TOML, neither: the command says why).
-pub(crate) enum Kind {
-    Sweep { cell: PathBuf },
-    Workcell { robots: Vec<String> },
-    Other,
-}
-
-/// The top-level keys of a sweep file (`vworks_sweep`'s format).
-const SWEEP_KEYS: [&str; 6] = ["cell", "combine", "seed", "until", "minimize", "variable"];
-/// The top-level keys of a workcell (`vworks_cell`'s format).
-const CELL_KEYS: [&str; 11] = [
-    "name",
-    "cycle",
-    "clearance",
-    "grip_distance",
-    "on_collision",
-    "robot",
-    "device",
-    "part",
-    "allow_collision",
-    "params",
-    "io",
-];
-
-pub(crate) fn kind_of(path: &Path) -> Kind {
-    if !path.is_file() {
-        return Kind::Other;
-    }
-    let Ok(Ok(file)) = crate::read(path).map(|t| t.parse::<toml::Table>()) else {
-        return Kind::Other;
-    };
-    match file.get("cell") {
-        Some(toml::Value::String(cell))
-            if file.contains_key("variable")
-                || file.keys().all(|k| SWEEP_KEYS.contains(&k.as_str())) =>
-        {
-            let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
-            Kind::Sweep {
-                cell: dir.join(cell),
-            }
-        }
-        None if file.keys().any(|k| CELL_KEYS.contains(&k.as_str())) => Kind::Workcell {
-            robots: file
-                .get("robot")
-                .and_then(toml::Value::as_array)
-                .map(|rs| {
-                    rs.iter()
-                        .filter_map(|r| r.get("name")?.as_str().map(str::to_string))
-                        .collect()
-                })
-                .unwrap_or_default(),
-        },
-        _ => Kind::Other,
-    }
-}
-
-/// `Err` if `path`, given to `vworks COMMAND` as a workcell, is a sweep file: how to run
-/// it, and the workcell it names.
-pub(crate) fn not_a_sweep_file(path: &Path, command: &str) -> Result<(), String> {
-    let Kind::Sweep { cell } = kind_of(path) else {
-        return Ok(());
-    };
-    let missing = if cell.is_file() {
-        ""
-    } else {
-        " (not there: check its `cell`, relative to the sweep file)"
-    };
-    Err(format!(
-        "`{}` is a sweep file (the workcell to vary and its `[[variable]]`s), but `vworks {command}` takes a workcell: run the sweep with `vworks sweep {}`, or the workcell it names with `vworks {command} {}`{missing}",
-        path.display(),
-        path.display(),
-        cell.display(),
-    ))
 }
 
 /// The sweep file `vworks sweep` was given as `path`: the path itself, or the sweep file

@@ -4,7 +4,8 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use crate::{out, report_to};
+use crate::output::out;
+use crate::report::report_to;
 
 /// `vworks view`: the report in a temporary file, opened in the browser (`$BROWSER`, else
 /// the system's opener where there is a display), or its path printed. The file is made

@@ -338,14 +338,6 @@ fn find_cycle(graph: &BTreeMap<String, BTreeSet<String>>) -> Option<Vec<String>>
     None
 }
 
-/// Crates whose root still forms a loop with a module, found when the check began to count
-/// the root (lib.rs, main.rs), and not yet untangled — each a known debt, listed so the
-/// check holds for every other crate now and for these once they are fixed (remove the
-/// name then): `cell` (io, params and paths are parts of the loader `Ctx` in lib.rs and
-/// use it), `cli` (check, sweep and view use main.rs's helpers: `cell_file`, `plural`,
-/// `display`, `read`, `report_to`), `py` (sweep uses lib.rs's exceptions and `to_ns`).
-const KNOWN_ROOT_LOOPS: [&str; 3] = ["cell", "cli", "py"];
-
 #[test]
 fn no_import_loops_between_the_modules_of_a_crate() {
     let mut checked = 0;
@@ -353,22 +345,12 @@ fn no_import_loops_between_the_modules_of_a_crate() {
     for c in LAYERS {
         let src = root().join("crates").join(c).join("src");
         let graph = module_graph(&src);
-        if let Some(cycle) = find_cycle(&graph)
-            && !KNOWN_ROOT_LOOPS.contains(&c)
-        {
+        if let Some(cycle) = find_cycle(&graph) {
             loops.push(format!("crates/{c}: {}", cycle.join(" → ")));
         }
         checked += graph.len();
     }
     assert!(loops.is_empty(), "modules import each other: {loops:#?}");
-    // A known loop that is gone leaves the list.
-    for c in KNOWN_ROOT_LOOPS {
-        let graph = module_graph(&root().join("crates").join(c).join("src"));
-        assert!(
-            find_cycle(&graph).is_some(),
-            "crates/{c} has no import loop any more: remove it from KNOWN_ROOT_LOOPS"
-        );
-    }
     assert!(checked > 20, "only {checked} modules found");
     // The check finds a loop where there is one.
     let looped = BTreeMap::from([

@@ -15,10 +15,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
-use pyo3::create_exception;
-use pyo3::exceptions::{
-    PyException, PyIndexError, PyKeyError, PyRuntimeError, PyRuntimeWarning, PyValueError,
-};
+use pyo3::exceptions::{PyIndexError, PyKeyError, PyRuntimeError, PyRuntimeWarning, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PySlice};
 use vworks_cell::CellError as WorkcellError;
@@ -28,59 +25,16 @@ use vworks_log::mcaplog::LoggedEvent;
 use vworks_log::result::{Outcome, RunResult};
 use vworks_log::trace::{TraceEvent, Value};
 
+mod errors;
 mod interrupt;
 mod place;
 mod program;
 mod sweep;
+mod units;
 
+use errors::{CellError, CompileError, Error, LinkError, SimulationError};
 use program::{Diagnostic, Module, compile, compile_files, diagnostic, program_error};
-
-create_exception!(
-    vworks,
-    Error,
-    PyException,
-    "Every error vworks raises: a program that does not compile or link, a workcell that does not load, a simulation that fails, a log that cannot be read."
-);
-create_exception!(
-    vworks,
-    CompileError,
-    Error,
-    "A program does not compile. `.diagnostics` lists every problem (`Diagnostic`: code, message, file, line, col, rendered)."
-);
-create_exception!(
-    vworks,
-    LinkError,
-    Error,
-    "The cell's programs compile but do not fit together (globals, remote calls, signals, parts, joints). `.diagnostics` lists why."
-);
-create_exception!(
-    vworks,
-    CellError,
-    Error,
-    "A workcell file (or a robot model it names) is wrong: the message names the file, the place and what to do."
-);
-create_exception!(
-    vworks,
-    SimulationError,
-    Error,
-    "A robot's program failed while running. `.robot`, `.file`, `.line`, `.col` say where; `.result` holds the run up to the failure when there is one."
-);
-
-const NS: f64 = 1e9;
-
-fn secs(ns: i64) -> f64 {
-    ns as f64 / NS
-}
-
-/// A time to stop at, in seconds (a float or an int), to integer nanoseconds: any time
-/// from 0, as `vworks run --until` and sweeps take it ([`vworks_app::until_ns`]).
-fn to_ns(seconds: f64, what: &str) -> PyResult<i64> {
-    vworks_app::until_ns(seconds).map_err(|_| {
-        PyValueError::new_err(format!(
-            "{what} must be a time in seconds, at least 0 (got {seconds})"
-        ))
-    })
-}
+use units::{secs, to_ns};
 
 /// A loaded workcell: robots with their models and compiled, linked programs; devices;
 /// parts. Run it whole (`run`) or step by step (`simulation`); a cell can be run many times.

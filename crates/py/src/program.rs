@@ -6,7 +6,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyList;
 use vworks_wslc::Diagnostic as WslDiagnostic;
 
-use crate::{CompileError, LinkError};
+use crate::errors::{CompileError, LinkError};
 
 /// One compiler or linker diagnostic.
 #[pyclass(frozen, module = "vworks", get_all)]

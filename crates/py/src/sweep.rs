@@ -17,7 +17,8 @@ use vworks_sweep::Table;
 use vworks_sweep::run::RunOptions;
 use vworks_sweep::table::Value;
 
-use crate::CellError;
+use crate::errors::CellError;
+use crate::units::to_ns;
 
 /// A Python value as the workcell file would write it.
 fn toml_value(v: &Bound<'_, PyAny>, path: &str) -> PyResult<toml::Value> {
@@ -77,7 +78,7 @@ pub(crate) fn run_variants<'py>(
         }
         parsed.push(o);
     }
-    let until_ns = until.map(|t| crate::to_ns(t, "until")).transpose()?;
+    let until_ns = until.map(|t| to_ns(t, "until")).transpose()?;
     let memory = files.map(|f| MemoryFiles {
         files: f.into_iter().map(|(p, b)| (PathBuf::from(p), b)).collect(),
     });
