@@ -140,6 +140,7 @@ impl Fold {
         }
     }
 
+    #[inline]
     fn close(&mut self, r: usize, a: Activity, t: i64) {
         let robot = &mut self.robots[r];
         if let Some(s) = robot.open[a as usize].take() {

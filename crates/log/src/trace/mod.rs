@@ -188,6 +188,7 @@ impl Kind {
     }
 
     /// The kind of a VM event (the VM's kinds come first, in the order of its table).
+    #[inline]
     pub fn of(kind: &EventKind) -> Kind {
         Kind::ALL[kind.index()]
     }

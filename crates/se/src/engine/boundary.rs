@@ -95,6 +95,7 @@ impl Boundaries {
     /// between boundaries (see [`Collider::sweep`]); runs before every boundary and
     /// before every event, so motions do not change within a swept stretch. The time of
     /// the contact the run stops on, if it does.
+    #[inline]
     pub(super) fn sweep_until(
         &mut self,
         cell: &Cell,
@@ -110,6 +111,11 @@ impl Boundaries {
             self.swept = t;
             return None;
         }
+        self.sweep_to(cell, vms, rec, t)
+    }
+
+    /// [`Boundaries::sweep_until`] once there is a stretch to sweep.
+    fn sweep_to(&mut self, cell: &Cell, vms: &[Vm], rec: &mut Recording, t: i64) -> Option<i64> {
         let contacts = self.collider.sweep(cell, vms, self.swept, t);
         self.swept = t;
         for contact in contacts {
@@ -124,7 +130,23 @@ impl Boundaries {
     /// Processes every cycle boundary up to and including `t`; `next_event` is the time of
     /// the earliest queue entry (boundaries before it where nothing moves are skipped).
     /// The time of the contact the run stops on, if it does.
+    #[inline]
     pub(super) fn advance(
+        &mut self,
+        cell: &Cell,
+        vms: &[Vm],
+        rec: &mut Recording,
+        t: i64,
+        next_event: Option<i64>,
+    ) -> Option<i64> {
+        if self.next > t {
+            return None;
+        }
+        self.advance_to(cell, vms, rec, t, next_event)
+    }
+
+    /// [`Boundaries::advance`] once a boundary is due.
+    fn advance_to(
         &mut self,
         cell: &Cell,
         vms: &[Vm],

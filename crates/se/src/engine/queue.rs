@@ -31,6 +31,7 @@ pub(super) enum Entry {
 impl Entry {
     /// The entry in 64 bits: kind (2 bits), robot (22 bits), generation or global (40
     /// bits), so that a queued entry is 24 bytes.
+    #[inline]
     pub(super) fn pack(self) -> u64 {
         let (kind, r, payload) = match self {
             Entry::Vm(r, g) => (0, r, g),
@@ -41,6 +42,7 @@ impl Entry {
         (payload << 24) | ((r as u64 & 0x3f_ffff) << 2) | kind
     }
 
+    #[inline]
     pub(super) fn unpack(x: u64) -> Entry {
         let (r, payload) = (((x >> 2) & 0x3f_ffff) as usize, x >> 24);
         match x & 3 {
@@ -52,6 +54,7 @@ impl Entry {
     }
 
     /// The robot the entry is for.
+    #[inline]
     pub(super) fn robot(self) -> usize {
         match self {
             Entry::Vm(r, _) | Entry::CheckWait(r, _) | Entry::CheckWhen(r, _) => r,
@@ -109,6 +112,7 @@ impl EventQueue {
 
     /// Queues `entry` at `time`; `now` is the simulated time (an entry of the robot whose
     /// turn it is, at `now`, goes first).
+    #[inline]
     pub(super) fn push(&mut self, time: i64, entry: Entry, now: i64) {
         self.seq += 1;
         let robot = entry.robot();
@@ -121,11 +125,13 @@ impl EventQueue {
     }
 
     /// The time of the earliest entry, stale or not.
+    #[inline]
     pub(super) fn next_time(&self) -> Option<i64> {
         self.heap.peek().map(|Reverse(q)| q.time)
     }
 
     /// Takes the earliest entry: its time and the entry.
+    #[inline]
     pub(super) fn pop(&mut self) -> Option<(i64, Entry)> {
         self.heap
             .pop()
@@ -133,6 +139,7 @@ impl EventQueue {
     }
 
     /// Whether `entry` stands for an event its robot no longer has next.
+    #[inline]
     pub(super) fn is_stale(&self, entry: Entry) -> bool {
         matches!(entry, Entry::Vm(r, g) | Entry::Resume(r, g) if g != self.generation[r])
     }
@@ -146,27 +153,32 @@ impl EventQueue {
     }
 
     /// The robot whose turn it is.
+    #[inline]
     pub(super) fn turn(&self) -> Option<usize> {
         self.turn
     }
 
     /// Gives the turn to `robot` (`None`: to no robot).
+    #[inline]
     pub(super) fn set_turn(&mut self, robot: Option<usize>) {
         self.turn = robot;
     }
 
     /// When robot `r`'s entry is due, while one is queued.
+    #[inline]
     pub(super) fn queued_at(&self, r: usize) -> Option<i64> {
         self.queued_at[r]
     }
 
     /// Robot `r`'s entry came up (or was dropped): none is queued.
+    #[inline]
     pub(super) fn taken(&mut self, r: usize) {
         self.queued_at[r] = None;
     }
 
     /// Starts robot `r`'s new generation: its queued entry, if any, becomes stale.
     /// Returns the generation.
+    #[inline]
     pub(super) fn renew(&mut self, r: usize) -> u64 {
         self.generation[r] += 1;
         self.queued_at[r] = None;
@@ -176,6 +188,7 @@ impl EventQueue {
 
     /// Queues robot `r`'s entry of generation `g` for `event` (kept for `take_pending`), or,
     /// without an event, a `Resume` at `now`.
+    #[inline]
     pub(super) fn queue_robot(&mut self, r: usize, g: u64, event: Option<Event>, now: i64) {
         match event {
             Some(e) => {
@@ -191,6 +204,7 @@ impl EventQueue {
     }
 
     /// The event robot `r`'s entry stands for (taken: performed once).
+    #[inline]
     pub(super) fn take_pending(&mut self, r: usize) -> Option<Event> {
         self.pending[r].take()
     }

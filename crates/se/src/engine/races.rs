@@ -108,6 +108,7 @@ impl RaceDetector {
     }
 
     /// Whether races were found and not yet taken.
+    #[inline]
     pub(super) fn has_races(&self) -> bool {
         !self.found.is_empty()
     }
@@ -131,6 +132,7 @@ impl RaceDetector {
     }
 
     /// Robot `r` acts: its own clock entry advances; returns it (the action's stamp).
+    #[inline]
     pub(super) fn tick(&mut self, r: usize) -> u64 {
         let n = self.robots;
         self.clock[r * n + r] += 1;
@@ -138,12 +140,14 @@ impl RaceDetector {
     }
 
     /// Whether robot `r` has seen the action of robot `q` stamped `stamp`.
+    #[inline]
     fn has_seen(&self, r: usize, q: usize, stamp: u64) -> bool {
         self.clock[r * self.robots + q] >= stamp
     }
 
     /// Robot `r` has now seen what `from` records: what a robot had seen (its own actions
     /// included), or what the setter of a global had seen at its last set.
+    #[inline]
     pub(super) fn merge(&mut self, r: usize, from: Seen) {
         let n = self.robots;
         for k in 0..n {
@@ -227,6 +231,7 @@ impl RaceDetector {
     /// Robot `r` signals robot `target` at `t`. `waiting`: where `target` waits for the
     /// signal with a wait timing out at this instant, if it does: that timeout (or one
     /// already passed at this instant) races with the signal.
+    #[inline]
     pub(super) fn signal(
         &mut self,
         r: usize,
@@ -293,10 +298,15 @@ impl RaceDetector {
     /// The globals robot `r`'s last segment read at this instant `t` (its VM `vm`; module
     /// global → cell global `to_cell`): a race with a set of another robot at the same
     /// instant that `r` has not seen (either order), as for `wait_until` conditions.
+    #[inline]
     pub(super) fn note_reads(&mut self, r: usize, t: i64, vm: &mut Vm, to_cell: &[u32]) {
-        if !vm.has_reads() {
-            return;
+        if vm.has_reads() {
+            self.note_taken_reads(r, t, vm, to_cell);
         }
+    }
+
+    /// [`RaceDetector::note_reads`] once the VM has reads (kept out of the hot path).
+    fn note_taken_reads(&mut self, r: usize, t: i64, vm: &mut Vm, to_cell: &[u32]) {
         let mut reads = std::mem::take(&mut self.reads);
         vm.take_reads(&mut reads);
         let n = self.robots;

@@ -167,10 +167,15 @@ impl Simulation {
     }
 
     /// The races the detector found since, as warnings (in the order found).
+    #[inline]
     pub(super) fn report_races(&mut self) {
-        if !self.races.has_races() {
-            return;
+        if self.races.has_races() {
+            self.word_races();
         }
+    }
+
+    /// [`Simulation::report_races`] once there are some (kept out of the hot path).
+    fn word_races(&mut self) {
         let cell = &*self.cell;
         for race in self.races.take_races() {
             let subject = match race.subject {

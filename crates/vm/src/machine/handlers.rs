@@ -119,7 +119,11 @@ impl Handlers {
     }
 
     /// The earliest handler firing: (time, enabled index).
+    #[inline]
     pub(super) fn next_fire(&self) -> Option<(i64, usize)> {
+        if self.enabled.is_empty() && self.fires.is_empty() {
+            return None;
+        }
         let timers = self
             .enabled
             .iter()
