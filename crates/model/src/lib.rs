@@ -13,6 +13,7 @@
 //! - [`output`]: where every file vworks writes goes through: never over an input, through
 //!   a temporary file renamed at the end.
 //! - [`math`]: the small rigid-transform algebra all of it uses.
+//! - [`timing`]: the time-optimal timing of a path within axis and path limits (TOPP-RA).
 //! - [`text`]: names from files as a terminal may print them (control characters escaped).
 //!
 //! Joint values are radians for revolute axes and metres for prismatic ones. A joint
@@ -28,6 +29,7 @@ pub mod mesh;
 pub mod model;
 pub mod output;
 pub mod text;
+pub mod timing;
 pub mod urdf;
 
 pub use error::{ModelError, UrdfProblem};

@@ -1,0 +1,373 @@
+//! Time-optimal timing of a path: the fastest way to move along a geometric path of the
+//! joints, `q(s)` for `s` from 0 to 1, from rest to rest, within every axis's speed and
+//! acceleration and the path's own speed and acceleration (the TCP's and the
+//! orientation's, as fractions of the path per second).
+//!
+//! The method is the reachability analysis of TOPP-RA (Pham & Pham, "A New Approach to
+//! Time-Optimal Path Parameterization Based on Reachability Analysis", IEEE T-RO 2018;
+//! PyPI `toppra`), in the state `x = ṡ²` and control `u = s̈`: the path is cut into
+//! [`SEGMENTS`] equal steps of `s`, `u` is constant on each (so `x` is linear in `s`
+//! and `s(t)` is a parabola), and every limit holds at both ends of every step with that
+//! step's `u` (TOPP-RA's "interpolation" scheme). With the axis's speed `q'(s)·ṡ` and
+//! acceleration `q'(s)·s̈ + q''(s)·ṡ²`, each limit is linear in `(u, x)`:
+//!
+//! - a backward pass finds at each knot the largest `x` from which the end can still be
+//!   reached at rest (the controllable set `[0, K_k]`, a 2-D linear program solved
+//!   exactly: the smallest root of the lines its constraints make);
+//! - a forward pass from rest takes the largest `u` that stays within them.
+//!
+//! The result is exact arithmetic on the samples: no iteration, no tolerance, the same
+//! bits for the same inputs. Nothing allocates: a [`Timing`] is two arrays of [`KNOTS`]
+//! numbers.
+
+use crate::ik::MAX_AXES;
+
+/// Steps the path is cut into.
+pub const SEGMENTS: usize = 128;
+/// Points where the limits hold: the ends of the steps.
+pub const KNOTS: usize = SEGMENTS + 1;
+
+/// The joints along a path at the knots: `q[k]` at `s = k / SEGMENTS`, axes first.
+#[derive(Clone, Debug)]
+pub struct JointPath {
+    /// How many axes move.
+    pub axes: usize,
+    /// The joints at each knot (rad or m).
+    pub q: [[f64; MAX_AXES]; KNOTS],
+}
+
+impl JointPath {
+    /// A path of `axes` axes, every knot at zero.
+    pub fn new(axes: usize) -> JointPath {
+        JointPath {
+            axes: axes.min(MAX_AXES),
+            q: [[0.0; MAX_AXES]; KNOTS],
+        }
+    }
+
+    /// Axis `i`'s derivatives `(q', q'')` at knot `k` by finite differences (central
+    /// inside, second-order one-sided at the ends).
+    pub fn derivatives(&self, k: usize, i: usize) -> (f64, f64) {
+        let n = SEGMENTS as f64;
+        let q = |j: usize| self.q[j][i];
+        let k = k.min(SEGMENTS);
+        if k == 0 {
+            let d1 = (-3.0 * q(0) + 4.0 * q(1) - q(2)) * 0.5 * n;
+            let d2 = (2.0 * q(0) - 5.0 * q(1) + 4.0 * q(2) - q(3)) * n * n;
+            (d1, d2)
+        } else if k == SEGMENTS {
+            let d1 = (3.0 * q(k) - 4.0 * q(k - 1) + q(k - 2)) * 0.5 * n;
+            let d2 = (2.0 * q(k) - 5.0 * q(k - 1) + 4.0 * q(k - 2) - q(k - 3)) * n * n;
+            (d1, d2)
+        } else {
+            let d1 = (q(k + 1) - q(k - 1)) * 0.5 * n;
+            let d2 = (q(k + 1) - 2.0 * q(k) + q(k - 1)) * n * n;
+            (d1, d2)
+        }
+    }
+}
+
+/// The limits a path's timing keeps.
+#[derive(Clone, Copy, Debug)]
+pub struct Limits<'a> {
+    /// Per axis, its largest speed (rad/s or m/s).
+    pub axis_speed: &'a [f64],
+    /// Per axis, its largest acceleration (rad/s² or m/s²).
+    pub axis_accel: &'a [f64],
+    /// The largest path speed `ṡ` (1/s): the TCP's speed over the path's length, or the
+    /// orientation's over its angle, whichever is less.
+    pub path_speed: f64,
+    /// The largest path acceleration `|s̈|` (1/s²).
+    pub path_accel: f64,
+}
+
+/// Why a path has no timing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum TimingError {
+    /// A limit is not a positive number (its value).
+    BadLimit(f64),
+    /// A joint at this knot is not a finite number.
+    NotFinite {
+        /// The knot (0 to [`SEGMENTS`]).
+        knot: usize,
+        /// The axis.
+        axis: usize,
+    },
+    /// At this knot the path cannot move at all: an axis would need infinite speed (a
+    /// singularity, or the joints jump between two knots).
+    Stuck {
+        /// The knot (0 to [`SEGMENTS`]).
+        knot: usize,
+        /// The axis whose limit leaves no speed.
+        axis: usize,
+    },
+}
+
+/// The time-optimal timing of a path: `ṡ²` and the time at each knot.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Timing {
+    x: [f64; KNOTS],
+    t: [f64; KNOTS],
+}
+
+/// Where on the path, how fast and how it accelerates at a time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathState {
+    /// The fraction of the path done, 0 to 1.
+    pub s: f64,
+    /// `ds/dt` (1/s).
+    pub speed: f64,
+    /// `d²s/dt²` (1/s²).
+    pub accel: f64,
+}
+
+/// One linear constraint `a·u + b·x ≤ c` of a step (`c ≥ 0`: rest is always allowed).
+#[derive(Clone, Copy, Debug)]
+struct Line {
+    a: f64,
+    b: f64,
+    c: f64,
+}
+
+/// The constraints of step `k` (from knot `k` to `k + 1`) on `(u, x_k)`: every limit at
+/// both knots and halfway, `x = x_k + 2Δ·u·(s − s_k)/Δ` along the step. Halfway the
+/// speed `q'` is the exact central difference of the two knots. `out` holds at most
+/// `6·axes + 5` lines.
+fn step_lines(path: &JointPath, lim: &Limits<'_>, k: usize, out: &mut [Line]) -> usize {
+    let delta = 1.0 / SEGMENTS as f64;
+    let mut m = 0;
+    let mut push = |a: f64, b: f64, c: f64| {
+        out[m] = Line { a, b, c };
+        m += 1;
+    };
+    // The path's own acceleration, on u alone.
+    push(1.0, 0.0, lim.path_accel);
+    push(-1.0, 0.0, lim.path_accel);
+    // (where, x there = x_k + shift·u)
+    for (point, shift) in [(0u8, 0.0), (1, delta), (2, 2.0 * delta)] {
+        let mut x_max = lim.path_speed * lim.path_speed;
+        for i in 0..path.axes {
+            let (d1, d2) = match point {
+                0 => path.derivatives(k, i),
+                2 => path.derivatives(k + 1, i),
+                _ => (
+                    (path.q[k + 1][i] - path.q[k][i]) * SEGMENTS as f64,
+                    0.5 * (path.derivatives(k, i).1 + path.derivatives(k + 1, i).1),
+                ),
+            };
+            let amax = lim.axis_accel[i];
+            // -amax ≤ d1·u + d2·(x + shift·u) ≤ amax.
+            let (a, b) = (d1 + d2 * shift, d2);
+            push(a, b, amax);
+            push(-a, -b, amax);
+            if d1 != 0.0 {
+                let v = lim.axis_speed[i] / d1.abs();
+                x_max = x_max.min(v * v);
+            }
+        }
+        // x + shift·u ≤ x_max.
+        if x_max.is_finite() {
+            push(shift, 1.0, x_max);
+        }
+    }
+    m
+}
+
+/// The largest `x ≥ 0` for which some `u` satisfies every line, and that `u`'s bounds.
+/// Rest (`u = 0, x = 0`) satisfies them all, so the feasible `x` are an interval from 0.
+fn largest_x(lines: &[Line]) -> f64 {
+    let mut best = f64::INFINITY;
+    // Lines without u bound x alone.
+    for l in lines.iter().filter(|l| l.a == 0.0) {
+        if l.b > 0.0 {
+            best = best.min(l.c / l.b);
+        }
+    }
+    // A lower bound on u (a < 0) against an upper one (a > 0): u ≥ (c₁ − b₁x)/a₁ and
+    // u ≤ (c₂ − b₂x)/a₂ meet where their difference, linear in x, turns negative.
+    for lo in lines.iter().filter(|l| l.a < 0.0) {
+        for hi in lines.iter().filter(|l| l.a > 0.0) {
+            // g(x) = (c₂ − b₂x)/a₂ − (c₁ − b₁x)/a₁ = g0 + g1·x, g0 ≥ 0.
+            let g0 = hi.c / hi.a - lo.c / lo.a;
+            let g1 = -hi.b / hi.a + lo.b / lo.a;
+            if g1 < 0.0 {
+                best = best.min((g0 / -g1).max(0.0));
+            }
+        }
+    }
+    best.max(0.0)
+}
+
+/// The largest `u` the lines allow at state `x` (`f64::INFINITY` if none bounds it).
+fn largest_u(lines: &[Line], x: f64) -> f64 {
+    lines
+        .iter()
+        .filter(|l| l.a > 0.0)
+        .map(|l| (l.c - l.b * x) / l.a)
+        .fold(f64::INFINITY, f64::min)
+}
+
+impl Timing {
+    /// The time-optimal timing of `path` within `limits`, from rest to rest.
+    pub fn optimal(path: &JointPath, limits: &Limits<'_>) -> Result<Timing, TimingError> {
+        let all = limits
+            .axis_speed
+            .iter()
+            .chain(limits.axis_accel)
+            .take(2 * path.axes)
+            .chain([&limits.path_speed, &limits.path_accel]);
+        for v in all {
+            if v.is_nan() || *v <= 0.0 {
+                return Err(TimingError::BadLimit(*v));
+            }
+        }
+        if limits.axis_speed.len() < path.axes || limits.axis_accel.len() < path.axes {
+            return Err(TimingError::BadLimit(f64::NAN));
+        }
+        for (knot, q) in path.q.iter().enumerate() {
+            if let Some(axis) = q[..path.axes].iter().position(|v| !v.is_finite()) {
+                return Err(TimingError::NotFinite { knot, axis });
+            }
+        }
+        let two_delta = 2.0 / SEGMENTS as f64;
+        let mut lines = [Line {
+            a: 0.0,
+            b: 0.0,
+            c: 0.0,
+        }; 6 * MAX_AXES + 8];
+        // Backward: the controllable sets [0, K_k].
+        let mut reach = [0.0f64; KNOTS];
+        reach[SEGMENTS] = 0.0;
+        for k in (0..SEGMENTS).rev() {
+            let mut m = step_lines(path, limits, k, &mut lines);
+            // x_{k+1} = x + 2Δu within [0, K_{k+1}].
+            lines[m] = Line {
+                a: two_delta,
+                b: 1.0,
+                c: reach[k + 1],
+            };
+            lines[m + 1] = Line {
+                a: -two_delta,
+                b: -1.0,
+                c: 0.0,
+            };
+            m += 2;
+            reach[k] = largest_x(&lines[..m]);
+            if k > 0 && reach[k] <= 0.0 {
+                // No speed at all inside the path: the axis whose speed bound is zero.
+                let axis = (0..path.axes)
+                    .max_by(|&a, &b| {
+                        let da = path.derivatives(k, a).0.abs() / limits.axis_speed[a];
+                        let db = path.derivatives(k, b).0.abs() / limits.axis_speed[b];
+                        da.total_cmp(&db)
+                    })
+                    .unwrap_or(0);
+                return Err(TimingError::Stuck { knot: k, axis });
+            }
+        }
+        // Forward: from rest, the largest u that keeps x_{k+1} controllable.
+        let mut x = [0.0f64; KNOTS];
+        let mut t = [0.0f64; KNOTS];
+        for k in 0..SEGMENTS {
+            let m = step_lines(path, limits, k, &mut lines);
+            let u_max = largest_u(&lines[..m], x[k]);
+            let u = u_max.min((reach[k + 1] - x[k]) / two_delta);
+            x[k + 1] = (x[k] + two_delta * u).clamp(0.0, reach[k + 1]);
+            let (v0, v1) = (x[k].sqrt(), x[k + 1].sqrt());
+            let dt = if v0 + v1 > 0.0 {
+                two_delta / (v0 + v1)
+            } else {
+                0.0
+            };
+            t[k + 1] = t[k] + dt;
+        }
+        if x[1..SEGMENTS].iter().any(|v| *v <= 0.0) {
+            let knot = x[1..SEGMENTS]
+                .iter()
+                .position(|v| *v <= 0.0)
+                .map_or(0, |p| p + 1);
+            return Err(TimingError::Stuck { knot, axis: 0 });
+        }
+        Ok(Timing { x, t })
+    }
+
+    /// How long the path takes (s).
+    pub fn duration(&self) -> f64 {
+        self.t[SEGMENTS]
+    }
+
+    /// The largest path speed `ṡ` it reaches (1/s).
+    pub fn top_speed(&self) -> f64 {
+        self.x.iter().fold(0.0f64, |m, x| m.max(*x)).sqrt()
+    }
+
+    /// The path speed at knot `k` (1/s).
+    pub fn speed_at_knot(&self, k: usize) -> f64 {
+        self.x[k.min(SEGMENTS)].sqrt()
+    }
+
+    /// The step a time falls in, and the time into it.
+    fn step_of(&self, time: f64) -> (usize, f64) {
+        // The last knot at or before `time`.
+        let k = self.t[..SEGMENTS]
+            .partition_point(|tk| *tk <= time)
+            .saturating_sub(1);
+        (k, time - self.t[k])
+    }
+
+    /// Where the path is at `time` seconds from its start (its start before, its end
+    /// after).
+    pub fn at(&self, time: f64) -> PathState {
+        if time.is_nan() || time <= 0.0 {
+            return PathState {
+                s: 0.0,
+                speed: 0.0,
+                accel: 0.0,
+            };
+        }
+        if time >= self.duration() {
+            return PathState {
+                s: 1.0,
+                speed: 0.0,
+                accel: 0.0,
+            };
+        }
+        let (k, tau) = self.step_of(time);
+        let delta = 1.0 / SEGMENTS as f64;
+        let u = (self.x[k + 1] - self.x[k]) / (2.0 * delta);
+        let v0 = self.x[k].sqrt();
+        let s = (k as f64 * delta + v0 * tau + 0.5 * u * tau * tau).clamp(0.0, 1.0);
+        PathState {
+            s,
+            speed: (v0 + u * tau).max(0.0),
+            accel: u,
+        }
+    }
+
+    /// The time (s) at which the path reaches fraction `s`.
+    pub fn time_at(&self, s: f64) -> f64 {
+        if s.is_nan() || s <= 0.0 {
+            return 0.0;
+        }
+        if s >= 1.0 {
+            return self.duration();
+        }
+        let delta = 1.0 / SEGMENTS as f64;
+        let k = ((s * SEGMENTS as f64) as usize).min(SEGMENTS - 1);
+        let ds = s - k as f64 * delta;
+        let u = (self.x[k + 1] - self.x[k]) / (2.0 * delta);
+        let v0 = self.x[k].sqrt();
+        // ½u·τ² + v0·τ = ds, in the form that does not cancel.
+        let root = (v0 * v0 + 2.0 * u * ds).max(0.0).sqrt();
+        let tau = if v0 + root > 0.0 {
+            2.0 * ds / (v0 + root)
+        } else {
+            0.0
+        };
+        self.t[k] + tau
+    }
+}
+
+#[cfg(test)]
+mod tests;
