@@ -1,0 +1,355 @@
+#!/usr/bin/env python3
+"""How close are vworks's straight-line motions (`move_l`) to the time-optimal motion
+along the same path under the same limits? toppra (time-optimal path parameterisation,
+PyPI `toppra`) is the oracle.
+
+For each built-in 6-axis arm (irb120, kr6r900, lrmate200id, ur5) and N random cases:
+
+1. Start joints at random in a sane part of the workspace (elbow bent, wrist axis 5 at
+   least 25 degrees from 0, model by model: `START` below), a straight line from the TCP
+   there, translated by a random vector of 50-600 mm with the same orientation, at a TCP
+   speed drawn from 100 mm/s, 500 mm/s, 1 m/s, 2 m/s, 4 m/s.
+2. A one-robot workcell in a temporary folder runs
+   `move_j START; move_l offset(current_pose(), dx, dy, dz) speed V;` (a fine point, the
+   model's default acceleration). The move_l's duration is its motion_start to its
+   motion_end (events, ns). A case vworks cannot run (unreachable on the way, a joint
+   limit, a self-collision) is skipped and counted. A Simulation is then stepped through
+   the move_l on a uniform grid of about 1 ms (T / ceil(T / 1 ms)), reading the joints
+   and the TCP.
+3. The path for toppra: the joints as a cubic spline (scipy, through toppra's
+   SplineInterpolator) of s, the TCP's arc length along the recorded positions (samples
+   closer than L/4000 in s are dropped, as at the ends, where the TCP is at rest), plus a
+   virtual 7th joint equal to s. Constraints (toppra JointVelocityConstraint and
+   JointAccelerationConstraint, interpolation scheme, 801 gridpoints): each axis's URDF
+   velocity limit and acceleration limit (none of the built-in URDFs gives one, so
+   velocity / 0.3 s, docs/models.md), and for s the programmed TCP speed V and the TCP
+   acceleration vworks uses by default, V / 0.3 s (the worked example in docs/engine.md,
+   "Zones", uses a = v / 0.3 s; the script checks it: `tcp_accel_ratio` in the JSON is the
+   recorded peak TCP acceleration over V / 0.3 s). toppra's duration is
+   sum 2 ds / (sd_i + sd_i+1) over its grid (piecewise-constant path acceleration).
+4. From the recorded joints: peak joint speed and peak joint acceleration as ratios of
+   the limits (largest over the axes), by finite differences on the ~1 ms grid (first
+   differences for speed, second differences for acceleration). A case whose joints move
+   faster than 2x a limit between two samples is a "jump": the joints along the line
+   leave one configuration for another (the TCP stays on the line); there is no smooth
+   path for toppra, so it is counted but left out of the ratios and peaks.
+
+The table gives per model: cases run and skipped, the ratio vworks time / toppra time
+(median, worst = largest, best = smallest), how many cases vworks is faster than toppra
+(ratio below 1 - 1e-3: faster than the limits allow, which can only be by leaving
+one of them, e.g. the axis accelerations, which move_l does not bound: docs/engine.md,
+"Zones"), and the largest peak joint speed and acceleration ratios. `--json FILE`
+writes every case.
+
+    .venv/bin/python bench/fidelity.py --cases 15 [--seed 1] [--json fidelity.json]
+
+Needs toppra (`.venv/bin/python -m pip install toppra`, which brings scipy). Deterministic
+for a given seed: case i of a model is the same whatever --cases is.
+"""
+
+import argparse
+import json
+import math
+import sys
+import tempfile
+import time
+import warnings
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+MODELS_DIR = ROOT / "crates" / "model" / "models"
+
+DEFAULT_ACCEL_TIME = 0.3  # s: full speed in 0.3 s, axes without <limit acceleration> (docs/models.md)
+TCP_ACCEL_TIME = 0.3  # s: the TCP's default ramp for move_l, a = V / 0.3 s (docs/engine.md, "Zones")
+SPEEDS = [0.1, 0.5, 1.0, 2.0, 4.0]  # m/s
+LENGTH_MM = (50.0, 600.0)
+STEP = 1e-3  # s, the recording grid (at most)
+MAX_SAMPLES = 20_000  # a motion longer than 20 s (a vworks slowdown) is recorded on a coarser grid
+JUMP = 2.0  # a joint faster than this times its limit between two samples: the IK switched branches
+GRIDPOINTS = 801  # toppra's grid
+FASTER_TOL = 1e-3  # a ratio below 1 - this counts as "vworks faster than toppra"
+
+# Start joints, degrees, per axis (lo, hi); axis 5 (index 4) is drawn with a random sign
+# from the magnitude range given, away from the wrist singularity at 0.
+START = {
+    # axis 2 upper arm upright to leaning forward, axis 3 forearm horizontal to tilted down
+    # (stretched near -77 deg); the arm reaches 0.58 m, so many 600 mm lines leave it
+    "irb120": [(-90, 90), (0, 40), (0, 60), (-90, 90), (25, 90), (-90, 90)],
+    # upper arm horizontal and the arm stretched at zero: A2 -90 deg is upright, A3 90 deg
+    # puts the forearm horizontal
+    "kr6r900": [(-90, 90), (-110, -60), (70, 135), (-90, 90), (25, 90), (-90, 90)],
+    # like the IRB 120, axis 3 about -y (stretched near +84 deg)
+    "lrmate200id": [(-90, 90), (-10, 40), (-50, 20), (-90, 90), (25, 90), (-90, 90)],
+    # standard DH, stretched horizontally at zero: shoulder raised, elbow bent, wrist 2
+    # away from 0 and 180 deg
+    "ur5": [(-90, 90), (-120, -45), (45, 120), (-150, -30), (30, 150), (-90, 90)],
+}
+WRIST = 4  # the axis drawn with a random sign
+
+
+def urdf_limits(model):
+    """Per moving joint, in file order (the chain of the built-in arms): lower, upper,
+    velocity, acceleration (velocity / 0.3 s where the URDF gives none)."""
+    rows = []
+    for joint in ET.parse(MODELS_DIR / f"{model}.urdf").getroot().iter("joint"):
+        if joint.get("type") not in ("revolute", "prismatic", "continuous"):
+            continue
+        lim = joint.find("limit")
+        vel = float(lim.get("velocity"))
+        acc = lim.get("acceleration")
+        rows.append((float(lim.get("lower", "-inf")), float(lim.get("upper", "inf")), vel,
+                     float(acc) if acc is not None else vel / DEFAULT_ACCEL_TIME))
+    return np.array(rows)
+
+
+def draw_case(model, seed, model_index, case, limits):
+    """The case's start joints (rad), offset (m) and TCP speed (m/s): its own generator,
+    so case i does not depend on how many cases run."""
+    rng = np.random.default_rng([seed, model_index, case])
+    q = np.array([rng.uniform(lo, hi) for lo, hi in START[model]])
+    q[WRIST] *= rng.choice([-1.0, 1.0])
+    q = np.clip(np.radians(q), limits[:, 0], limits[:, 1])
+    direction = rng.normal(size=3)
+    direction /= np.linalg.norm(direction)
+    offset = direction * rng.uniform(*LENGTH_MM) / 1000.0
+    speed = float(rng.choice(SPEEDS))
+    return q, offset, speed
+
+
+def write_cell(folder, model, q, offset, speed):
+    folder.joinpath("cell.toml").write_text(
+        f'name = "fidelity"\n[[robot]]\nname = "r1"\nmodel = "{model}"\nprogram = "r1.wsl"\n')
+    joints = ", ".join(f"{v:.15f}rad" for v in q)
+    dx, dy, dz = (f"{v * 1000.0:.12f}mm" for v in offset)
+    folder.joinpath("r1.wsl").write_text(
+        "proc main() {\n"
+        f"    move_j joints({joints});\n"
+        f"    move_l offset(current_pose(), {dx}, {dy}, {dz}) speed {speed * 1000.0:g}mm/s zone fine;\n"
+        "}\n")
+    return folder / "cell.toml"
+
+
+def skip_reason(result):
+    if result.outcome == "collision":
+        c = result.collisions[0]
+        return f"collision {c.a} {c.b}"
+    if result.errors:
+        return result.errors[0].message
+    return result.outcome
+
+
+def record(cell, t0_ns, t1_ns):
+    """Step a Simulation through [t0, t1] on a uniform grid of at most STEP: times (s,
+    from the sim's own ns clock), joints (n, 6) and TCP positions (n, 3)."""
+    sim = cell.simulation()
+    robot = sim.robot("r1")
+    n = min(MAX_SAMPLES, max(2, math.ceil((t1_ns - t0_ns) * 1e-9 / STEP)))
+    times, joints, tcp = [], [], []
+    for k in range(n + 1):
+        t_ns = t0_ns + round((t1_ns - t0_ns) * k / n)
+        sim.run_until(t_ns * 1e-9)
+        times.append(sim.time_ns * 1e-9)
+        joints.append(robot.joints.copy())
+        tcp.append(robot.tcp[:3, 3].copy())
+    return np.array(times), np.array(joints), np.array(tcp)
+
+
+def path_samples(q, p):
+    """(s, q) knots for the spline: s is the cumulative TCP chord length; samples closer
+    than L/4000 to the previous knot are dropped (the ends, where the TCP is at rest), and
+    the last sample is always a knot."""
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
+    ds_min = s[-1] / 4000.0
+    keep = [0]
+    for i in range(1, len(s)):
+        if s[i] - s[keep[-1]] >= ds_min:
+            keep.append(i)
+    if keep[-1] != len(s) - 1:
+        keep[-1] = len(s) - 1
+    return s[keep], q[keep]
+
+
+def toppra_time(s, q, vlim, alim, speed):
+    """Time-optimal duration along q(s) (cubic spline), joints within vlim/alim, the
+    virtual joint s within speed and speed / 0.3 s. None if toppra finds no profile."""
+    import toppra as ta
+    import toppra.algorithm as algo
+    import toppra.constraint as constraint
+
+    way = np.column_stack([q, s])
+    path = ta.SplineInterpolator(s, way)
+    v = np.append(vlim, speed)
+    a = np.append(alim, speed / TCP_ACCEL_TIME)
+    cons = [constraint.JointVelocityConstraint(np.column_stack([-v, v])),
+            constraint.JointAccelerationConstraint(
+                np.column_stack([-a, a]), discretization_scheme=constraint.DiscretizationType.Interpolation)]
+    grid = np.linspace(s[0], s[-1], GRIDPOINTS)
+    instance = algo.TOPPRA(cons, path, gridpoints=grid)
+    sdd, sd, _ = instance.compute_parameterization(0.0, 0.0)
+    if sd is None or not np.all(np.isfinite(sd)):
+        return None
+    mean = sd[1:] + sd[:-1]
+    if np.any(mean <= 0):
+        return None
+    return float(np.sum(2.0 * np.diff(grid) / mean))
+
+
+def peaks(t, q, s, limits, speed):
+    """Peak joint speed and acceleration ratios (largest over the axes, and which axis),
+    and the TCP's, by finite differences on the recorded grid."""
+    dt = np.diff(t)
+    qd = np.diff(q, axis=0) / dt[:, None]
+    qdd = np.diff(qd, axis=0) / (0.5 * (t[2:] - t[:-2]))[:, None]
+    v_ratio = np.abs(qd).max(axis=0) / limits[:, 2]
+    a_ratio = np.abs(qdd).max(axis=0) / limits[:, 3]
+    sd = np.diff(s) / dt
+    sdd = np.diff(sd) / (0.5 * (t[2:] - t[:-2]))
+    return {
+        "peak_joint_speed_ratio": float(v_ratio.max()), "peak_speed_axis": int(v_ratio.argmax()) + 1,
+        "peak_joint_accel_ratio": float(a_ratio.max()), "peak_accel_axis": int(a_ratio.argmax()) + 1,
+        "tcp_speed_ratio": float(sd.max() / speed),
+        "tcp_accel_ratio": float(np.abs(sdd).max() / (speed / TCP_ACCEL_TIME)),
+    }
+
+
+def run_case(vworks, folder, model, index, case, seed, limits):
+    q0, offset, speed = draw_case(model, seed, index, case, limits)
+    row = {"model": model, "case": case, "start_deg": np.degrees(q0).round(6).tolist(),
+           "offset_mm": (offset * 1000).round(6).tolist(), "length_mm": float(np.linalg.norm(offset) * 1000),
+           "speed_mps": speed}
+    try:
+        cell = vworks.load_cell(write_cell(folder, model, q0, offset, speed))
+        result = cell.run(check=False)
+    except vworks.Error as e:  # a start outside the limits, a program that does not load
+        row["skipped"] = f"{type(e).__name__}: {e}".splitlines()[0]
+        return row
+    if result.outcome != "completed":
+        row["skipped"] = skip_reason(result)
+        return row
+    events = list(result.events)
+    start = next(i for i, e in enumerate(events) if e.kind == "motion_start" and e.data["command"] == "move_l")
+    end = next(e for e in events[start:] if e.kind == "motion_end")
+    t0, t1 = events[start].time_ns, end.time_ns
+    row["slowdown"] = [w.message for w in result.warnings if w.kind == "slowdown"]
+    row["vworks_s"] = (t1 - t0) * 1e-9
+    if t1 == t0:
+        row["skipped"] = "move_l took no time"
+        return row
+
+    t, q, p = record(cell, t0, t1)
+    line = p[-1] - p[0]
+    chord = np.linalg.norm(line)
+    u = line / chord
+    off_line = p - p[0] - np.outer((p - p[0]) @ u, u)
+    row["samples"] = len(t)
+    row["path_error_mm"] = float(np.linalg.norm(off_line, axis=1).max() * 1000)
+    row["end_error_mm"] = float(np.linalg.norm(line - offset) * 1000)
+    s_all = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
+    row.update(peaks(t, q, s_all, limits, speed))
+    if row["peak_joint_speed_ratio"] > JUMP:
+        step = np.abs(np.diff(q, axis=0))
+        i, j = np.unravel_index(step.argmax(), step.shape)
+        row["jump"] = {"time_s": float(t[i + 1] - t[0]), "axis": int(j) + 1, "deg": float(np.degrees(step[i, j])),
+                       "path_fraction": float(s_all[i + 1] / s_all[-1])}
+        return row  # no smooth path for toppra: left out of the ratios
+
+    s, qk = path_samples(q, p)
+    row["knots"] = len(s)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        best = toppra_time(s, qk, limits[:, 2], limits[:, 3], speed)
+    if best is None:
+        row["skipped"] = "toppra found no profile"
+        return row
+    row["toppra_s"] = best
+    row["ratio"] = row["vworks_s"] / best
+    return row
+
+
+def summary(model, rows):
+    done = [r for r in rows if "ratio" in r]
+    jumps = sum(1 for r in rows if "jump" in r)
+    skipped = sum(1 for r in rows if "skipped" in r)
+    head = f"{model:<12} {len(done) + jumps:>3} {skipped:>4} {jumps:>4}"
+    if not done:
+        return head + "   (no case to compare)"
+    ratios = np.array([r["ratio"] for r in done])
+    faster = int(np.sum(ratios < 1.0 - FASTER_TOL))
+    slowed = sum(1 for r in done if r["slowdown"])
+    vmax = max(r["peak_joint_speed_ratio"] for r in done)
+    amax = max(r["peak_joint_accel_ratio"] for r in done)
+    over = sum(1 for r in done if r["peak_joint_accel_ratio"] > 1.0 + FASTER_TOL)
+    return (f"{head}   {np.median(ratios):>6.3f} {ratios.max():>6.3f} "
+            f"{ratios.min():>6.3f}   {faster:>3}/{len(done):<3} {slowed:>4}   {vmax:>6.2f}   {amax:>6.2f} "
+            f"({over} over 1)")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--cases", type=int, default=15, help="random cases per model (default 15)")
+    parser.add_argument("--seed", type=int, default=1, help="random seed (default 1)")
+    parser.add_argument("--models", nargs="+", default=list(START), choices=list(START))
+    parser.add_argument("--json", type=Path, help="write the per-case data to this file")
+    parser.add_argument("-v", "--verbose", action="store_true", help="print each case")
+    args = parser.parse_args()
+
+    try:
+        import toppra  # noqa: F401
+    except ImportError:
+        sys.exit("needs toppra: .venv/bin/python -m pip install toppra")
+    import logging
+    logging.getLogger("toppra").setLevel(logging.ERROR)
+    import vworks
+
+    began = time.perf_counter()
+    rows = {m: [] for m in args.models}
+    with tempfile.TemporaryDirectory() as tmp:
+        for model in args.models:
+            index = list(START).index(model)
+            limits = urdf_limits(model)
+            for case in range(args.cases):
+                row = run_case(vworks, Path(tmp), model, index, case, args.seed, limits)
+                rows[model].append(row)
+                if args.verbose:
+                    if "ratio" in row:
+                        what = (f"ratio {row['ratio']:.4f} vworks {row['vworks_s']:.4f} s toppra {row['toppra_s']:.4f} s "
+                                f"peak speed {row['peak_joint_speed_ratio']:.2f} accel {row['peak_joint_accel_ratio']:.2f}"
+                                + (" (slowed)" if row["slowdown"] else ""))
+                    elif "jump" in row:
+                        what = f"joint jump {row['jump']} vworks {row['vworks_s']:.3f} s"
+                    else:
+                        what = f"skipped: {row['skipped']}"
+                    print(f"  {model} {case:>3} {row['length_mm']:6.1f} mm {row['speed_mps']:g} m/s  {what}",
+                          file=sys.stderr)
+
+    print(f"move_l against toppra (time-optimal under the same joint and TCP speed/accel limits), "
+          f"{args.cases} cases per model, seed {args.seed}")
+    print("ratio = vworks time / toppra time; worst = largest, best = smallest; faster = ratio < 0.999;")
+    print("slowed = vworks warned it slowed the motion (an axis speed limit); peaks: max over cases of the")
+    print("largest |joint speed| and |joint accel| over its limit, finite differences on a ~1 ms grid;")
+    print(f"jump = ran, but a joint moved faster than {JUMP:g}x its limit between two samples (the IK changed")
+    print("configuration on the way): no smooth path for toppra, left out of the ratios and peaks")
+    print()
+    print(f"{'model':<12} {'run':>3} {'skip':>4} {'jump':>4}   {'median':>6} {'worst':>6} {'best':>6}   {'faster':>7} "
+          f"{'slowed':>6}   {'speed':>6}   {'accel':>6}")
+    for model in args.models:
+        print(summary(model, rows[model]))
+    reasons = {}
+    for model in args.models:
+        for r in rows[model]:
+            if "skipped" in r:
+                key = r["skipped"].split(":")[0][:60]
+                reasons[key] = reasons.get(key, 0) + 1
+    if reasons:
+        print("skipped: " + "; ".join(f"{n}x {k}" for k, n in sorted(reasons.items(), key=lambda kv: -kv[1])))
+    print(f"took {time.perf_counter() - began:.1f} s")
+    if args.json:
+        args.json.write_text(json.dumps({"seed": args.seed, "cases": args.cases,
+                                         "rows": [r for m in args.models for r in rows[m]]}, indent=1))
+
+
+if __name__ == "__main__":
+    main()
