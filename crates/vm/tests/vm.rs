@@ -608,7 +608,7 @@ fn limits_reach_and_speed_are_checked() {
     );
     let w = v.take_warnings();
     assert!(
-        w.iter().any(|w| w.message.contains("slowed")
+        w.iter().any(|w| w.message.contains("slows the motion")
             && w.pos.line == 3
             && w.kind == WarningKind::Slowdown),
         "{w:?}"

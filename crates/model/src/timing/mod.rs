@@ -23,7 +23,7 @@
 use crate::ik::MAX_AXES;
 
 /// Steps the path is cut into.
-pub const SEGMENTS: usize = 128;
+pub const SEGMENTS: usize = 256;
 /// Points where the limits hold: the ends of the steps.
 pub const KNOTS: usize = SEGMENTS + 1;
 

@@ -309,10 +309,7 @@ fn a_path_that_cannot_move_or_is_not_a_number_is_an_error() {
     assert!(
         matches!(
             Timing::optimal(&p, &lim),
-            Err(TimingError::Stuck {
-                axis: 1,
-                knot: 64 | 65
-            })
+            Err(TimingError::Stuck { axis: 1, knot }) if knot.abs_diff(SEGMENTS / 2) <= 1
         ),
         "{:?}",
         Timing::optimal(&p, &lim)

@@ -10,9 +10,8 @@ use vworks_model::RobotModel;
 use vworks_model::math::Iso;
 
 use super::blend::{self, Fading, Planned};
-use super::plan::{
-    self, Longer, MotionOperands, PathMemo, PlanError, PlanFrom, Slowed, Trajectory,
-};
+use super::path::PathMemo;
+use super::plan::{self, Longer, MotionOperands, PlanError, PlanFrom, Slowed, Trajectory};
 use crate::MAX_AXES;
 use crate::bytecode::SrcPos;
 use crate::motion::NS;

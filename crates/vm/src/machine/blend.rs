@@ -140,7 +140,7 @@ pub(super) fn zone_entry(
             return (point_ns, 0.0);
         }
         let r1 = r.min(0.5 * len);
-        let t = profile.time_at(profile.dist * (1.0 - r1 / len));
+        let t = traj.time_at_fraction(1.0 - r1 / len);
         return (to_ns(t), r1);
     }
     let n = model.dof();
@@ -254,20 +254,20 @@ fn corner_bounds(
             Trajectory::Cartesian {
                 path: p1,
                 profile: s1,
+                timing: t1,
                 ..
             },
             Trajectory::Cartesian {
                 path: p2,
                 profile: s2,
+                timing: t2,
                 ..
             },
         ) => {
             let (l1, l2) = (p1.length(), p2.length());
-            let frac = |p: &Profile, t: f64| {
-                if p.dist > 0.0 { p.at(t) / p.dist } else { 1.0 }
-            };
-            let a = l1 * (1.0 - frac(s1, off1));
-            let b = l2 * frac(s2, window);
+            let first = &f.motion.traj;
+            let a = l1 * (1.0 - first.fraction_at(off1));
+            let b = l2 * next.fraction_at(window);
             let radius = match (p1, p2) {
                 (Path::Line { from, to }, Path::Line { to: to2, .. }) if l1 > 0.0 && l2 > 0.0 => {
                     use vworks_model::math::{norm, sub};
@@ -285,11 +285,23 @@ fn corner_bounds(
             if radius > f.motion.zone.min(0.5 * l2) + 1e-12 {
                 return None;
             }
-            let k1 = if s1.dist > 0.0 { l1 / s1.dist } else { 0.0 };
-            let k2 = if s2.dist > 0.0 { l2 / s2.dist } else { 0.0 };
-            let vmax = (k1 * s1.v).max(k2 * s2.v);
-            let (speed, _) = window_extremes(window, [(s1, off1, k1), (s2, 0.0, k2)]);
-            (speed <= vmax * (1.0 + 1e-9)).then_some(radius)
+            if t1.is_none() && t2.is_none() {
+                let k1 = if s1.dist > 0.0 { l1 / s1.dist } else { 0.0 };
+                let k2 = if s2.dist > 0.0 { l2 / s2.dist } else { 0.0 };
+                let vmax = (k1 * s1.v).max(k2 * s2.v);
+                let (speed, _) = window_extremes(window, [(s1, off1, k1), (s2, 0.0, k2)]);
+                return (speed <= vmax * (1.0 + 1e-9)).then_some(radius);
+            }
+            // A path timed within its axes' limits: the summed path speed at 65 points of
+            // the window within the faster motion's top speed (the sampled checks of the
+            // axes follow).
+            let vmax = (l1 * first.top_path_speed()).max(l2 * next.top_path_speed());
+            let within = (0..=64).all(|j| {
+                let tau = window * f64::from(j) / 64.0;
+                let v = l1 * first.path_speed_at(off1 + tau) + l2 * next.path_speed_at(tau);
+                v <= vmax * (1.0 + 1e-9)
+            });
+            within.then_some(radius)
         }
         _ => {
             if 2.0 * window > next_ns as f64 / NS {

@@ -19,6 +19,7 @@ mod describe;
 mod handlers;
 mod interp;
 mod names;
+mod path;
 mod plan;
 mod pulses;
 mod remote;

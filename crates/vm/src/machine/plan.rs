@@ -4,7 +4,8 @@
 //! and TCP at any time inside a trajectory (the collider's sweep reads its speed bounds).
 //!
 //! Planning allocates nothing: operands are read into fixed-size arrays, and a Cartesian
-//! path's samples are remembered in a [`PathMemo`] of fixed capacity.
+//! path's samples are remembered in a [`PathMemo`](super::path::PathMemo) of fixed
+//! capacity (module `path`).
 
 use vworks_model::math::Iso;
 use vworks_model::{IkError, RobotModel};
@@ -14,14 +15,9 @@ use crate::MAX_AXES;
 use crate::bytecode::{Instr, MoveFlags};
 use crate::motion::{NS, Path, Profile, cartesian_at};
 use crate::types::{Dim, fmt_quantity};
+use vworks_model::timing::{SEGMENTS, Timing};
 
-/// Points a Cartesian path is checked at (reachability and axis speeds).
-const PATH_SAMPLES: usize = 64;
-/// Sampled paths a VM remembers (the oldest goes first).
-const PATH_MEMO: usize = 32;
-/// A sampled path's key: the bits of the start joints, the start and goal poses (rotation,
-/// translation), the via point (NaN for a line) and the path speed.
-const PATH_KEY: usize = MAX_AXES + 12 + 12 + 3 + 1 + 12;
+use super::path::{PATH_KEY, PathMemo, PathSamples, sample_path};
 
 /// How far (relative) an axis's speed found by sampling may exceed its limit and still
 /// count as within it: `|Δq|/Δt > v_max · (1 + JOINT_SPEED_TOLERANCE)` is too fast. Both
@@ -42,6 +38,34 @@ pub enum PlanError {
         error: IkError,
         /// Where on a Cartesian path (percent of its length), if not at the target.
         at_percent: Option<f64>,
+    },
+    /// The path passes a point where an axis would need unbounded speed (a singularity,
+    /// or inverse kinematics changing configuration): the motion cannot move there.
+    #[error(
+        "the path passes a singularity at {at_percent:.0}% of its length: axis {} would need unbounded speed there; move the path away from it (change the target or the approach), or use move_j",
+        axis + 1
+    )]
+    Singular {
+        /// The axis (0-based).
+        axis: usize,
+        /// Where (percent of the path).
+        at_percent: f64,
+    },
+    /// Along the path the joints jump to another configuration: an axis turns more than
+    /// [`MAX_KNOT_TURN`] within one step of the path (a wrist or shoulder singularity on the
+    /// way, or inverse kinematics changing branch).
+    #[error(
+        "the path passes a singularity at {at_percent:.0}% of its length: axis {} would turn {turn_deg:.0}° within 1/{} of the path (the arm changes configuration there); a controller stops here too: move the path away from it (another target, approach or wrist configuration), or use move_j",
+        axis + 1,
+        SEGMENTS
+    )]
+    ConfigurationJump {
+        /// The axis (0-based).
+        axis: usize,
+        /// Where (percent of the path).
+        at_percent: f64,
+        /// How far it would turn (degrees, or mm for a prismatic axis).
+        turn_deg: f64,
     },
     /// A `move_j` target outside an axis's range.
     #[error(
@@ -101,52 +125,6 @@ pub enum PlanError {
         fmt_quantity(*.0, Dim::LENGTH)
     )]
     Zone(f64),
-}
-
-/// What sampling a Cartesian path found: the slowest ratio of an axis's speed limit to its
-/// speed (1 if none is exceeded) and that axis, each axis's largest speed, the joints at
-/// the end.
-#[derive(Clone, Copy, Debug)]
-struct PathSamples {
-    worst: f64,
-    worst_axis: usize,
-    rates: [f64; MAX_AXES],
-    end: [f64; MAX_AXES],
-}
-
-/// Cartesian paths sampled, by the bits of their joints, poses, speed and tool: a program
-/// repeating its moves samples each once. A cache of a pure function (exact keys): [`plan`]
-/// gives the same with an empty memo as with a full one.
-#[derive(Debug)]
-pub(super) struct PathMemo {
-    entries: Vec<([u64; PATH_KEY], PathSamples)>,
-}
-
-impl PathMemo {
-    /// An empty memo, its room reserved once.
-    pub(super) fn new() -> PathMemo {
-        PathMemo {
-            entries: Vec::with_capacity(PATH_MEMO),
-        }
-    }
-
-    /// The samples under `key`, or those `sample` makes (then remembered; the oldest goes
-    /// when the memo is full, so it never grows past its capacity).
-    fn get_or_sample(
-        &mut self,
-        key: [u64; PATH_KEY],
-        sample: impl FnOnce() -> Result<PathSamples, PlanError>,
-    ) -> Result<PathSamples, PlanError> {
-        if let Some((_, s)) = self.entries.iter().find(|(k, _)| *k == key) {
-            return Ok(*s);
-        }
-        let s = sample()?;
-        if self.entries.len() >= PATH_MEMO {
-            self.entries.remove(0);
-        }
-        self.entries.push((key, s));
-        Ok(s)
-    }
 }
 
 /// Up to 12 slots of a pose (6) or joints (12) operand, without allocating.
@@ -313,12 +291,14 @@ pub(super) struct Longer {
     pub(super) how: &'static str,
 }
 
-/// A Cartesian motion slowed to `ratio` of its speed: axis `axis` (0-based) would exceed
-/// its speed limit.
+/// A Cartesian motion slowed below its programmed speed where axis `axis` (0-based) would
+/// exceed its speed or acceleration limit: it lasts `lasts` ns where the programmed speed
+/// and acceleration alone would take `would` ns.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Slowed {
-    pub(super) ratio: f64,
     pub(super) axis: usize,
+    pub(super) lasts: i64,
+    pub(super) would: i64,
 }
 /// A planned motion.
 // One per VM (its current motion), never in a collection: the variants' sizes do not
@@ -340,12 +320,15 @@ pub(super) enum Trajectory {
         delta: [f64; MAX_AXES],
         profiles: [Profile; MAX_AXES],
     },
-    /// Cartesian: the TCP along `path`, orientation by slerp; joints by IK.
+    /// Cartesian: the TCP along `path`, orientation by slerp; joints by IK. The path
+    /// fraction follows `profile`, or `timing` where the profile would take an axis past
+    /// a limit (the time-optimal timing within them).
     Cartesian {
         path: Path,
         from: Iso,
         to: Iso,
         profile: Profile,
+        timing: Option<Timing>,
         end_joints: [f64; MAX_AXES],
         /// The analytic IK branch the motion stays on (spherical-wrist arms).
         branch: Option<u8>,
@@ -452,16 +435,76 @@ impl Trajectory {
                 }
                 Some(q)
             }
-            Trajectory::Cartesian {
-                profile,
-                end_joints,
-                ..
-            } => {
-                if dt >= profile.t_total {
+            Trajectory::Cartesian { end_joints, .. } => {
+                if dt >= self.path_duration() {
                     return Some(*end_joints);
                 }
                 self.ik_on(model, &self.pose_at(model, &Iso::IDENTITY, dt))
             }
+        }
+    }
+
+    /// How long a Cartesian trajectory takes (s; 0 for a joint one).
+    pub(super) fn path_duration(&self) -> f64 {
+        match self {
+            Trajectory::Cartesian {
+                timing: Some(t), ..
+            } => t.duration(),
+            Trajectory::Cartesian { profile, .. } => profile.t_total,
+            _ => 0.0,
+        }
+    }
+
+    /// The fraction of a Cartesian trajectory's path done `dt` seconds in (1 for a joint
+    /// one).
+    pub(super) fn fraction_at(&self, dt: f64) -> f64 {
+        match self {
+            Trajectory::Cartesian {
+                timing: Some(t), ..
+            } => t.at(dt).s,
+            Trajectory::Cartesian { profile, .. } if profile.dist > 0.0 => {
+                (profile.at(dt) / profile.dist).min(1.0)
+            }
+            _ => 1.0,
+        }
+    }
+
+    /// The path speed `ds/dt` (fractions of the path per second) of a Cartesian trajectory
+    /// `dt` seconds in (0 for a joint one).
+    pub(super) fn path_speed_at(&self, dt: f64) -> f64 {
+        match self {
+            Trajectory::Cartesian {
+                timing: Some(t), ..
+            } => t.at(dt).speed,
+            Trajectory::Cartesian { profile, .. } if profile.dist > 0.0 => {
+                profile.speed_at(dt) / profile.dist
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// The largest path speed of a Cartesian trajectory (fractions of the path per
+    /// second; 0 for a joint one).
+    pub(super) fn top_path_speed(&self) -> f64 {
+        match self {
+            Trajectory::Cartesian {
+                timing: Some(t), ..
+            } => t.top_speed(),
+            Trajectory::Cartesian { profile, .. } if profile.dist > 0.0 => {
+                profile.speed_at(0.5 * profile.t_total) / profile.dist
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// The time (s) a Cartesian trajectory reaches path fraction `s`.
+    pub(super) fn time_at_fraction(&self, s: f64) -> f64 {
+        match self {
+            Trajectory::Cartesian {
+                timing: Some(t), ..
+            } => t.time_at(s),
+            Trajectory::Cartesian { profile, .. } => profile.time_at(s * profile.dist),
+            _ => 0.0,
         }
     }
 
@@ -488,19 +531,8 @@ impl Trajectory {
     /// (a Cartesian one has its own).
     pub(super) fn pose_at(&self, model: &RobotModel, tool: &Iso, dt: f64) -> Iso {
         match self {
-            Trajectory::Cartesian {
-                path,
-                from,
-                to,
-                profile,
-                ..
-            } => {
-                let s = if profile.dist > 0.0 {
-                    (profile.at(dt) / profile.dist).min(1.0)
-                } else {
-                    1.0
-                };
-                cartesian_at(path, from, to, s)
+            Trajectory::Cartesian { path, from, to, .. } => {
+                cartesian_at(path, from, to, self.fraction_at(dt))
             }
             _ => {
                 // (A joint trajectory always has joints.)
@@ -536,7 +568,7 @@ pub(super) fn plan(
 }
 
 /// The joints of TCP pose `tcp` with tool `tool`, nearest `near`.
-fn ik_tcp(
+pub(super) fn ik_tcp(
     model: &RobotModel,
     tool: &Iso,
     tcp: &Iso,
@@ -741,13 +773,14 @@ fn plan_cartesian(
             "at 7 m/s and 500°/s, the fastest TCP and orientation speeds",
         );
     }
-    let (mut vs, mut as_, mut js) = limits(v, a, w);
+    let (vs, as_, js) = limits(v, a, w);
     if !vs.is_finite() {
         let traj = Trajectory::Cartesian {
             path,
             from: start,
             to: goal,
             profile: Profile::new(0.0, 1.0, 1.0),
+            timing: None,
             end_joints: start_joints,
             branch: None,
             rates: [0.0; MAX_AXES],
@@ -761,9 +794,10 @@ fn plan_cartesian(
             slowed: None,
         });
     }
-    // Joints along the path: reachable, and within every axis's speed at this speed.
-    // The same path from the same joints at the same speed samples the same: a program
-    // repeating its moves samples each once (`memo`, exact: keyed by the bits).
+    // Joints along the path: reachable, and within every axis's speed and acceleration
+    // under the profile; where they are not, the time-optimal timing along the path.
+    // The same path from the same joints with the same limits samples the same: a
+    // program repeating its moves samples each once (`memo`, exact: keyed by the bits).
     let mut key = [0u64; PATH_KEY];
     let via_or_none = via_t.unwrap_or([f64::NAN; 3]);
     for (k, x) in start_joints
@@ -773,44 +807,45 @@ fn plan_cartesian(
         .chain(goal.r.iter().flatten())
         .chain(&goal.t)
         .chain(&via_or_none)
-        .chain([&vs])
+        .chain([&vs, &as_, &js])
         .chain(tool.r.iter().flatten())
         .chain(&tool.t)
         .enumerate()
     {
         key[k] = x.to_bits();
     }
+    let profile = Profile::with_jerk(1.0, vs, as_, js);
+    let branch = model.ik_branch(&start.mul(&tool.inverse()), &start_joints[..n]);
     let sampled = memo.get_or_sample(key, || {
-        sample_path(model, &tool, &path, &start, &goal, &start_joints, vs)
+        let ends = (&path, &start, &goal, &start_joints);
+        sample_path(model, &tool, ends, branch, &profile)
     })?;
     let PathSamples {
-        worst,
+        timing,
         worst_axis,
-        mut rates,
+        rates,
         end: prev,
     } = sampled;
-    let mut slowed = None;
-    if worst < 1.0 {
-        vs *= worst;
-        as_ *= worst;
-        js *= worst;
-        for r in &mut rates {
-            *r *= worst;
+    let (duration_ns, slowed) = match &timing {
+        None => (profile.duration_ns(), None),
+        Some(t) => {
+            let lasts = (t.duration() * NS).ceil() as i64;
+            let would = profile.duration_ns();
+            let slowed = Slowed {
+                axis: worst_axis,
+                lasts,
+                would,
+            };
+            (lasts, Some(slowed))
         }
-        slowed = Some(Slowed {
-            ratio: worst,
-            axis: worst_axis,
-        });
-    }
-    let profile = Profile::with_jerk(1.0, vs, as_, js);
-    let duration_ns = profile.duration_ns();
-    let branch = model.ik_branch(&start.mul(&tool.inverse()), &start_joints[..n]);
+    };
     Ok(Plan {
         traj: Trajectory::Cartesian {
             path,
             from: start,
             to: goal,
             profile,
+            timing,
             end_joints: prev,
             branch,
             rates,
@@ -820,52 +855,6 @@ fn plan_cartesian(
         duration_ns,
         longer,
         slowed,
-    })
-}
-
-/// Samples a Cartesian path at [`PATH_SAMPLES`] points from joints `from`: every point
-/// reachable (or the error, naming where), each axis's largest speed at path speed `vs`
-/// (1/s), and the slowest ratio of an axis's limit to its speed, if one is exceeded.
-fn sample_path(
-    model: &RobotModel,
-    tool: &Iso,
-    path: &Path,
-    start: &Iso,
-    goal: &Iso,
-    from: &[f64; MAX_AXES],
-    vs: f64,
-) -> Result<PathSamples, PlanError> {
-    let n = model.dof();
-    let mut prev = *from;
-    let mut worst = 1.0f64;
-    let mut worst_axis = 0;
-    let mut rates = [0.0f64; MAX_AXES];
-    for k in 1..=PATH_SAMPLES {
-        let s = k as f64 / PATH_SAMPLES as f64;
-        let pose = cartesian_at(path, start, goal, s);
-        let q = ik_tcp(model, tool, &pose, &prev).map_err(|error| PlanError::Unreachable {
-            error,
-            at_percent: Some(s * 100.0),
-        })?;
-        for i in 0..n {
-            // ds/dt at most vs: axis speed ≈ |Δq/Δs|·vs.
-            let rate = (q[i] - prev[i]).abs() * PATH_SAMPLES as f64 * vs;
-            rates[i] = rates[i].max(rate);
-            let j = model.axis(i);
-            if rate > j.max_velocity * (1.0 + JOINT_SPEED_TOLERANCE)
-                && j.max_velocity / rate < worst
-            {
-                worst = j.max_velocity / rate;
-                worst_axis = i;
-            }
-        }
-        prev = q;
-    }
-    Ok(PathSamples {
-        worst,
-        worst_axis,
-        rates,
-        end: prev,
     })
 }
 

@@ -704,10 +704,11 @@ impl Vm {
                 pos,
                 kind: WarningKind::Slowdown,
                 message: format!(
-                    "the motion is slowed to {:.0}% of its speed: axis {} `{}` would exceed its speed limit",
-                    s.ratio * 100.0,
+                    "axis {} `{}` slows the motion where it would exceed its speed or acceleration limit: it takes {}, {} at the programmed speed alone",
                     s.axis + 1,
-                    j.name
+                    j.name,
+                    fmt_quantity(s.lasts as f64 / NS, Dim::TIME),
+                    fmt_quantity(s.would as f64 / NS, Dim::TIME),
                 ),
             });
         }
