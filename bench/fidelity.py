@@ -1,21 +1,30 @@
 #!/usr/bin/env python3
-"""How close are vworks's straight-line motions (`move_l`) to the time-optimal motion
-along the same path under the same limits? toppra (time-optimal path parameterisation,
-PyPI `toppra`) is the oracle.
+"""How close are vworks's straight-line and circular motions (`move_l`, `move_c`) to the
+time-optimal motion along the same path under the same limits? toppra (time-optimal path
+parameterisation, PyPI `toppra`) is the oracle.
 
 For each built-in 6-axis arm (irb120, kr6r900, lrmate200id, ur5) and N random cases:
 
 1. Start joints at random in a sane part of the workspace (elbow bent, wrist axis 5 at
    least 25 degrees from 0, model by model: `START` below), a straight line from the TCP
    there, translated by a random vector of 50-600 mm with the same orientation, at a TCP
-   speed drawn from 100 mm/s, 500 mm/s, 1 m/s, 2 m/s, 4 m/s.
+   speed drawn from 100 mm/s, 500 mm/s, 1 m/s, 2 m/s, 4 m/s. An arc case (`--kind arc`)
+   has the same start, target and speed as the line case of its number, and a via point:
+   the chord's midpoint pushed sideways by 20-45 % of the chord length, in a random
+   direction perpendicular to the chord (its own generator, so the line cases do not
+   change), the same orientation throughout; the program's last motion is then
+   `move_c offset(current_pose(), vx, vy, vz), offset(current_pose(), dx, dy, dz) speed V`
+   (both offsets from the start pose).
 2. A one-robot workcell in a temporary folder runs
    `move_j START; move_l offset(current_pose(), dx, dy, dz) speed V;` (a fine point, the
-   model's default acceleration). The move_l's duration is its motion_start to its
-   motion_end (events, ns). A case vworks cannot run (unreachable on the way, a joint
-   limit, a self-collision) is skipped and counted. A Simulation is then stepped through
-   the move_l on a uniform grid of about 1 ms (T / ceil(T / 1 ms)), reading the joints
-   and the TCP.
+   model's default acceleration). The move_l's (move_c's) duration is its motion_start to
+   its motion_end (events, ns). A case vworks cannot run (unreachable on the way, a joint
+   limit, a self-collision, a singularity) is skipped and counted. A Simulation is then stepped through
+   the motion on a uniform grid of about 1 ms (T / ceil(T / 1 ms)), reading the joints
+   and the TCP. `path_error_mm` is the largest distance of the recorded TCP from the line
+   through start and target (a line) or from the circle through start, via and target
+   (an arc); for an arc `via_miss_mm` is the distance from the via point to the recorded
+   polyline (the arc passes through it, not the other way round the circle).
 3. The path for toppra: the joints as a cubic spline (scipy, through toppra's
    SplineInterpolator) of s, the TCP's arc length along the recorded positions (samples
    closer than L/4000 in s are dropped, as at the ends, where the TCP is at rest), plus a
@@ -31,17 +40,17 @@ For each built-in 6-axis arm (irb120, kr6r900, lrmate200id, ur5) and N random ca
    the limits (largest over the axes), by finite differences on the ~1 ms grid (first
    differences for speed, second differences for acceleration). A case whose joints move
    faster than 2x a limit between two samples is a "jump": the joints along the line
-   leave one configuration for another (the TCP stays on the line); there is no smooth
+   leave one configuration for another (the TCP stays on the path); there is no smooth
    path for toppra, so it is counted but left out of the ratios and peaks.
 
-The table gives per model: cases run and skipped, the ratio vworks time / toppra time
+The table gives per model and kind (line, arc): cases run and skipped, the ratio vworks time / toppra time
 (median, worst = largest, best = smallest), how many cases vworks is faster than toppra
 (ratio below 1 - 1e-3: faster than the limits allow, which can only be by leaving
 one of them, e.g. the axis accelerations, which move_l does not bound: docs/engine.md,
 "Zones"), and the largest peak joint speed and acceleration ratios. `--json FILE`
 writes every case.
 
-    .venv/bin/python bench/fidelity.py --cases 15 [--seed 1] [--json fidelity.json]
+    .venv/bin/python bench/fidelity.py --cases 15 [--kind line|arc|both] [--seed 1] [--json fidelity.json]
 
 Needs toppra (`.venv/bin/python -m pip install toppra`, which brings scipy). Deterministic
 for a given seed: case i of a model is the same whatever --cases is.
@@ -66,6 +75,8 @@ DEFAULT_ACCEL_TIME = 0.3  # s: full speed in 0.3 s, axes without <limit accelera
 TCP_ACCEL_TIME = 0.3  # s: the TCP's default ramp for move_l, a = V / 0.3 s (docs/engine.md, "Zones")
 SPEEDS = [0.1, 0.5, 1.0, 2.0, 4.0]  # m/s
 LENGTH_MM = (50.0, 600.0)
+VIA_SIDEWAYS = (0.20, 0.45)  # an arc's via point: the chord's midpoint pushed sideways by this times the chord
+KINDS = ("line", "arc")
 STEP = 1e-3  # s, the recording grid (at most)
 MAX_SAMPLES = 20_000  # a motion longer than 20 s (a vworks slowdown) is recorded on a coarser grid
 JUMP = 2.0  # a joint faster than this times its limit between two samples: the IK switched branches
@@ -119,15 +130,38 @@ def draw_case(model, seed, model_index, case, limits):
     return q, offset, speed
 
 
-def write_cell(folder, model, q, offset, speed):
+def draw_via(seed, model_index, case, offset):
+    """An arc case's via point (m, from the start TCP): the chord's midpoint pushed sideways
+    by VIA_SIDEWAYS of the chord, in a random direction perpendicular to it. Its own
+    generator, so the line cases (draw_case) stay as they are."""
+    rng = np.random.default_rng([seed, model_index, case, 1])
+    chord = np.linalg.norm(offset)
+    u = offset / chord
+    while True:
+        side = rng.normal(size=3)
+        side -= (side @ u) * u
+        if np.linalg.norm(side) > 1e-6:
+            break
+    side /= np.linalg.norm(side)
+    return 0.5 * offset + side * rng.uniform(*VIA_SIDEWAYS) * chord
+
+
+def write_cell(folder, model, q, offset, speed, via=None):
     folder.joinpath("cell.toml").write_text(
         f'name = "fidelity"\n[[robot]]\nname = "r1"\nmodel = "{model}"\nprogram = "r1.wsl"\n')
     joints = ", ".join(f"{v:.15f}rad" for v in q)
-    dx, dy, dz = (f"{v * 1000.0:.12f}mm" for v in offset)
+
+    def at(v):
+        return "offset(current_pose(), " + ", ".join(f"{x * 1000.0:.12f}mm" for x in v) + ")"
+
+    if via is None:
+        motion = f"move_l {at(offset)}"
+    else:
+        motion = f"move_c {at(via)}, {at(offset)}"
     folder.joinpath("r1.wsl").write_text(
         "proc main() {\n"
         f"    move_j joints({joints});\n"
-        f"    move_l offset(current_pose(), {dx}, {dy}, {dz}) speed {speed * 1000.0:g}mm/s zone fine;\n"
+        f"    {motion} speed {speed * 1000.0:g}mm/s zone fine;\n"
         "}\n")
     return folder / "cell.toml"
 
@@ -155,6 +189,32 @@ def record(cell, t0_ns, t1_ns):
         joints.append(robot.joints.copy())
         tcp.append(robot.tcp[:3, 3].copy())
     return np.array(times), np.array(joints), np.array(tcp)
+
+
+def circle(a, b, c):
+    """Centre, unit normal and radius of the circle through three points."""
+    ab, ac = b - a, c - a
+    n = np.cross(ab, ac)
+    nn = n @ n
+    centre = a + (np.cross(n, ab) * (ac @ ac) + np.cross(ac, n) * (ab @ ab)) / (2.0 * nn)
+    return centre, n / math.sqrt(nn), float(np.linalg.norm(a - centre))
+
+
+def circle_distance(p, centre, normal, radius):
+    """Distance of each point of p (n, 3) from the circle."""
+    d = p - centre
+    h = d @ normal
+    r = np.linalg.norm(d - np.outer(h, normal), axis=1)
+    return np.hypot(h, r - radius)
+
+
+def polyline_distance(x, p):
+    """Distance of the point x from the polyline through the points p (n, 3)."""
+    a, b = p[:-1], p[1:]
+    ab = b - a
+    ll = np.einsum("ij,ij->i", ab, ab)
+    t = np.clip(np.einsum("ij,ij->i", x - a, ab) / np.where(ll > 0, ll, 1.0), 0.0, 1.0)
+    return float(np.linalg.norm(a + t[:, None] * ab - x, axis=1).min())
 
 
 def path_samples(q, p):
@@ -215,13 +275,18 @@ def peaks(t, q, s, limits, speed):
     }
 
 
-def run_case(vworks, folder, model, index, case, seed, limits):
+def run_case(vworks, folder, model, index, case, seed, limits, kind="line"):
+    """One case: kind "line" (move_l) or "arc" (move_c through a via point)."""
     q0, offset, speed = draw_case(model, seed, index, case, limits)
-    row = {"model": model, "case": case, "start_deg": np.degrees(q0).round(6).tolist(),
+    via = draw_via(seed, index, case, offset) if kind == "arc" else None
+    command = "move_c" if kind == "arc" else "move_l"
+    row = {"model": model, "kind": kind, "case": case, "start_deg": np.degrees(q0).round(6).tolist(),
            "offset_mm": (offset * 1000).round(6).tolist(), "length_mm": float(np.linalg.norm(offset) * 1000),
            "speed_mps": speed}
+    if via is not None:
+        row["via_mm"] = (via * 1000).round(6).tolist()
     try:
-        cell = vworks.load_cell(write_cell(folder, model, q0, offset, speed))
+        cell = vworks.load_cell(write_cell(folder, model, q0, offset, speed, via))
         result = cell.run(check=False)
     except vworks.Error as e:  # a start outside the limits, a program that does not load
         row["skipped"] = f"{type(e).__name__}: {e}".splitlines()[0]
@@ -230,23 +295,28 @@ def run_case(vworks, folder, model, index, case, seed, limits):
         row["skipped"] = skip_reason(result)
         return row
     events = list(result.events)
-    start = next(i for i, e in enumerate(events) if e.kind == "motion_start" and e.data["command"] == "move_l")
+    start = next(i for i, e in enumerate(events) if e.kind == "motion_start" and e.data["command"] == command)
     end = next(e for e in events[start:] if e.kind == "motion_end")
     t0, t1 = events[start].time_ns, end.time_ns
     row["slowdown"] = [w.message for w in result.warnings if w.kind == "slowdown"]
     row["vworks_s"] = (t1 - t0) * 1e-9
     if t1 == t0:
-        row["skipped"] = "move_l took no time"
+        row["skipped"] = f"{command} took no time"
         return row
 
     t, q, p = record(cell, t0, t1)
-    line = p[-1] - p[0]
-    chord = np.linalg.norm(line)
-    u = line / chord
-    off_line = p - p[0] - np.outer((p - p[0]) @ u, u)
     row["samples"] = len(t)
-    row["path_error_mm"] = float(np.linalg.norm(off_line, axis=1).max() * 1000)
-    row["end_error_mm"] = float(np.linalg.norm(line - offset) * 1000)
+    if via is None:
+        line = p[-1] - p[0]
+        u = line / np.linalg.norm(line)
+        off_line = p - p[0] - np.outer((p - p[0]) @ u, u)
+        row["path_error_mm"] = float(np.linalg.norm(off_line, axis=1).max() * 1000)
+    else:
+        centre, normal, radius = circle(p[0], p[0] + via, p[0] + offset)  # the programmed circle
+        row["radius_mm"] = radius * 1000
+        row["path_error_mm"] = float(circle_distance(p, centre, normal, radius).max() * 1000)
+        row["via_miss_mm"] = polyline_distance(p[0] + via, p) * 1000
+    row["end_error_mm"] = float(np.linalg.norm(p[-1] - p[0] - offset) * 1000)
     s_all = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
     row.update(peaks(t, q, s_all, limits, speed))
     if row["peak_joint_speed_ratio"] > JUMP:
@@ -269,11 +339,11 @@ def run_case(vworks, folder, model, index, case, seed, limits):
     return row
 
 
-def summary(model, rows):
+def summary(label, rows):
     done = [r for r in rows if "ratio" in r]
     jumps = sum(1 for r in rows if "jump" in r)
     skipped = sum(1 for r in rows if "skipped" in r)
-    head = f"{model:<12} {len(done) + jumps:>3} {skipped:>4} {jumps:>4}"
+    head = f"{label:<17} {len(done) + jumps:>3} {skipped:>4} {jumps:>4}"
     if not done:
         return head + "   (no case to compare)"
     ratios = np.array([r["ratio"] for r in done])
@@ -282,9 +352,24 @@ def summary(model, rows):
     vmax = max(r["peak_joint_speed_ratio"] for r in done)
     amax = max(r["peak_joint_accel_ratio"] for r in done)
     over = sum(1 for r in done if r["peak_joint_accel_ratio"] > 1.0 + FASTER_TOL)
+    path = max(r["path_error_mm"] for r in done)
     return (f"{head}   {np.median(ratios):>6.3f} {ratios.max():>6.3f} "
             f"{ratios.min():>6.3f}   {faster:>3}/{len(done):<3} {slowed:>4}   {vmax:>6.2f}   {amax:>6.2f} "
-            f"({over} over 1)")
+            f"({over} over 1)   {path:.1e}")
+
+
+def report(row):
+    """One case on stderr (--verbose)."""
+    if "ratio" in row:
+        what = (f"ratio {row['ratio']:.4f} vworks {row['vworks_s']:.4f} s toppra {row['toppra_s']:.4f} s "
+                f"peak speed {row['peak_joint_speed_ratio']:.2f} accel {row['peak_joint_accel_ratio']:.2f} "
+                f"path {row['path_error_mm']:.1e} mm" + (" (slowed)" if row["slowdown"] else ""))
+    elif "jump" in row:
+        what = f"joint jump {row['jump']} vworks {row['vworks_s']:.3f} s"
+    else:
+        what = f"skipped: {row['skipped']}"
+    print(f"  {row['model']} {row['kind']} {row['case']:>3} {row['length_mm']:6.1f} mm {row['speed_mps']:g} m/s  {what}",
+          file=sys.stderr)
 
 
 def main():
@@ -292,6 +377,8 @@ def main():
     parser.add_argument("--cases", type=int, default=15, help="random cases per model (default 15)")
     parser.add_argument("--seed", type=int, default=1, help="random seed (default 1)")
     parser.add_argument("--models", nargs="+", default=list(START), choices=list(START))
+    parser.add_argument("--kind", choices=["line", "arc", "both"], default="both",
+                        help="straight lines (move_l), circular arcs (move_c) or both (default)")
     parser.add_argument("--json", type=Path, help="write the per-case data to this file")
     parser.add_argument("-v", "--verbose", action="store_true", help="print each case")
     args = parser.parse_args()
@@ -304,42 +391,40 @@ def main():
     logging.getLogger("toppra").setLevel(logging.ERROR)
     import vworks
 
+    kinds = list(KINDS) if args.kind == "both" else [args.kind]
     began = time.perf_counter()
-    rows = {m: [] for m in args.models}
+    rows = {(m, k): [] for m in args.models for k in kinds}
     with tempfile.TemporaryDirectory() as tmp:
         for model in args.models:
             index = list(START).index(model)
             limits = urdf_limits(model)
-            for case in range(args.cases):
-                row = run_case(vworks, Path(tmp), model, index, case, args.seed, limits)
-                rows[model].append(row)
-                if args.verbose:
-                    if "ratio" in row:
-                        what = (f"ratio {row['ratio']:.4f} vworks {row['vworks_s']:.4f} s toppra {row['toppra_s']:.4f} s "
-                                f"peak speed {row['peak_joint_speed_ratio']:.2f} accel {row['peak_joint_accel_ratio']:.2f}"
-                                + (" (slowed)" if row["slowdown"] else ""))
-                    elif "jump" in row:
-                        what = f"joint jump {row['jump']} vworks {row['vworks_s']:.3f} s"
-                    else:
-                        what = f"skipped: {row['skipped']}"
-                    print(f"  {model} {case:>3} {row['length_mm']:6.1f} mm {row['speed_mps']:g} m/s  {what}",
-                          file=sys.stderr)
+            for kind in kinds:
+                for case in range(args.cases):
+                    row = run_case(vworks, Path(tmp), model, index, case, args.seed, limits, kind)
+                    rows[model, kind].append(row)
+                    if args.verbose:
+                        report(row)
 
-    print(f"move_l against toppra (time-optimal under the same joint and TCP speed/accel limits), "
-          f"{args.cases} cases per model, seed {args.seed}")
+
+    what = {"line": "move_l", "arc": "move_c", "both": "move_l and move_c"}[args.kind]
+    print(f"{what} against toppra (time-optimal under the same joint and TCP speed/accel limits), "
+          f"{args.cases} cases per model and kind, seed {args.seed}")
     print("ratio = vworks time / toppra time; worst = largest, best = smallest; faster = ratio < 0.999;")
     print("slowed = vworks warned it slowed the motion (an axis speed limit); peaks: max over cases of the")
     print("largest |joint speed| and |joint accel| over its limit, finite differences on a ~1 ms grid;")
     print(f"jump = ran, but a joint moved faster than {JUMP:g}x its limit between two samples (the IK changed")
-    print("configuration on the way): no smooth path for toppra, left out of the ratios and peaks")
+    print("configuration on the way): no smooth path for toppra, left out of the ratios and peaks;")
+    print("path = max over cases of the TCP's largest distance (mm) from the line, or from the circle")
+    print("through start, via and target")
     print()
-    print(f"{'model':<12} {'run':>3} {'skip':>4} {'jump':>4}   {'median':>6} {'worst':>6} {'best':>6}   {'faster':>7} "
-          f"{'slowed':>6}   {'speed':>6}   {'accel':>6}")
+    print(f"{'model':<17} {'run':>3} {'skip':>4} {'jump':>4}   {'median':>6} {'worst':>6} {'best':>6}   {'faster':>7} "
+          f"{'slowed':>6}   {'speed':>6}   {'accel':>6}             {'path':>7}")
     for model in args.models:
-        print(summary(model, rows[model]))
+        for kind in kinds:
+            print(summary(f"{model} {kind}", rows[model, kind]))
     reasons = {}
-    for model in args.models:
-        for r in rows[model]:
+    for key in rows:
+        for r in rows[key]:
             if "skipped" in r:
                 key = r["skipped"].split(":")[0][:60]
                 reasons[key] = reasons.get(key, 0) + 1
@@ -348,7 +433,7 @@ def main():
     print(f"took {time.perf_counter() - began:.1f} s")
     if args.json:
         args.json.write_text(json.dumps({"seed": args.seed, "cases": args.cases,
-                                         "rows": [r for m in args.models for r in rows[m]]}, indent=1))
+                                         "kind": args.kind, "rows": [r for k in rows for r in rows[k]]}, indent=1))
 
 
 if __name__ == "__main__":

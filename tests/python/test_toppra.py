@@ -1,10 +1,11 @@
-"""`move_l` against the time-optimal motion along the same path (toppra, the PyPI wheel):
-random straight lines of the four built-in arms, the joint path recorded from vworks and
-handed to toppra with the same axis speed and acceleration limits and the same TCP speed
-and acceleration (`bench/fidelity.py` does the measuring; this test runs a few cases of
-it). docs/engine.md ("Timing") states the targets: within 1 % of toppra's time, never
-faster (toppra's own grid leaves it 0.1 %), axis accelerations within their limits (to the
-0.1 % a 1 ms finite difference resolves), and no jump between configurations."""
+"""`move_l` and `move_c` against the time-optimal motion along the same path (toppra, the
+PyPI wheel): random straight lines and circular arcs of the four built-in arms, the joint
+path recorded from vworks and handed to toppra with the same axis speed and acceleration
+limits and the same TCP speed and acceleration (`bench/fidelity.py` does the measuring;
+this test runs a few cases of it). docs/engine.md ("Timing") states the targets: within
+1 % of toppra's time, never faster (toppra's own grid leaves it 0.1 %), axis
+accelerations within their limits (to the 0.1 % a 1 ms finite difference resolves), and
+no jump between configurations."""
 
 import os
 import sys
@@ -19,12 +20,14 @@ sys.path.insert(0, os.path.join(ROOT, "bench"))
 
 import fidelity  # noqa: E402
 
-CASES = 6
+CASES = 6  # lines per model
+ARC_CASES = 4  # arcs per model
+# What vworks may refuse: out of reach, a self-collision on the way, a singularity, and (an
+# arc) a via point on the line through start and target.
+REFUSED = ("unreachable", "collision", "singularity", "via point lies on the line")
 
 
-@pytest.mark.oracle
-@pytest.mark.parametrize("model", list(fidelity.START))
-def test_move_l_takes_the_time_optimal_time_within_the_axis_limits(model):
+def check_cases(model, kind, cases):
     pytest.importorskip("toppra")
     import logging
 
@@ -36,17 +39,28 @@ def test_move_l_takes_the_time_optimal_time_within_the_axis_limits(model):
     compared = 0
     with tempfile.TemporaryDirectory() as tmp, warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        for case in range(CASES):
-            row = fidelity.run_case(vworks, Path(tmp), model, index, case, 1, limits)
-            where = f"{model} case {case}: {row}"
+        for case in range(cases):
+            row = fidelity.run_case(vworks, Path(tmp), model, index, case, 1, limits, kind)
+            where = f"{model} {kind} case {case}: {row}"
             assert "jump" not in row, where
             if "skipped" in row:
-                # Out of reach, a self-collision on the way, or a singularity refused.
-                assert any(w in row["skipped"] for w in ("unreachable", "collision", "singularity")), where
+                assert any(w in row["skipped"] for w in REFUSED), where
                 continue
             compared += 1
             assert 0.999 <= row["ratio"] <= 1.01, where
             assert row["peak_joint_accel_ratio"] <= 1.001, where
             assert row["peak_joint_speed_ratio"] <= 1.001, where
             assert row["path_error_mm"] < 1e-3 and row["end_error_mm"] < 1e-3, where
-    assert compared >= 2, f"{model}: only {compared} of {CASES} cases ran"
+    assert compared >= 2, f"{model}: only {compared} of {cases} {kind} cases ran"
+
+
+@pytest.mark.oracle
+@pytest.mark.parametrize("model", list(fidelity.START))
+def test_move_l_takes_the_time_optimal_time_within_the_axis_limits(model):
+    check_cases(model, "line", CASES)
+
+
+@pytest.mark.oracle
+@pytest.mark.parametrize("model", list(fidelity.START))
+def test_move_c_takes_the_time_optimal_time_within_the_axis_limits(model):
+    check_cases(model, "arc", ARC_CASES)
