@@ -34,6 +34,14 @@ pub struct JointPath {
     pub axes: usize,
     /// The joints at each knot (rad or m).
     pub q: [[f64; MAX_AXES]; KNOTS],
+    /// Per step, the fraction of every axis limit it may use: 1, unless a check between
+    /// the knots found that the path's curvature there needs room (see
+    /// [`Timing::slower`] for the last resort).
+    pub room: [f64; SEGMENTS],
+    /// Per end (start, end) and axis, the steepest `q'` found close to it (by the caller,
+    /// e.g. from points 1/64 of a step in): where a path starts or ends near a singularity
+    /// its slope there is steeper than the knots show. 0 where not known.
+    pub end_slopes: [[f64; MAX_AXES]; 2],
 }
 
 impl JointPath {
@@ -42,6 +50,8 @@ impl JointPath {
         JointPath {
             axes: axes.min(MAX_AXES),
             q: [[0.0; MAX_AXES]; KNOTS],
+            room: [1.0; SEGMENTS],
+            end_slopes: [[0.0; MAX_AXES]; 2],
         }
     }
 
@@ -51,14 +61,18 @@ impl JointPath {
         let n = SEGMENTS as f64;
         let q = |j: usize| self.q[j][i];
         let k = k.min(SEGMENTS);
+        let steeper = |d1: f64, end: usize| {
+            let s = self.end_slopes[end][i];
+            if s.abs() > d1.abs() { s } else { d1 }
+        };
         if k == 0 {
             let d1 = (-3.0 * q(0) + 4.0 * q(1) - q(2)) * 0.5 * n;
             let d2 = (2.0 * q(0) - 5.0 * q(1) + 4.0 * q(2) - q(3)) * n * n;
-            (d1, d2)
+            (steeper(d1, 0), d2)
         } else if k == SEGMENTS {
             let d1 = (3.0 * q(k) - 4.0 * q(k - 1) + q(k - 2)) * 0.5 * n;
             let d2 = (2.0 * q(k) - 5.0 * q(k - 1) + 4.0 * q(k - 2) - q(k - 3)) * n * n;
-            (d1, d2)
+            (steeper(d1, 1), d2)
         } else {
             let d1 = (q(k + 1) - q(k - 1)) * 0.5 * n;
             let d2 = (q(k + 1) - 2.0 * q(k) + q(k - 1)) * n * n;
@@ -156,13 +170,13 @@ fn step_lines(path: &JointPath, lim: &Limits<'_>, k: usize, out: &mut [Line]) ->
                     0.5 * (path.derivatives(k, i).1 + path.derivatives(k + 1, i).1),
                 ),
             };
-            let amax = lim.axis_accel[i];
+            let amax = lim.axis_accel[i] * path.room[k];
             // -amax ≤ d1·u + d2·(x + shift·u) ≤ amax.
             let (a, b) = (d1 + d2 * shift, d2);
             push(a, b, amax);
             push(-a, -b, amax);
             if d1 != 0.0 {
-                let v = lim.axis_speed[i] / d1.abs();
+                let v = lim.axis_speed[i] * path.room[k] / d1.abs();
                 x_max = x_max.min(v * v);
             }
         }
@@ -290,6 +304,27 @@ impl Timing {
             return Err(TimingError::Stuck { knot, axis: 0 });
         }
         Ok(Timing { x, t })
+    }
+
+    /// The same timing `factor` (≥ 1) times slower: every speed divided by it, every
+    /// acceleration by its square.
+    pub fn slower(&self, factor: f64) -> Timing {
+        let mut out = self.clone();
+        for x in &mut out.x {
+            *x /= factor * factor;
+        }
+        for t in &mut out.t {
+            *t *= factor;
+        }
+        out
+    }
+
+    /// `ṡ²` at knot `k` and the path acceleration `s̈` over step `k` (from knot `k` to
+    /// `k + 1`): the timing's state anywhere on the step is `x_k + 2·s̈·(s − s_k)`.
+    pub fn step_state(&self, k: usize) -> (f64, f64) {
+        let k = k.min(SEGMENTS - 1);
+        let delta = 1.0 / SEGMENTS as f64;
+        (self.x[k], (self.x[k + 1] - self.x[k]) / (2.0 * delta))
     }
 
     /// How long the path takes (s).

@@ -93,12 +93,11 @@ pub(super) fn sample_path(
     let mut joints = JointPath::new(n);
     joints.q[0] = *from;
     let tool_inv = tool.inverse();
-    for k in 1..KNOTS {
-        let s = k as f64 / SEGMENTS as f64;
+    // The joints at path fraction `s`, seeded from `prev`: on the motion's own branch where
+    // it is within the joint limits (the executed path); else the nearest solution, which
+    // then shows as a jump.
+    let joints_at = |s: f64, prev: &[f64; MAX_AXES]| -> Result<[f64; MAX_AXES], PlanError> {
         let pose = cartesian_at(path, start, goal, s);
-        let prev = joints.q[k - 1];
-        // The motion's own branch where it is within the joint limits (the executed
-        // path); else the nearest solution, which then shows as a jump below.
         let mut q = [0.0; MAX_AXES];
         let on_branch = branch.is_some_and(|b| {
             let flange = pose.mul(&tool_inv);
@@ -107,14 +106,40 @@ pub(super) fn sample_path(
                 .is_ok()
                 && model.within_limits(&q[..n])
         });
-        joints.q[k] = if on_branch {
-            q
-        } else {
-            ik_tcp(model, tool, &pose, &prev).map_err(|error| PlanError::Unreachable {
-                error,
-                at_percent: Some(s * 100.0),
-            })?
-        };
+        if on_branch {
+            return Ok(q);
+        }
+        ik_tcp(model, tool, &pose, prev).map_err(|error| PlanError::Unreachable {
+            error,
+            at_percent: Some(s * 100.0),
+        })
+    };
+    for k in 1..KNOTS {
+        let prev = joints.q[k - 1];
+        joints.q[k] = joints_at(k as f64 / SEGMENTS as f64, &prev)?;
+    }
+    // Close to each end, the steepest slope of points 1/4 to 1/4096 of a step in: a
+    // path that starts or ends near a singularity is steeper there than the knots show.
+    let delta = 1.0 / SEGMENTS as f64;
+    for (end, (s0, sign)) in [(0.0, 1.0), (1.0, -1.0)].into_iter().enumerate() {
+        let q0 = joints.q[end * SEGMENTS];
+        for frac in [
+            0.25,
+            0.0625,
+            0.015625,
+            0.00390625,
+            0.0009765625,
+            0.000244140625,
+        ] {
+            let ds = frac * delta;
+            let q = joints_at(s0 + sign * ds, &q0)?;
+            for i in 0..n {
+                let slope = sign * (q[i] - q0[i]) / ds;
+                if slope.abs() > joints.end_slopes[end][i].abs() {
+                    joints.end_slopes[end][i] = slope;
+                }
+            }
+        }
     }
     for k in 1..KNOTS {
         for i in 0..n {
@@ -139,6 +164,7 @@ pub(super) fn sample_path(
     let mut worst = 1.0f64;
     let mut worst_axis = 0;
     let mut sd = [0.0f64; KNOTS];
+    let mut near = [false; SEGMENTS];
     for (k, sd_k) in sd.iter_mut().enumerate() {
         let s = k as f64 / SEGMENTS as f64;
         let (v_path, a_path) = state_at_distance(profile, s * profile.dist);
@@ -152,6 +178,10 @@ pub(super) fn sample_path(
                 worst = ratio;
                 worst_axis = i;
             }
+            if ratio < 1.0 / NEAR_LIMIT {
+                near[k.min(SEGMENTS - 1)] = true;
+                near[k.saturating_sub(1)] = true;
+            }
         }
     }
     // The profile's top speed is halfway through its time: the step it falls in moves
@@ -160,7 +190,22 @@ pub(super) fn sample_path(
     let peak = profile.speed_at(0.5 * profile.t_total);
     let peak_step = ((peak_s * SEGMENTS as f64) as usize).min(SEGMENTS - 1);
     let end = joints.q[SEGMENTS];
-    if worst >= 1.0 - JOINT_SPEED_TOLERANCE {
+    // Between the knots (at each step's quarter points), where an axis comes near a limit
+    // at the knots: the path's curvature within a step (near a singularity) can take it
+    // past.
+    let mut inner = Inner::new();
+    let mut ratios = [0.0f64; SEGMENTS];
+    let mut fits = worst >= 1.0 - JOINT_SPEED_TOLERANCE;
+    if fits && worst < 1.0 / NEAR_LIMIT {
+        inner.fill(&joints, &near, joints_at)?;
+        let state = |_: usize, s: f64| {
+            let (v, a) = state_at_distance(profile, s * profile.dist);
+            (v * v, a)
+        };
+        let (rv, ra) = inner.ratios(&joints, &speed[..n], &accel[..n], state, &mut ratios);
+        fits = rv.max(ra) <= 1.0 + JOINT_SPEED_TOLERANCE;
+    }
+    if fits {
         let mut step_speed = [0.0f64; SEGMENTS];
         for (k, v) in step_speed.iter_mut().enumerate() {
             *v = if k == peak_step {
@@ -186,19 +231,71 @@ pub(super) fn sample_path(
         path_speed: profile.v,
         path_accel: profile.a,
     };
-    let timing = Timing::optimal(&joints, &limits).map_err(|e| match e {
-        TimingError::Stuck { knot, axis } | TimingError::NotFinite { knot, axis } => {
-            PlanError::Singular {
-                axis,
-                at_percent: knot as f64 * 100.0 / SEGMENTS as f64,
+    let optimal = |joints: &JointPath| {
+        Timing::optimal(joints, &limits).map_err(|e| match e {
+            TimingError::Stuck { knot, axis } | TimingError::NotFinite { knot, axis } => {
+                PlanError::Singular {
+                    axis,
+                    at_percent: knot as f64 * 100.0 / SEGMENTS as f64,
+                }
+            }
+            // (The limits come from a checked model and a checked profile.)
+            _ => PlanError::Singular {
+                axis: 0,
+                at_percent: 0.0,
+            },
+        })
+    };
+    // The timing keeps the limits at the knots and halfway; between them, where the
+    // quarter points find an axis past a limit, that step gets less room and the timing
+    // is made again (a few rounds; then, if still needed, the whole timing slower).
+    let mut timing = optimal(&joints)?;
+    let (mut speed_full, mut accel_full) = ([0.0f64; MAX_AXES], [0.0f64; MAX_AXES]);
+    for i in 0..n {
+        speed_full[i] = model.axis(i).max_velocity;
+        accel_full[i] = model.axis(i).max_accel;
+    }
+    for round in 0..=ROOM_ROUNDS {
+        // The steps where an axis comes near a limit at a knot under the timing.
+        let mut near = [false; SEGMENTS];
+        for (k, flag) in near.iter_mut().enumerate() {
+            let (x, u) = timing.step_state(k);
+            let x1 = x + 2.0 * u / SEGMENTS as f64;
+            *flag = [(k, x), (k + 1, x1)].iter().any(|&(knot, x)| {
+                (0..n).any(|i| {
+                    let (d1, d2) = joints.derivatives(knot, i);
+                    let v = (d1 * x.max(0.0).sqrt()).abs() / speed_full[i];
+                    let a = (d1 * u + d2 * x).abs() / accel_full[i];
+                    v.max(a) > NEAR_LIMIT
+                })
+            });
+        }
+        inner.fill(&joints, &near, joints_at)?;
+        let state = |k: usize, s: f64| {
+            let (x, u) = timing.step_state(k);
+            (x + 2.0 * u * (s - k as f64 / SEGMENTS as f64), u)
+        };
+        let (rv, ra) = inner.ratios(
+            &joints,
+            &speed_full[..n],
+            &accel_full[..n],
+            state,
+            &mut ratios,
+        );
+        if rv.max(ra) <= 1.0 {
+            break;
+        }
+        if round == ROOM_ROUNDS {
+            timing = timing.slower(rv.max(ra.sqrt()).max(1.0));
+            break;
+        }
+        for (room, r) in joints.room.iter_mut().zip(&ratios) {
+            if *r > 1.0 - TIMING_MARGIN {
+                *room *= (1.0 - TIMING_MARGIN) / r;
             }
         }
-        // (The limits come from a checked model and a checked profile.)
-        _ => PlanError::Singular {
-            axis: 0,
-            at_percent: 0.0,
-        },
-    })?;
+        timing = optimal(&joints)?;
+    }
     // ṡ² is linear in s within a step: ṡ is largest at one of its ends.
     let mut step_speed = [0.0f64; SEGMENTS];
     for (k, v) in step_speed.iter_mut().enumerate() {
@@ -210,6 +307,95 @@ pub(super) fn sample_path(
         worst_axis,
         end,
     })
+}
+
+/// How near a limit (its fraction) an axis may come at the knots under the programmed
+/// profile before the path is also checked between them.
+const NEAR_LIMIT: f64 = 0.95;
+
+/// Rounds of giving steps less room before the timing is slowed as a whole.
+const ROOM_ROUNDS: usize = 4;
+
+/// The joints at each step's quarter points (`s_k + j·Δ/4`, j = 1, 2, 3), solved only when
+/// needed; on the stack (planning allocates nothing).
+struct Inner {
+    filled: [bool; SEGMENTS],
+    q: [[[f64; MAX_AXES]; 3]; SEGMENTS],
+}
+
+impl Inner {
+    fn new() -> Inner {
+        Inner {
+            filled: [false; SEGMENTS],
+            q: [[[0.0; MAX_AXES]; 3]; SEGMENTS],
+        }
+    }
+
+    /// Solves the quarter points of the steps `wanted` that are not solved yet, each
+    /// seeded from the point before.
+    fn fill(
+        &mut self,
+        joints: &JointPath,
+        wanted: &[bool; SEGMENTS],
+        joints_at: impl Fn(f64, &[f64; MAX_AXES]) -> Result<[f64; MAX_AXES], PlanError>,
+    ) -> Result<(), PlanError> {
+        for (k, quarters) in self.q.iter_mut().enumerate() {
+            if !wanted[k] || self.filled[k] {
+                continue;
+            }
+            self.filled[k] = true;
+            let mut prev = joints.q[k];
+            for (j, q) in quarters.iter_mut().enumerate() {
+                let s = (k as f64 + (j + 1) as f64 / 4.0) / SEGMENTS as f64;
+                *q = joints_at(s, &prev)?;
+                prev = *q;
+            }
+        }
+        Ok(())
+    }
+
+    /// Per solved step, the largest ratio of an axis's speed or acceleration to its limit
+    /// at the quarter points (finite differences over the quarter grid), the path at
+    /// `state(k, s) = (ṡ², s̈)` (0 for the steps not solved: not near a limit at their
+    /// knots); and the largest speed and acceleration ratios overall.
+    fn ratios(
+        &self,
+        joints: &JointPath,
+        speed: &[f64],
+        accel: &[f64],
+        state: impl Fn(usize, f64) -> (f64, f64),
+        out: &mut [f64; SEGMENTS],
+    ) -> (f64, f64) {
+        let h = 0.25 / SEGMENTS as f64;
+        let (mut rv, mut ra) = (0.0f64, 0.0f64);
+        for (k, r) in out.iter_mut().enumerate() {
+            let p = |j: usize| match j {
+                0 => &joints.q[k],
+                4 => &joints.q[k + 1],
+                _ => &self.q[k][j - 1],
+            };
+            *r = 0.0;
+            if !self.filled[k] {
+                continue;
+            }
+            for j in 1..4 {
+                let s = (k as f64 + j as f64 / 4.0) / SEGMENTS as f64;
+                let (x, u) = state(k, s);
+                let sd = x.max(0.0).sqrt();
+                for i in 0..joints.axes {
+                    let (a, b, c) = (p(j - 1)[i], p(j)[i], p(j + 1)[i]);
+                    let d1 = (c - a) / (2.0 * h);
+                    let d2 = (c - 2.0 * b + a) / (h * h);
+                    let v = (d1 * sd).abs() / speed[i];
+                    let acc = (d1 * u + d2 * x).abs() / accel[i];
+                    rv = rv.max(v);
+                    ra = ra.max(acc);
+                    *r = r.max(v).max(acc);
+                }
+            }
+        }
+        (rv, ra)
+    }
 }
 
 /// A profile's speed and acceleration where it has covered `d`: in closed form for a
