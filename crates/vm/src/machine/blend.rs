@@ -88,7 +88,11 @@ pub(super) fn blend_joints(
         if t >= f.end() {
             return next.joints_at(model, d2);
         }
-        return next.ik_on(model, &blend_pose(model, f, next, ts, t));
+        return next.ik_on(
+            model,
+            &blend_pose(model, f, next, ts, t),
+            next.fraction_at(d2),
+        );
     }
     let q1 = f.motion.traj.joints_at(model, d1)?;
     let mut q = next.joints_at(model, d2)?;

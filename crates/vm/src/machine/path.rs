@@ -35,6 +35,8 @@ pub(super) const PATH_KEY: usize = MAX_AXES + 12 + 12 + 3 + 3 + 12;
 /// the end.
 #[derive(Clone, Debug)]
 pub(super) struct PathSamples {
+    /// The joints at every 16th knot: the seeds the executed path's IK starts from.
+    pub(super) seeds: [[f64; MAX_AXES]; SEEDS],
     pub(super) timing: Option<Timing>,
     pub(super) worst_axis: usize,
     pub(super) rates: [f64; MAX_AXES],
@@ -215,6 +217,7 @@ pub(super) fn sample_path(
             };
         }
         return Ok(PathSamples {
+            seeds: seeds_of(&joints),
             timing: None,
             worst_axis,
             rates: rate_bounds(&joints, &step_speed),
@@ -302,11 +305,24 @@ pub(super) fn sample_path(
         *v = timing.speed_at_knot(k).max(timing.speed_at_knot(k + 1));
     }
     Ok(PathSamples {
+        seeds: seeds_of(&joints),
         rates: rate_bounds(&joints, &step_speed),
         timing: Some(timing),
         worst_axis,
         end,
     })
+}
+
+/// Knots kept as IK seeds for the executed path: every 16th (0, 16, …, 256).
+pub(super) const SEEDS: usize = SEGMENTS / 16 + 1;
+
+/// The seeds of a sampled path: its joints at every 16th knot.
+fn seeds_of(joints: &JointPath) -> [[f64; MAX_AXES]; SEEDS] {
+    let mut out = [[0.0; MAX_AXES]; SEEDS];
+    for (j, s) in out.iter_mut().enumerate() {
+        *s = joints.q[j * 16];
+    }
+    out
 }
 
 /// How near a limit (its fraction) an axis may come at the knots under the programmed

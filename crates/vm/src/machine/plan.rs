@@ -17,7 +17,7 @@ use crate::motion::{NS, Path, Profile, cartesian_at};
 use crate::types::{Dim, fmt_quantity};
 use vworks_model::timing::{SEGMENTS, Timing};
 
-use super::path::{PATH_KEY, PathMemo, PathSamples, sample_path};
+use super::path::{PATH_KEY, PathMemo, PathSamples, SEEDS, sample_path};
 
 /// How far (relative) an axis's speed found by sampling may exceed its limit and still
 /// count as within it: `|Δq|/Δt > v_max · (1 + JOINT_SPEED_TOLERANCE)` is too fast. Both
@@ -335,8 +335,9 @@ pub(super) enum Trajectory {
         /// Per axis, the largest speed found at the samples the motion was checked at
         /// (rad/s or m/s).
         rates: [f64; MAX_AXES],
-        /// The joints it starts from (the seed of numeric IK).
-        seed: [f64; MAX_AXES],
+        /// The joints at every 16th knot of the sampled path: a point's IK starts from the
+        /// nearest (the path executed is the path checked).
+        seeds: [[f64; MAX_AXES]; SEEDS],
         /// The TCP (in the tool link's frame) the path is for.
         tool: Iso,
     },
@@ -439,7 +440,8 @@ impl Trajectory {
                 if dt >= self.path_duration() {
                     return Some(*end_joints);
                 }
-                self.ik_on(model, &self.pose_at(model, &Iso::IDENTITY, dt))
+                let s = self.fraction_at(dt);
+                self.ik_on(model, &self.pose_at(model, &Iso::IDENTITY, dt), s)
             }
         }
     }
@@ -508,15 +510,20 @@ impl Trajectory {
         }
     }
 
-    /// The joints of a TCP pose on the configuration of a Cartesian trajectory: on its
-    /// analytic branch, or seeded from its start joints (numeric IK).
-    pub(super) fn ik_on(&self, model: &RobotModel, tcp: &Iso) -> Option<[f64; MAX_AXES]> {
+    /// The joints of a TCP pose at path fraction `s` of a Cartesian trajectory: on its
+    /// analytic branch, each from the sampled path's joints nearest `s` (the seed).
+    pub(super) fn ik_on(&self, model: &RobotModel, tcp: &Iso, s: f64) -> Option<[f64; MAX_AXES]> {
         let Trajectory::Cartesian {
-            branch, seed, tool, ..
+            branch,
+            seeds,
+            tool,
+            ..
         } = self
         else {
             return None;
         };
+        let nearest = (s.clamp(0.0, 1.0) * (SEEDS - 1) as f64).round() as usize;
+        let seed = &seeds[nearest.min(SEEDS - 1)];
         let flange = tcp.mul(&tool.inverse());
         let mut q = [0.0; MAX_AXES];
         let n = model.dof();
@@ -784,7 +791,7 @@ fn plan_cartesian(
             end_joints: start_joints,
             branch: None,
             rates: [0.0; MAX_AXES],
-            seed: start_joints,
+            seeds: [start_joints; SEEDS],
             tool,
         };
         return Ok(Plan {
@@ -821,6 +828,7 @@ fn plan_cartesian(
         sample_path(model, &tool, ends, branch, &profile)
     })?;
     let PathSamples {
+        seeds,
         timing,
         worst_axis,
         rates,
@@ -849,7 +857,7 @@ fn plan_cartesian(
             end_joints: prev,
             branch,
             rates,
-            seed: start_joints,
+            seeds,
             tool,
         },
         duration_ns,
