@@ -5,7 +5,7 @@
 //! 2 ms. The planner holds the limits at five points of each of a path's 256 steps (its
 //! knots, quarter points and middle) and at points down to 1/4096 of a step from its ends;
 //! between them, near a singularity, the path's curvature can add a little: 1 % is allowed
-//! (the worst found, on an arc passing near the irb120's axis 1, is 0.58 % with samples
+//! (the worst found, on an arc passing near the irb120's axis 1, is 0.59 % with samples
 //! 0.05 ms apart).
 //!
 //! A motion the VM refuses (a point out of reach, a singularity on the way, a self-made

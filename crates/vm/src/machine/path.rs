@@ -224,13 +224,12 @@ pub(super) fn sample_path(
             end,
         });
     }
-    for i in 0..n {
-        speed[i] *= 1.0 - TIMING_MARGIN;
-        accel[i] *= 1.0 - TIMING_MARGIN;
-    }
+    // The timing keeps a margin below the limits the checks measure against.
+    let speed_timed = speed.map(|v| v * (1.0 - TIMING_MARGIN));
+    let accel_timed = accel.map(|a| a * (1.0 - TIMING_MARGIN));
     let limits = Limits {
-        axis_speed: &speed[..n],
-        axis_accel: &accel[..n],
+        axis_speed: &speed_timed[..n],
+        axis_accel: &accel_timed[..n],
         path_speed: profile.v,
         path_accel: profile.a,
     };
@@ -253,11 +252,6 @@ pub(super) fn sample_path(
     // quarter points find an axis past a limit, that step gets less room and the timing
     // is made again (a few rounds; then, if still needed, the whole timing slower).
     let mut timing = optimal(&joints)?;
-    let (mut speed_full, mut accel_full) = ([0.0f64; MAX_AXES], [0.0f64; MAX_AXES]);
-    for i in 0..n {
-        speed_full[i] = model.axis(i).max_velocity;
-        accel_full[i] = model.axis(i).max_accel;
-    }
     for round in 0..=ROOM_ROUNDS {
         // The steps where an axis comes near a limit at a knot under the timing.
         let mut near = [false; SEGMENTS];
@@ -267,8 +261,8 @@ pub(super) fn sample_path(
             *flag = [(k, x), (k + 1, x1)].iter().any(|&(knot, x)| {
                 (0..n).any(|i| {
                     let (d1, d2) = joints.derivatives(knot, i);
-                    let v = (d1 * x.max(0.0).sqrt()).abs() / speed_full[i];
-                    let a = (d1 * u + d2 * x).abs() / accel_full[i];
+                    let v = (d1 * x.max(0.0).sqrt()).abs() / speed[i];
+                    let a = (d1 * u + d2 * x).abs() / accel[i];
                     v.max(a) > NEAR_LIMIT
                 })
             });
@@ -278,13 +272,7 @@ pub(super) fn sample_path(
             let (x, u) = timing.step_state(k);
             (x + 2.0 * u * (s - k as f64 / SEGMENTS as f64), u)
         };
-        let (rv, ra) = inner.ratios(
-            &joints,
-            &speed_full[..n],
-            &accel_full[..n],
-            state,
-            &mut ratios,
-        );
+        let (rv, ra) = inner.ratios(&joints, &speed[..n], &accel[..n], state, &mut ratios);
         if rv.max(ra) <= 1.0 {
             break;
         }
