@@ -31,10 +31,11 @@ For each built-in 6-axis arm (irb120, kr6r900, lrmate200id, ur5) and N random ca
    virtual 7th joint equal to s. Constraints (toppra JointVelocityConstraint and
    JointAccelerationConstraint, interpolation scheme, 801 gridpoints): each axis's URDF
    velocity limit and acceleration limit (none of the built-in URDFs gives one, so
-   velocity / 0.3 s, docs/models.md), and for s the programmed TCP speed V and the TCP
-   acceleration vworks uses by default, V / 0.3 s (the worked example in docs/engine.md,
-   "Zones", uses a = v / 0.3 s; the script checks it: `tcp_accel_ratio` in the JSON is the
-   recorded peak TCP acceleration over V / 0.3 s). toppra's duration is
+   velocity / 0.3 s where a URDF gives none, docs/models.md), and for s the programmed TCP
+   speed V (at most the model's `<tcp_limits speed>`) and the model's TCP acceleration
+   (`<tcp_limits acceleration>`; none where the model gives none: the axes alone bound the
+   path, as vworks does; `tcp_accel_ratio` in the JSON is the recorded peak TCP
+   acceleration over that limit). toppra's duration is
    sum 2 ds / (sd_i + sd_i+1) over its grid (piecewise-constant path acceleration).
 4. From the recorded joints: peak joint speed and peak joint acceleration as ratios of
    the limits (largest over the axes), by finite differences on the ~1 ms grid (first
@@ -72,7 +73,7 @@ ROOT = Path(__file__).resolve().parents[1]
 MODELS_DIR = ROOT / "crates" / "model" / "models"
 
 DEFAULT_ACCEL_TIME = 0.3  # s: full speed in 0.3 s, axes without <limit acceleration> (docs/models.md)
-TCP_ACCEL_TIME = 0.3  # s: the TCP's default ramp for move_l, a = V / 0.3 s (docs/engine.md, "Zones")
+UNBOUNDED = 1e6  # m/s²: the virtual joint s's acceleration where the model gives no TCP limit
 SPEEDS = [0.1, 0.5, 1.0, 2.0, 4.0]  # m/s
 LENGTH_MM = (50.0, 600.0)
 VIA_SIDEWAYS = (0.20, 0.45)  # an arc's via point: the chord's midpoint pushed sideways by this times the chord
@@ -114,6 +115,13 @@ def urdf_limits(model):
         rows.append((float(lim.get("lower", "-inf")), float(lim.get("upper", "inf")), vel,
                      float(acc) if acc is not None else vel / DEFAULT_ACCEL_TIME))
     return np.array(rows)
+
+
+def urdf_tcp(model):
+    """The model's TCP speed and acceleration limits (`<tcp_limits>`; inf where none)."""
+    tcp = ET.parse(MODELS_DIR / f"{model}.urdf").getroot().find("tcp_limits")
+    get = lambda key: float(tcp.get(key)) if tcp is not None and tcp.get(key) else float("inf")
+    return get("speed"), get("acceleration")
 
 
 def draw_case(model, seed, model_index, case, limits):
@@ -232,9 +240,9 @@ def path_samples(q, p):
     return s[keep], q[keep]
 
 
-def toppra_time(s, q, vlim, alim, speed):
+def toppra_time(s, q, vlim, alim, speed, accel=float("inf")):
     """Time-optimal duration along q(s) (cubic spline), joints within vlim/alim, the
-    virtual joint s within speed and speed / 0.3 s. None if toppra finds no profile."""
+    virtual joint s within speed and accel (inf: none). None if toppra finds no profile."""
     import toppra as ta
     import toppra.algorithm as algo
     import toppra.constraint as constraint
@@ -242,7 +250,7 @@ def toppra_time(s, q, vlim, alim, speed):
     way = np.column_stack([q, s])
     path = ta.SplineInterpolator(s, way)
     v = np.append(vlim, speed)
-    a = np.append(alim, speed / TCP_ACCEL_TIME)
+    a = np.append(alim, accel if np.isfinite(accel) else UNBOUNDED)
     cons = [constraint.JointVelocityConstraint(np.column_stack([-v, v])),
             constraint.JointAccelerationConstraint(
                 np.column_stack([-a, a]), discretization_scheme=constraint.DiscretizationType.Interpolation)]
@@ -257,7 +265,7 @@ def toppra_time(s, q, vlim, alim, speed):
     return float(np.sum(2.0 * np.diff(grid) / mean))
 
 
-def peaks(t, q, s, limits, speed):
+def peaks(t, q, s, limits, speed, accel=float("inf")):
     """Peak joint speed and acceleration ratios (largest over the axes, and which axis),
     and the TCP's, by finite differences on the recorded grid."""
     dt = np.diff(t)
@@ -271,7 +279,7 @@ def peaks(t, q, s, limits, speed):
         "peak_joint_speed_ratio": float(v_ratio.max()), "peak_speed_axis": int(v_ratio.argmax()) + 1,
         "peak_joint_accel_ratio": float(a_ratio.max()), "peak_accel_axis": int(a_ratio.argmax()) + 1,
         "tcp_speed_ratio": float(sd.max() / speed),
-        "tcp_accel_ratio": float(np.abs(sdd).max() / (speed / TCP_ACCEL_TIME)),
+        "tcp_accel_ratio": float(np.abs(sdd).max() / accel) if np.isfinite(accel) else None,
     }
 
 
@@ -304,6 +312,8 @@ def run_case(vworks, folder, model, index, case, seed, limits, kind="line"):
         row["skipped"] = f"{command} took no time"
         return row
 
+    tcp_speed, tcp_accel = urdf_tcp(model)
+    speed = min(speed, tcp_speed)
     t, q, p = record(cell, t0, t1)
     row["samples"] = len(t)
     if via is None:
@@ -318,7 +328,7 @@ def run_case(vworks, folder, model, index, case, seed, limits, kind="line"):
         row["via_miss_mm"] = polyline_distance(p[0] + via, p) * 1000
     row["end_error_mm"] = float(np.linalg.norm(p[-1] - p[0] - offset) * 1000)
     s_all = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
-    row.update(peaks(t, q, s_all, limits, speed))
+    row.update(peaks(t, q, s_all, limits, speed, tcp_accel))
     if row["peak_joint_speed_ratio"] > JUMP:
         step = np.abs(np.diff(q, axis=0))
         i, j = np.unravel_index(step.argmax(), step.shape)
@@ -330,7 +340,7 @@ def run_case(vworks, folder, model, index, case, seed, limits, kind="line"):
     row["knots"] = len(s)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        best = toppra_time(s, qk, limits[:, 2], limits[:, 3], speed)
+        best = toppra_time(s, qk, limits[:, 2], limits[:, 3], speed, tcp_accel)
     if best is None:
         row["skipped"] = "toppra found no profile"
         return row

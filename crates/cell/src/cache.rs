@@ -37,6 +37,8 @@ pub(crate) struct ModelKey {
     pub(crate) package_path: Vec<String>,
     /// The `jerk` value as TOML writes it (a TOML value has no order of its own).
     pub(crate) jerk: Option<String>,
+    /// The `tcp_speed` and `tcp_acceleration` values, as TOML writes them.
+    pub(crate) tcp: [Option<String>; 2],
 }
 
 /// Programs and models by what they are made from, shared by the variants.

@@ -32,6 +32,8 @@ pub(crate) struct RobotFile {
     pub(crate) default_zone: Option<toml::Value>,
     pub(crate) grip_distance: Option<toml::Value>,
     pub(crate) jerk: Option<toml::Value>,
+    pub(crate) tcp_speed: Option<toml::Value>,
+    pub(crate) tcp_acceleration: Option<toml::Value>,
     pub(crate) home: Option<Vec<toml::Value>>,
     /// Values of its program's `param`s (`[robot.params]`).
     #[serde(default)]

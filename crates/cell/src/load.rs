@@ -143,6 +143,8 @@ pub(crate) fn load_parsed(
             tool_link: r.tool_link.clone(),
             package_path: r.package_path.clone(),
             jerk: r.jerk.as_ref().map(toml::Value::to_string),
+            tcp: [&r.tcp_speed, &r.tcp_acceleration]
+                .map(|v| v.as_ref().map(toml::Value::to_string)),
         };
         let model = if let Some((m, urdf)) = cache.model(&model_key) {
             files.extend(urdf);
@@ -179,6 +181,35 @@ pub(crate) fn load_parsed(
         };
             if let Some(jerk) = &r.jerk {
                 cx.override_jerk(&mut model, jerk, &format!("{key}.jerk"))?;
+            }
+            // The TCP's limits, replacing the model's (a payload, a process, a safety
+            // configuration can lower them).
+            let tcp_keys = [
+                (
+                    &r.tcp_speed,
+                    "tcp_speed",
+                    Dim::SPEED,
+                    "\"1500mm/s\" or 1.5 (m/s)",
+                ),
+                (
+                    &r.tcp_acceleration,
+                    "tcp_acceleration",
+                    Dim::ACCEL,
+                    "\"5m/s2\" or 5 (m/s²)",
+                ),
+            ];
+            for (k, (value, name, dim, hint)) in tcp_keys.into_iter().enumerate() {
+                let Some(value) = value else { continue };
+                let at = format!("{key}.{name}");
+                let x = cx.quantity(value, dim, &at)?;
+                if !(x.is_finite() && x > 0.0) {
+                    return Err(cx.bad(&at, format!("must be greater than 0; write {hint}")));
+                }
+                if k == 0 {
+                    model.tcp.speed = Some(x);
+                } else {
+                    model.tcp.accel = Some(x);
+                }
             }
             let urdf = r.urdf.as_ref().and_then(|u| {
                 let upath = dir.join(u).display().to_string();

@@ -176,6 +176,8 @@ fn variables(table: &toml::Table, cell: &Cell) -> Vec<String> {
         out.push(format!("{prefix}.default_speed"));
         out.push(format!("{prefix}.default_zone"));
         out.push(format!("{prefix}.grip_distance"));
+        out.push(format!("{prefix}.tcp_speed"));
+        out.push(format!("{prefix}.tcp_acceleration"));
         for (name, ..) in crate::params::declared(&r.module) {
             out.push(format!("{prefix}.params.{name}"));
             out.push(format!("params.{name}"));

@@ -18,7 +18,8 @@
 //!
 //! Joint values are radians for revolute axes and metres for prismatic ones. A joint
 //! whose URDF gives no acceleration limit accelerates to full speed in
-//! [`model::DEFAULT_ACCEL_TIME`] (0.3 s).
+//! [`model::DEFAULT_ACCEL_TIME`] (0.3 s); the built-in arms carry their own
+//! (docs/models.md), and a model may limit its TCP ([`model::TcpLimits`]).
 
 pub mod builtin;
 pub mod error;

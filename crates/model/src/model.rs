@@ -207,8 +207,21 @@ pub struct RobotModel {
     pub tool_link: usize,
     /// The analytic IK geometry, when the robot is a spherical-wrist 6-axis arm.
     pub wrist: Option<SphericalWrist>,
+    /// The TCP's own speed and acceleration limits, where the model gives them.
+    pub tcp: TcpLimits,
     /// The joints from the root to the tool link, in order.
     pub(crate) chain_cache: Vec<usize>,
+}
+
+/// The TCP's limits of a model (a URDF's `<tcp_limits speed="…" acceleration="…"/>`, in
+/// m/s and m/s²), as a vendor's data sheet gives them: `move_l`/`move_c` never ask more
+/// of the path. `None`: the axes alone bound it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TcpLimits {
+    /// The fastest TCP speed (m/s).
+    pub speed: Option<f64>,
+    /// The largest TCP acceleration along the path (m/s²).
+    pub accel: Option<f64>,
 }
 
 /// A default acceleration for joints whose model gives none: full speed in 0.3 s.

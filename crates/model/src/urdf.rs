@@ -17,7 +17,7 @@ use crate::files::{Disk, Files};
 use crate::math::{Iso, V3, norm};
 use crate::mesh;
 use crate::model::{
-    AxisDir, DEFAULT_ACCEL_TIME, Geometry, Joint, JointKind, Link, LinkShape, RobotModel,
+    AxisDir, DEFAULT_ACCEL_TIME, Geometry, Joint, JointKind, Link, LinkShape, RobotModel, TcpLimits,
 };
 
 /// How to load a URDF.
@@ -427,6 +427,7 @@ pub fn load_str_with(
         axes,
         tool_link,
         wrist: None,
+        tcp: tcp_limits(&stripped, file)?,
         chain_cache: Vec::new(),
     };
     model.chain_cache = model.chain();
@@ -629,6 +630,37 @@ fn attribute<'t>(tag: &'t str, key: &str) -> Option<&'t str> {
         return Some(&v[..v.find(q)?]);
     }
     None
+}
+
+/// The model's TCP limits: the attributes of a `<tcp_limits>` element (a vworks extension
+/// other URDF readers ignore), each positive and finite.
+fn tcp_limits(stripped: &str, file: &str) -> Result<TcpLimits, ModelError> {
+    let Some(at) = stripped.find("<tcp_limits") else {
+        return Ok(TcpLimits::default());
+    };
+    let tag = &stripped[at..];
+    let tag = &tag[..tag.find('>').unwrap_or(tag.len())];
+    let value = |key: &str, unit: &str| -> Result<Option<f64>, ModelError> {
+        let Some(text) = attribute(tag, key) else {
+            return Ok(None);
+        };
+        match text.trim().parse::<f64>() {
+            Ok(v) if v.is_finite() && v > 0.0 => Ok(Some(v)),
+            _ => Err(ModelError::Invalid {
+                problem: UrdfProblem::BadDynamicLimit,
+                file: file.to_string(),
+                element: "tcp_limits".into(),
+                message: format!("its {key} is `{text}`"),
+                help: format!(
+                    "write {key}=\"…\" as a number of {unit} greater than 0, or leave it out"
+                ),
+            }),
+        }
+    };
+    Ok(TcpLimits {
+        speed: value("speed", "m/s")?,
+        accel: value("acceleration", "m/s²")?,
+    })
 }
 
 /// The text without comments and without `<transmission>`/`<gazebo>` blocks, whose

@@ -175,7 +175,7 @@ fn every_first_contact_of_grazing_arms_agrees_with_a_40x_finer_cycle() {
     // Found by the adaptive-checking property test: two arms whose links graze nearly
     // parallel. parry's f32 capsule query read the overlapping links as 1 µm apart, then as
     // not in contact at all, so the sweep missed left.link_3/right.link_4's first contact
-    // (1606.2 ms) until the 1608 ms boundary; its f32 GJK also put a capsule 1.9 mm from a
+    // (then at 1606.2 ms) until the 1608 ms boundary; its f32 GJK also put a capsule 1.9 mm from a
     // cylinder in contact. Every pair's first contact must be within 0.1 ms of a
     // boundary-only run with 0.1 ms cycles.
     let toml = std::fs::read_to_string(root().join("workcells/crash/cell.toml"))
@@ -218,7 +218,14 @@ fn every_first_contact_of_grazing_arms_agrees_with_a_40x_finer_cycle() {
         );
     }
     let graze = ("left.link_3".to_string(), "right.link_4".to_string());
-    assert!((1_606_100_000..=1_606_400_000).contains(&coarse[&graze]));
+    // (1562.2 ms in a run with the IRB 120's dynamics; 1606.2 ms, the time the property
+    // test found, with the 0.3 s ramps the model had then: the joint paths are the same,
+    // the timing along them is not.)
+    assert!(
+        (1_562_100_000..=1_562_400_000).contains(&coarse[&graze]),
+        "{:?}",
+        coarse[&graze]
+    );
 }
 
 #[test]

@@ -155,9 +155,11 @@ fn step_lines(path: &JointPath, lim: &Limits<'_>, k: usize, out: &mut [Line]) ->
         out[m] = Line { a, b, c };
         m += 1;
     };
-    // The path's own acceleration, on u alone.
-    push(1.0, 0.0, lim.path_accel);
-    push(-1.0, 0.0, lim.path_accel);
+    // The path's own acceleration, on u alone (none: the axes alone bound it).
+    if lim.path_accel.is_finite() {
+        push(1.0, 0.0, lim.path_accel);
+        push(-1.0, 0.0, lim.path_accel);
+    }
     // (where, x there = x_k + shift·u)
     for (point, shift) in [(0u8, 0.0), (1, delta), (2, 2.0 * delta)] {
         let mut x_max = lim.path_speed * lim.path_speed;

@@ -38,6 +38,12 @@ pub(super) struct PathSamples {
     /// The joints at every 16th knot: the seeds the executed path's IK starts from.
     pub(super) seeds: [[f64; MAX_AXES]; SEEDS],
     pub(super) timing: Option<Timing>,
+    /// The profile the motion executes where it is not the programmed one: the same shape
+    /// at a lower acceleration (`None` with a timing, or the programmed profile).
+    pub(super) executed: Option<Profile>,
+    /// Where the axes make the motion slower than its programmed speed and acceleration
+    /// alone would (s): how long it would take without them; `None` if they do not.
+    pub(super) unslowed: Option<f64>,
     pub(super) worst_axis: usize,
     pub(super) rates: [f64; MAX_AXES],
     pub(super) end: [f64; MAX_AXES],
@@ -89,7 +95,7 @@ pub(super) fn sample_path(
     tool: &Iso,
     (path, start, goal, from): (&Path, &Iso, &Iso, &[f64; MAX_AXES]),
     branch: Option<u8>,
-    profile: &Profile,
+    (profile, vs, js): (&Profile, f64, f64),
 ) -> Result<PathSamples, PlanError> {
     let n = model.dof();
     let mut joints = JointPath::new(n);
@@ -162,75 +168,38 @@ pub(super) fn sample_path(
         speed[i] = j.max_velocity;
         accel[i] = j.max_accel;
     }
-    // The profile at each knot: path speed and acceleration where it passes.
-    let mut worst = 1.0f64;
-    let mut worst_axis = 0;
-    let mut sd = [0.0f64; KNOTS];
-    let mut near = [false; SEGMENTS];
-    for (k, sd_k) in sd.iter_mut().enumerate() {
-        let s = k as f64 / SEGMENTS as f64;
-        let (v_path, a_path) = state_at_distance(profile, s * profile.dist);
-        *sd_k = v_path;
-        for i in 0..n {
-            let (d1, d2) = joints.derivatives(k, i);
-            let v = (d1 * v_path).abs();
-            let a = (d1 * a_path + d2 * v_path * v_path).abs();
-            let ratio = (speed[i] / v).min(accel[i] / a);
-            if ratio < worst {
-                worst = ratio;
-                worst_axis = i;
-            }
-            if ratio < 1.0 / NEAR_LIMIT {
-                near[k.min(SEGMENTS - 1)] = true;
-                near[k.saturating_sub(1)] = true;
-            }
-        }
-    }
-    // The profile's top speed is halfway through its time: the step it falls in moves
-    // at most that fast.
-    let peak_s = profile.at(0.5 * profile.t_total) / profile.dist.max(f64::MIN_POSITIVE);
-    let peak = profile.speed_at(0.5 * profile.t_total);
-    let peak_step = ((peak_s * SEGMENTS as f64) as usize).min(SEGMENTS - 1);
     let end = joints.q[SEGMENTS];
-    // Between the knots (at each step's quarter points), where an axis comes near a limit
-    // at the knots: the path's curvature within a step (near a singularity) can take it
-    // past.
     let mut inner = Inner::new();
-    let mut ratios = [0.0f64; SEGMENTS];
-    let mut fits = worst >= 1.0 - JOINT_SPEED_TOLERANCE;
-    if fits && worst < 1.0 / NEAR_LIMIT {
-        inner.fill(&joints, &near, joints_at)?;
-        let state = |_: usize, s: f64| {
-            let (v, a) = state_at_distance(profile, s * profile.dist);
-            (v * v, a)
-        };
-        let (rv, ra) = inner.ratios(&joints, &speed[..n], &accel[..n], state, &mut ratios);
-        fits = rv.max(ra) <= 1.0 + JOINT_SPEED_TOLERANCE;
-    }
-    if fits {
-        let mut step_speed = [0.0f64; SEGMENTS];
-        for (k, v) in step_speed.iter_mut().enumerate() {
-            *v = if k == peak_step {
-                peak
-            } else {
-                sd[k].max(sd[k + 1])
-            };
+    let limits_of = (&speed[..n], &accel[..n]);
+    // Without an acceleration of its own (no `accel`, no TCP limit in the model) the path
+    // accelerates as fast as its axes let it: never the programmed profile as it is.
+    let bounded = profile.a.is_finite();
+    if bounded {
+        let check = check_profile(&joints, profile, limits_of, &mut inner, &joints_at)?;
+        if check.fits {
+            return Ok(profile_samples(&joints, profile, &check, None, end));
         }
-        return Ok(PathSamples {
-            seeds: seeds_of(&joints),
-            timing: None,
-            worst_axis,
-            rates: rate_bounds(&joints, &step_speed),
-            end,
-        });
     }
+    // The same trapezoid (S-curve) at the highest lower acceleration that keeps every
+    // axis within its limits: where an axis binds only in the ramps (a short ramp at a
+    // high acceleration), as fast as a timing can be — the time-optimal timing below
+    // changes speed only at its knots, and loses up to a step's time at each end when the
+    // whole ramp lies within one step. The faster of the two is the motion's.
+    let lower = lower_profile(
+        &joints,
+        profile,
+        (vs, js),
+        limits_of,
+        &mut inner,
+        &joints_at,
+    )?;
     // The timing keeps a margin below the limits the checks measure against.
     let speed_timed = speed.map(|v| v * (1.0 - TIMING_MARGIN));
     let accel_timed = accel.map(|a| a * (1.0 - TIMING_MARGIN));
     let limits = Limits {
         axis_speed: &speed_timed[..n],
         axis_accel: &accel_timed[..n],
-        path_speed: profile.v,
+        path_speed: vs,
         path_accel: profile.a,
     };
     let optimal = |joints: &JointPath| {
@@ -252,6 +221,7 @@ pub(super) fn sample_path(
     // quarter points find an axis past a limit, that step gets less room and the timing
     // is made again (a few rounds; then, if still needed, the whole timing slower).
     let mut timing = optimal(&joints)?;
+    let mut ratios = [0.0f64; SEGMENTS];
     for round in 0..=ROOM_ROUNDS {
         // The steps where an axis comes near a limit at a knot under the timing.
         let mut near = [false; SEGMENTS];
@@ -292,13 +262,207 @@ pub(super) fn sample_path(
     for (k, v) in step_speed.iter_mut().enumerate() {
         *v = timing.speed_at_knot(k).max(timing.speed_at_knot(k + 1));
     }
+    if let Some((lower, check)) = lower
+        && lower.t_total <= timing.duration()
+    {
+        return Ok(profile_samples(&joints, &lower, &check, Some(lower), end));
+    }
+    // Slowed: where an axis's speed keeps the TCP below its programmed speed (the axes'
+    // accelerations are the path's own dynamics, as on a controller), against the same
+    // timing without the axis speeds.
+    let (worst_axis, nearest) = fastest_axis(&joints, &timing, &speed[..n]);
+    let unslowed = if nearest < SPEED_BINDS {
+        None
+    } else {
+        let no_speed = [f64::INFINITY; MAX_AXES];
+        let unbound = Limits {
+            axis_speed: &no_speed[..n],
+            ..limits
+        };
+        let would = Timing::optimal(&joints, &unbound).map_or(0.0, |t| t.duration());
+        (timing.duration() > would * (1.0 + 1e-9)).then_some(would)
+    };
     Ok(PathSamples {
         seeds: seeds_of(&joints),
         rates: rate_bounds(&joints, &step_speed),
         timing: Some(timing),
+        executed: None,
+        unslowed,
         worst_axis,
         end,
     })
+}
+
+/// How near its speed limit (its fraction) an axis must come under a timing for the
+/// timing to be compared with one without the axis speeds (a `slowdown` warning).
+const SPEED_BINDS: f64 = 0.99;
+
+/// The axis that comes nearest its speed limit at a knot under `timing`, and how near
+/// (its fraction of the limit).
+fn fastest_axis(joints: &JointPath, timing: &Timing, speed: &[f64]) -> (usize, f64) {
+    let (mut best, mut axis) = (0.0f64, 0);
+    for k in 0..KNOTS {
+        let sd = timing.speed_at_knot(k);
+        for (i, v) in speed.iter().enumerate() {
+            let r = (joints.derivatives(k, i).0 * sd).abs() / v;
+            if r > best {
+                (best, axis) = (r, i);
+            }
+        }
+    }
+    (axis, best)
+}
+
+/// How a profile keeps the axis limits along a sampled path.
+struct ProfileCheck {
+    /// Every axis within its speed and acceleration at the knots, and between them where
+    /// one comes near a limit.
+    fits: bool,
+    /// The axis nearest its limit (its largest fraction) at a knot.
+    worst_axis: usize,
+    /// The path speed at each knot.
+    sd: [f64; KNOTS],
+}
+
+/// Checks `profile` against every axis's speed and acceleration at the knots (axis speed
+/// q′(s)·ṡ, acceleration q′(s)·s̈ + q″(s)·ṡ²) and, where an axis comes within
+/// [`NEAR_LIMIT`] of a limit there, at the quarter points of the steps around.
+fn check_profile(
+    joints: &JointPath,
+    profile: &Profile,
+    (speed, accel): (&[f64], &[f64]),
+    inner: &mut Inner,
+    joints_at: &impl Fn(f64, &[f64; MAX_AXES]) -> Result<[f64; MAX_AXES], PlanError>,
+) -> Result<ProfileCheck, PlanError> {
+    let mut worst = 1.0f64;
+    let mut worst_axis = 0;
+    let mut sd = [0.0f64; KNOTS];
+    let mut near = [false; SEGMENTS];
+    for (k, sd_k) in sd.iter_mut().enumerate() {
+        let s = k as f64 / SEGMENTS as f64;
+        let (v_path, a_path) = state_at_distance(profile, s * profile.dist);
+        *sd_k = v_path;
+        for i in 0..joints.axes {
+            let (d1, d2) = joints.derivatives(k, i);
+            let v = (d1 * v_path).abs();
+            let a = (d1 * a_path + d2 * v_path * v_path).abs();
+            let ratio = (speed[i] / v).min(accel[i] / a);
+            if ratio < worst {
+                worst = ratio;
+                worst_axis = i;
+            }
+            if ratio < 1.0 / NEAR_LIMIT {
+                near[k.min(SEGMENTS - 1)] = true;
+                near[k.saturating_sub(1)] = true;
+            }
+        }
+    }
+    let mut fits = worst >= 1.0 - JOINT_SPEED_TOLERANCE;
+    if fits && worst < 1.0 / NEAR_LIMIT {
+        inner.fill(joints, &near, joints_at)?;
+        let state = |_: usize, s: f64| {
+            let (v, a) = state_at_distance(profile, s * profile.dist);
+            (v * v, a)
+        };
+        let mut ratios = [0.0f64; SEGMENTS];
+        let (rv, ra) = inner.ratios(joints, speed, accel, state, &mut ratios);
+        fits = rv.max(ra) <= 1.0 + JOINT_SPEED_TOLERANCE;
+    }
+    Ok(ProfileCheck {
+        fits,
+        worst_axis,
+        sd,
+    })
+}
+
+/// The samples of a path that moves by `profile` (`executed`: the profile, when it is
+/// not the programmed one).
+fn profile_samples(
+    joints: &JointPath,
+    profile: &Profile,
+    check: &ProfileCheck,
+    executed: Option<Profile>,
+    end: [f64; MAX_AXES],
+) -> PathSamples {
+    // The profile's top speed is halfway through its time: the step it falls in moves
+    // at most that fast.
+    let peak_s = profile.at(0.5 * profile.t_total) / profile.dist.max(f64::MIN_POSITIVE);
+    let peak = profile.speed_at(0.5 * profile.t_total);
+    let peak_step = ((peak_s * SEGMENTS as f64) as usize).min(SEGMENTS - 1);
+    let mut step_speed = [0.0f64; SEGMENTS];
+    for (k, v) in step_speed.iter_mut().enumerate() {
+        *v = if k == peak_step {
+            peak
+        } else {
+            check.sd[k].max(check.sd[k + 1])
+        };
+    }
+    PathSamples {
+        seeds: seeds_of(joints),
+        timing: None,
+        executed,
+        unslowed: None,
+        worst_axis: check.worst_axis,
+        rates: rate_bounds(joints, &step_speed),
+        end,
+    }
+}
+
+/// Halvings of the acceleration interval in [`lower_profile`]: to 2⁻²⁴ of the largest.
+const LOWER_ROUNDS: usize = 24;
+
+/// The programmed profile's shape (speed `vs`, jerk ramp kept) at the highest path
+/// acceleration below the programmed one (and below what the axes allow at the path's
+/// ends, where it starts from rest) at which every axis keeps its limits, found by
+/// bisection; `None` if even a tiny one does not (an axis's speed binds at cruise).
+fn lower_profile(
+    joints: &JointPath,
+    profile: &Profile,
+    (vs, js): (f64, f64),
+    limits: (&[f64], &[f64]),
+    inner: &mut Inner,
+    joints_at: &impl Fn(f64, &[f64; MAX_AXES]) -> Result<[f64; MAX_AXES], PlanError>,
+) -> Result<Option<(Profile, ProfileCheck)>, PlanError> {
+    // At rest at either end the axis accelerations are q′·s̈: a bound in closed form.
+    let mut hi = profile.a;
+    for slopes in &joints.end_slopes {
+        for (slope, a) in slopes.iter().zip(limits.1) {
+            if *slope != 0.0 {
+                hi = hi.min(a / slope.abs());
+            }
+        }
+    }
+    if !hi.is_finite() || hi <= 0.0 {
+        return Ok(None);
+    }
+    // The jerk ramp keeps its time (a / j).
+    let shaped = |a: f64| {
+        let j = if js.is_finite() && profile.a.is_finite() {
+            js * a / profile.a
+        } else {
+            f64::INFINITY
+        };
+        Profile::with_jerk(1.0, vs, a, j)
+    };
+    let top = shaped(hi);
+    let check = check_profile(joints, &top, limits, inner, joints_at)?;
+    if check.fits {
+        return Ok(Some((top, check)));
+    }
+    let (mut lo, mut hi) = (0.0, hi);
+    let mut best = None;
+    for _ in 0..LOWER_ROUNDS {
+        let mid = 0.5 * (lo + hi);
+        let p = shaped(mid);
+        let check = check_profile(joints, &p, limits, inner, joints_at)?;
+        if check.fits {
+            lo = mid;
+            best = Some((p, check));
+        } else {
+            hi = mid;
+        }
+    }
+    Ok(best)
 }
 
 /// Knots kept as IK seeds for the executed path: every 16th (0, 16, …, 256).

@@ -725,7 +725,13 @@ fn plan_cartesian(
         // motion take no time at all.)
         return Err(PlanError::Accel(a));
     }
-    let mut a = accel.unwrap_or(v / vworks_model::model::DEFAULT_ACCEL_TIME);
+    // The model's TCP limits bound what a program asks; without an `accel` (or a TCP
+    // acceleration in the model) the path accelerates as fast as its axes allow.
+    let tcp = model.tcp;
+    let tcp_speed = tcp.speed.unwrap_or(f64::INFINITY);
+    let tcp_accel = tcp.accel.unwrap_or(f64::INFINITY);
+    v = v.min(tcp_speed);
+    let mut a = accel.unwrap_or(f64::INFINITY).min(tcp_accel);
     let len = path.length();
     let angle = vworks_model::math::norm(vworks_model::math::rotation_vector(
         &vworks_model::math::mat_mul(&vworks_model::math::transpose(&start.r), &goal.r),
@@ -763,8 +769,10 @@ fn plan_cartesian(
         // acceleration with them, unless given; `orient`, if given, stays the
         // orientation's bound) at which the motion takes at most the duration.
         let at = |k: f64| {
-            let v = k * MAX_TCP_SPEED;
-            let a = accel.unwrap_or(v / vworks_model::model::DEFAULT_ACCEL_TIME);
+            let v = k * MAX_TCP_SPEED.min(tcp_speed);
+            let a = accel
+                .unwrap_or(v / vworks_model::model::DEFAULT_ACCEL_TIME)
+                .min(tcp_accel);
             (v, a, orient.unwrap_or(k * MAX_ORIENT_SPEED))
         };
         let lasts = |k: f64| {
@@ -825,28 +833,27 @@ fn plan_cartesian(
     let branch = model.ik_branch(&start.mul(&tool.inverse()), &start_joints[..n]);
     let sampled = memo.get_or_sample(key, || {
         let ends = (&path, &start, &goal, &start_joints);
-        sample_path(model, &tool, ends, branch, &profile)
+        sample_path(model, &tool, ends, branch, (&profile, vs, js))
     })?;
     let PathSamples {
         seeds,
         timing,
+        executed,
+        unslowed,
         worst_axis,
         rates,
         end: prev,
     } = sampled;
-    let (duration_ns, slowed) = match &timing {
-        None => (profile.duration_ns(), None),
-        Some(t) => {
-            let lasts = (t.duration() * NS).ceil() as i64;
-            let would = profile.duration_ns();
-            let slowed = Slowed {
-                axis: worst_axis,
-                lasts,
-                would,
-            };
-            (lasts, Some(slowed))
-        }
+    let profile = executed.unwrap_or(profile);
+    let duration_ns = match &timing {
+        None => profile.duration_ns(),
+        Some(t) => (t.duration() * NS).ceil() as i64,
     };
+    let slowed = unslowed.map(|would| Slowed {
+        axis: worst_axis,
+        lasts: duration_ns,
+        would: (would * NS).ceil() as i64,
+    });
     Ok(Plan {
         traj: Trajectory::Cartesian {
             path,

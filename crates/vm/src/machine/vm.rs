@@ -704,7 +704,7 @@ impl Vm {
                 pos,
                 kind: WarningKind::Slowdown,
                 message: format!(
-                    "axis {} `{}` slows the motion where it would exceed its speed or acceleration limit: it takes {}, {} at the programmed speed alone",
+                    "axis {} `{}` reaches its speed limit and slows the TCP below its programmed speed: the motion takes {}, {} without that limit",
                     s.axis + 1,
                     j.name,
                     fmt_quantity(s.lasts as f64 / NS, Dim::TIME),

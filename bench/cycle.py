@@ -1,0 +1,137 @@
+#!/usr/bin/env python3
+"""The built-in arms' published standard cycles, run in vworks: the fidelity table of
+docs/models.md ("Dynamics of the built-in arms") and BENCHMARKS.md ("Cycle times against
+the vendors' figures").
+
+The 1 kg picking cycle of ISO 9283 / the RIA, as ABB words it for the IRB 120: up 25 mm,
+300 mm across, down 25 mm, and back the same way. The vendors state neither the corner
+zones nor where in the workspace the cycle runs, so the script runs it four ways at two
+places and prints them all:
+
+- from pick `a` = (x, -150 mm, z) to place `b` = (x, +150 mm, z), the tool pointing down,
+  at (x, z) = (400 mm, 200 mm) and (450 mm, 100 mm) in the robot's base frame;
+- `move_j` or `move_l` between the points, at the model's TCP speed (its
+  `<tcp_limits speed>`, else 7 m/s: the axes bound it);
+- the four upper corners flying by with `zone 25mm`, or all six points `fine`; pick and
+  place are always `fine` (the gripper works there).
+
+A cycle is the mean of 10 back-and-forth rounds after a first `move_j` to `a`, from the
+programs' own `now()`. `--accel-time T` runs a copy of the model whose axes reach full speed
+in T seconds (the way the IRB 120's estimate was fitted: docs/models.md).
+
+    .venv/bin/python bench/cycle.py [--models irb120 kr6r900] [--accel-time 0.07]
+
+The places suit the IRB 120; another arm may not reach them or pass a singularity on the
+way, which the table says instead of a time.
+
+Needs the `vworks` Python package (`scripts/test` builds it into .venv).
+"""
+
+import argparse
+import re
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+MODELS_DIR = ROOT / "crates" / "model" / "models"
+
+# Published standard cycles (s), with their source: docs/models.md says how far each is
+# checked. Models without one are run all the same, for the table.
+PUBLISHED = {
+    "irb120": (0.58, "ABB IRB 120 data sheet, 1 kg picking cycle 25 x 300 x 25 mm"),
+}
+PLACES = [(400.0, 200.0), (450.0, 100.0)]  # (x, z) of pick and place, mm
+ROUNDS = 10
+FALLBACK_SPEED = 7.0  # m/s, where a model gives no TCP speed: the axes bound the motion
+
+
+def tcp_speed(model):
+    text = (MODELS_DIR / f"{model}.urdf").read_text()
+    m = re.search(r'<tcp_limits[^>]*\bspeed="([^"]+)"', text)
+    return float(m.group(1)) if m else FALLBACK_SPEED
+
+
+def write_cell(folder, model, motion, zone, x, z, accel_time=None):
+    """A one-robot cell that runs the cycle ROUNDS times and logs the mean."""
+    if accel_time is None:
+        robot = f'model = "{model}"'
+    else:
+        text = (MODELS_DIR / f"{model}.urdf").read_text()
+        text = re.sub(r'\s+acceleration="[^"]*"', "", text.replace("<tcp_limits", "<tcp_x"))
+        text = text.replace("<tcp_x", "<tcp_limits")
+        text = re.sub(r'velocity="([0-9.eE+-]+)"',
+                      lambda m: f'{m.group(0)} acceleration="{float(m.group(1)) / accel_time:.9f}"', text)
+        folder.joinpath("model.urdf").write_text(text)
+        robot = 'urdf = "model.urdf"'
+    folder.joinpath("cell.toml").write_text(
+        f'name = "cycle"\n[[robot]]\nname = "r1"\n{robot}\nprogram = "r1.wsl"\n'
+        f'default_speed = "{tcp_speed(model) * 1000.0:g}mm/s"\n'
+        'home = ["0deg", "0deg", "0deg", "0deg", "90deg", "0deg"]\n')
+    up = f"zone {zone}"
+    folder.joinpath("r1.wsl").write_text(f"""
+const a = pose({x}mm, -150mm, {z}mm, 180deg, 0deg, 0deg);
+const b = pose({x}mm, 150mm, {z}mm, 180deg, 0deg, 0deg);
+proc main() {{
+    move_j a;
+    var t0 = now();
+    for i in 0..{ROUNDS} {{
+        {motion} offset(a, 0mm, 0mm, 25mm) {up};
+        {motion} offset(b, 0mm, 0mm, 25mm) {up};
+        {motion} b zone fine;
+        {motion} offset(b, 0mm, 0mm, 25mm) {up};
+        {motion} offset(a, 0mm, 0mm, 25mm) {up};
+        {motion} a zone fine;
+    }}
+    log (now() - t0) / {ROUNDS};
+}}
+""")
+    return folder / "cell.toml"
+
+
+def cycle(vworks, folder, model, motion, zone, x, z, accel_time=None):
+    """The mean cycle (s), or the reason it did not run."""
+    try:
+        result = vworks.load_cell(str(write_cell(folder, model, motion, zone, x, z, accel_time))).run()
+    except vworks.Error as e:  # out of reach, a singularity on the way: said, not hidden
+        return type(e).__name__
+    if result.outcome != "completed":
+        return f"{result.outcome}"
+    return float(result.logs[-1].text.split()[0].rstrip("s"))
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--models", nargs="+", default=list(PUBLISHED),
+                        choices=["irb120", "kr6r900", "lrmate200id", "ur5"],
+                        help="default: the models with a published cycle")
+    parser.add_argument("--accel-time", type=float, help="axes reach full speed in this time (s)")
+    args = parser.parse_args()
+    import vworks
+
+    print("the 25 x 300 x 25 mm cycle (s), mean of 10 rounds; fly-by = zone 25mm at the upper corners")
+    if args.accel_time:
+        print(f"(axes reach full speed in {args.accel_time} s)")
+    print()
+    print("| model | (x, z) mm | move_j fly-by | move_j fine | move_l fly-by | move_l fine | published |")
+    print("|---|---|---|---|---|---|---|")
+    with tempfile.TemporaryDirectory() as tmp:
+        for model in args.models:
+            published = PUBLISHED.get(model)
+            for x, z in PLACES:
+                cells = []
+                for motion in ("move_j", "move_l"):
+                    for zone in ("25mm", "fine"):
+                        t = cycle(vworks, Path(tmp), model, motion, zone, x, z, args.accel_time)
+                        if isinstance(t, float) and published:
+                            cells.append(f"{t:.3f} ({t / published[0] - 1:+.1%})")
+                        elif isinstance(t, float):
+                            cells.append(f"{t:.3f}")
+                        else:
+                            cells.append(t)
+                pub = f"{published[0]:.2f} ({published[1]})" if published else "none published"
+                print(f"| {model} | ({x:g}, {z:g}) | " + " | ".join(cells) + f" | {pub} |")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
