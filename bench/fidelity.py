@@ -73,6 +73,7 @@ ROOT = Path(__file__).resolve().parents[1]
 MODELS_DIR = ROOT / "crates" / "model" / "models"
 
 DEFAULT_ACCEL_TIME = 0.3  # s: full speed in 0.3 s, axes without <limit acceleration> (docs/models.md)
+END_GRIDPOINTS = 40  # more gridpoints within the first and last two uniform steps
 UNBOUNDED = 1e6  # m/s²: the virtual joint s's acceleration where the model gives no TCP limit
 SPEEDS = [0.1, 0.5, 1.0, 2.0, 4.0]  # m/s
 LENGTH_MM = (50.0, 600.0)
@@ -254,7 +255,10 @@ def toppra_time(s, q, vlim, alim, speed, accel=float("inf")):
     cons = [constraint.JointVelocityConstraint(np.column_stack([-v, v])),
             constraint.JointAccelerationConstraint(
                 np.column_stack([-a, a]), discretization_scheme=constraint.DiscretizationType.Interpolation)]
-    grid = np.linspace(s[0], s[-1], GRIDPOINTS)
+    # Uniform, and dense near both ends: a ramp shorter than one uniform step (a slow, long
+    # line) would otherwise cost toppra up to a step's time at each end.
+    ends = (s[-1] - s[0]) * np.geomspace(1e-6, 2.0 / (GRIDPOINTS - 1), END_GRIDPOINTS)
+    grid = np.unique(np.concatenate([np.linspace(s[0], s[-1], GRIDPOINTS), s[0] + ends, s[-1] - ends]))
     instance = algo.TOPPRA(cons, path, gridpoints=grid)
     sdd, sd, _ = instance.compute_parameterization(0.0, 0.0)
     if sd is None or not np.all(np.isfinite(sd)):

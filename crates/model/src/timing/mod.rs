@@ -190,9 +190,69 @@ fn step_lines(path: &JointPath, lim: &Limits<'_>, k: usize, out: &mut [Line]) ->
     m
 }
 
-/// The largest `x ≥ 0` for which some `u` satisfies every line, and that `u`'s bounds.
-/// Rest (`u = 0, x = 0`) satisfies them all, so the feasible `x` are an interval from 0.
+/// The largest `x ≥ 0` for which some `u` satisfies every line. Rest (`u = 0, x = 0`)
+/// satisfies them all, so the feasible `x` are an interval from 0: below the lines that
+/// bound `x` alone, and where the room for `u`, h(x) = min of the upper bounds − max of
+/// the lower bounds (concave, piecewise linear), is not negative. Newton's method on h
+/// from the right finds its root in a few passes over the lines (each step's tangent is
+/// a pair of lines, whose root is at or right of h's); [`largest_x_by_pairs`], every
+/// pair of a lower and an upper bound, is the fallback.
 fn largest_x(lines: &[Line]) -> f64 {
+    // Lines without u bound x alone.
+    let mut right = f64::INFINITY;
+    for l in lines.iter().filter(|l| l.a == 0.0) {
+        if l.b > 0.0 {
+            right = right.min(l.c / l.b);
+        }
+    }
+    if !right.is_finite() {
+        return largest_x_by_pairs(lines);
+    }
+    // The tightest lower (a < 0) and upper (a > 0) bound on u at x.
+    let active = |x: f64| {
+        let (mut lo, mut lo_at, mut hi, mut hi_at) = (f64::NEG_INFINITY, None, f64::INFINITY, None);
+        for l in lines {
+            if l.a == 0.0 {
+                continue;
+            }
+            let u = (l.c - l.b * x) / l.a;
+            if l.a < 0.0 && u > lo {
+                (lo, lo_at) = (u, Some(l));
+            } else if l.a > 0.0 && u < hi {
+                (hi, hi_at) = (u, Some(l));
+            }
+        }
+        (hi - lo, lo_at, hi_at)
+    };
+    let mut x = right.max(0.0);
+    for _ in 0..NEWTON_STEPS {
+        let (room, lo, hi) = active(x);
+        if room >= 0.0 {
+            return x;
+        }
+        let (Some(lo), Some(hi)) = (lo, hi) else {
+            break;
+        };
+        // The pair's root, as `largest_x_by_pairs` computes it.
+        let g0 = hi.c / hi.a - lo.c / lo.a;
+        let g1 = -hi.b / hi.a + lo.b / lo.a;
+        if g1 >= 0.0 {
+            break;
+        }
+        let next = (g0 / -g1).max(0.0);
+        if next >= x {
+            return x.min(next);
+        }
+        x = next;
+    }
+    largest_x_by_pairs(lines)
+}
+
+/// Passes of [`largest_x`]'s Newton method before it falls back to every pair.
+const NEWTON_STEPS: usize = 64;
+
+/// [`largest_x`] by every pair of a lower and an upper bound on u.
+fn largest_x_by_pairs(lines: &[Line]) -> f64 {
     let mut best = f64::INFINITY;
     // Lines without u bound x alone.
     for l in lines.iter().filter(|l| l.a == 0.0) {

@@ -339,3 +339,42 @@ fn bad_limits_are_errors() {
         Err(TimingError::BadLimit(_))
     ));
 }
+
+/// Newton's method on the room for u finds what every pair of bounds finds: on the lines
+/// of real steps (random paths through the feasible region) and on random line sets that
+/// rest satisfies.
+#[test]
+fn newton_finds_the_largest_x_every_pair_finds() {
+    let mut seed = 0x2545_f491_4f6c_dd1du64;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut compared = 0;
+    for _ in 0..2000 {
+        let m = 3 + (next() * 30.0) as usize;
+        let mut lines = Vec::with_capacity(m + 2);
+        for j in 0..m {
+            let a = if j % 5 == 4 { 0.0 } else { next() * 4.0 - 2.0 };
+            let b = next() * 4.0 - 2.0;
+            // c ≥ 0: rest (u = 0, x = 0) satisfies every line.
+            let c = next() * 3.0;
+            lines.push(Line { a, b, c });
+        }
+        // x bounded alone, as the speed limits bound it.
+        lines.push(Line {
+            a: 0.0,
+            b: 1.0,
+            c: 0.5 + next() * 10.0,
+        });
+        let (newton, pairs) = (largest_x(&lines), largest_x_by_pairs(&lines));
+        assert!(
+            (newton - pairs).abs() <= 1e-12 * pairs.max(1.0),
+            "{newton} vs {pairs}: {lines:?}"
+        );
+        compared += 1;
+    }
+    assert_eq!(compared, 2000);
+}

@@ -193,6 +193,15 @@ pub(super) fn sample_path(
         &mut inner,
         &joints_at,
     )?;
+    // No timing beats the programmed profile (nor, without an acceleration, cruising at
+    // the programmed speed all the way): a trapezoid this close to it is kept without
+    // the time-optimal timing.
+    if let Some((lower, check)) = &lower {
+        let bound = if bounded { profile.t_total } else { 1.0 / vs };
+        if lower.t_total <= bound * (1.0 + NEAR_OPTIMAL) {
+            return Ok(profile_samples(&joints, lower, check, Some(*lower), end));
+        }
+    }
     // The timing keeps a margin below the limits the checks measure against.
     let speed_timed = speed.map(|v| v * (1.0 - TIMING_MARGIN));
     let accel_timed = accel.map(|a| a * (1.0 - TIMING_MARGIN));
@@ -408,6 +417,11 @@ fn profile_samples(
     }
 }
 
+/// How much slower than the fastest any timing could be (the programmed profile, or
+/// cruising at the programmed speed from end to end) a trapezoid at a lower acceleration
+/// may be for the time-optimal timing to be left out: 0.05 %.
+const NEAR_OPTIMAL: f64 = 5e-4;
+
 /// Halvings of the acceleration interval in [`lower_profile`]: to 2⁻²⁴ of the largest.
 const LOWER_ROUNDS: usize = 24;
 
@@ -444,26 +458,54 @@ fn lower_profile(
         };
         Profile::with_jerk(1.0, vs, a, j)
     };
-    let top = shaped(hi);
-    let check = check_profile(joints, &top, limits, inner, joints_at)?;
-    if check.fits {
-        return Ok(Some((top, check)));
+    // Bisection on the knots alone (cheap: no IK), then the full check between them; where
+    // that finds an axis past a limit, a little lower.
+    let mut a = hi;
+    if !fits_at_knots(joints, &shaped(hi), limits) {
+        let mut lo = 0.0;
+        for _ in 0..LOWER_ROUNDS {
+            let mid = 0.5 * (lo + a);
+            if fits_at_knots(joints, &shaped(mid), limits) {
+                lo = mid;
+            } else {
+                a = mid;
+            }
+        }
+        a = lo;
     }
-    let (mut lo, mut hi) = (0.0, hi);
-    let mut best = None;
-    for _ in 0..LOWER_ROUNDS {
-        let mid = 0.5 * (lo + hi);
-        let p = shaped(mid);
+    for _ in 0..LOWER_RETRIES {
+        if a <= 0.0 {
+            break;
+        }
+        let p = shaped(a);
         let check = check_profile(joints, &p, limits, inner, joints_at)?;
         if check.fits {
-            lo = mid;
-            best = Some((p, check));
-        } else {
-            hi = mid;
+            return Ok(Some((p, check)));
         }
+        a *= LOWER_STEP;
     }
-    Ok(best)
+    Ok(None)
 }
+
+/// Whether every axis keeps its speed and acceleration under `profile` at every knot.
+fn fits_at_knots(joints: &JointPath, profile: &Profile, (speed, accel): (&[f64], &[f64])) -> bool {
+    (0..KNOTS).all(|k| {
+        let s = k as f64 / SEGMENTS as f64;
+        let (v_path, a_path) = state_at_distance(profile, s * profile.dist);
+        (0..joints.axes).all(|i| {
+            let (d1, d2) = joints.derivatives(k, i);
+            let v = (d1 * v_path).abs();
+            let a = (d1 * a_path + d2 * v_path * v_path).abs();
+            v <= speed[i] * (1.0 + JOINT_SPEED_TOLERANCE)
+                && a <= accel[i] * (1.0 + JOINT_SPEED_TOLERANCE)
+        })
+    })
+}
+
+/// Tries of [`lower_profile`] when the check between the knots fails, each
+/// [`LOWER_STEP`] of the last.
+const LOWER_RETRIES: usize = 6;
+const LOWER_STEP: f64 = 0.97;
 
 /// Knots kept as IK seeds for the executed path: every 16th (0, 16, …, 256).
 pub(super) const SEEDS: usize = SEGMENTS / 16 + 1;
