@@ -58,10 +58,12 @@ def write_cell(folder, model, motion, zone, x, z, accel_time=None):
         robot = f'model = "{model}"'
     else:
         text = (MODELS_DIR / f"{model}.urdf").read_text()
-        text = re.sub(r'\s+acceleration="[^"]*"', "", text.replace("<tcp_limits", "<tcp_x"))
-        text = text.replace("<tcp_x", "<tcp_limits")
-        text = re.sub(r'velocity="([0-9.eE+-]+)"',
-                      lambda m: f'{m.group(0)} acceleration="{float(m.group(1)) / accel_time:.9f}"', text)
+        # Each joint's <limit>: its acceleration replaced by velocity / T (the TCP limits kept).
+        def limit(m):
+            tag = re.sub(r'\s+acceleration="[^"]*"', "", m.group(0))
+            v = float(re.search(r'velocity="([^"]+)"', tag).group(1))
+            return tag.replace("<limit", f'<limit acceleration="{v / accel_time:.9f}"', 1)
+        text = re.sub(r"<limit\b[^>]*>", limit, text)
         folder.joinpath("model.urdf").write_text(text)
         robot = 'urdf = "model.urdf"'
     folder.joinpath("cell.toml").write_text(
