@@ -168,14 +168,14 @@ def test_compile_files_makes_one_program_of_a_tasks_modules():
 def test_a_rapid_cell_runs_from_python():
     r = vworks.load_cell(str(ROOT / "workcells/rapid_handoff/cell.toml")).run()
     assert r.outcome == "completed"
-    assert r.end_time == pytest.approx(46.090, abs=5e-4)
+    assert r.end_time == pytest.approx(45.462, abs=5e-4)
 
 
 # --- load_cell and run --------------------------------------------------------------------
 
 
 def test_the_readme_line():
-    assert vworks.load_cell(str(HANDOFF)).run().end_time == pytest.approx(48.903006229)
+    assert vworks.load_cell(str(HANDOFF)).run().end_time == pytest.approx(46.497702586)
 
 
 def test_cell_properties():
@@ -201,10 +201,10 @@ def test_result_fields():
     r = vworks.load_cell(HANDOFF).run()
     assert r.outcome == "completed"
     assert r.end_time == pytest.approx(r.end_time_ns / 1e9)
-    assert r.cycles > 12000
+    assert r.cycles > 11000
     r1, r2 = r.robots
     assert (r1.name, r2.name) == ("r1", "r2")
-    assert r1.end_time == pytest.approx(48.903006229) and r1.ended == "ended"
+    assert r1.end_time == pytest.approx(46.497702586) and r1.ended == "ended"
     assert r1.moving + r1.waiting + r1.idle == pytest.approx(r.end_time, abs=1e-6)
     assert r1.motions == 41 and not hasattr(r1, "handler")
     assert r.globals == {"handed": 3}
@@ -419,12 +419,12 @@ def test_stepping_gives_the_same_run_as_run():
     steps = 0
     while sim.step_cycle():
         steps += 1
-    assert sim.outcome == "completed" and steps > 12000
+    assert sim.outcome == "completed" and steps > 11000
     assert sim.globals["handed"] == 3
     stepped = [e.trace_line() for e in sim.events_since()]
     assert stepped == golden("handoff")[0]
     r = sim.result()
-    assert r.outcome == "completed" and r.end_time_ns == 48_903_006_229
+    assert r.outcome == "completed" and r.end_time_ns == 46_497_702_586
     assert sim.result() is r
     with pytest.raises(vworks.Error, match="ended"):
         sim.step_event()
@@ -433,7 +433,7 @@ def test_stepping_gives_the_same_run_as_run():
 
 def test_simulation_run_and_early_result():
     cell = vworks.load_cell(HANDOFF)
-    assert cell.simulation().run().end_time_ns == 48_903_006_229
+    assert cell.simulation().run().end_time_ns == 46_497_702_586
     sim = cell.simulation()
     sim.run_until(10)
     early = sim.result()

@@ -745,8 +745,9 @@ fn plan_cartesian(
     let ramp = jerk_ramp_time(model);
     // The profile's limits along the path (per unit of its fraction) at TCP speed `v`
     // and acceleration `a`, orientation speed `w`.
-    let limits = |v: f64, a: f64, w: f64| {
-        let wa = w / vworks_model::model::DEFAULT_ACCEL_TIME;
+    // The orientation's acceleration: none of its own (the wrist axes bound it, as the
+    // TCP's), but with a `duration`, where speed and acceleration scale together.
+    let limits = |v: f64, a: f64, w: f64, wa: f64| {
         let (mut vs, mut as_, mut js) = (f64::INFINITY, f64::INFINITY, f64::INFINITY);
         // Below 0.1 µm and 0.1 µrad a move is a rounding error, not a motion.
         if len > 1e-7 {
@@ -777,7 +778,7 @@ fn plan_cartesian(
         };
         let lasts = |k: f64| {
             let (v, a, w) = at(k);
-            let (vs, as_, js) = limits(v, a, w);
+            let (vs, as_, js) = limits(v, a, w, w / vworks_model::model::DEFAULT_ACCEL_TIME);
             Profile::with_jerk(1.0, vs, as_, js).duration_ns()
         };
         let k = slowest_within(t, 1e-12, 1.0, lasts);
@@ -788,7 +789,12 @@ fn plan_cartesian(
             "at 7 m/s and 500°/s, the fastest TCP and orientation speeds",
         );
     }
-    let (vs, as_, js) = limits(v, a, w);
+    let wa = if duration_ns.is_some() {
+        w / vworks_model::model::DEFAULT_ACCEL_TIME
+    } else {
+        f64::INFINITY
+    };
+    let (vs, as_, js) = limits(v, a, w, wa);
     if !vs.is_finite() {
         let traj = Trajectory::Cartesian {
             path,
