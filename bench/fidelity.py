@@ -30,8 +30,8 @@ For each built-in 6-axis arm (irb120, kr6r900, lrmate200id, ur5) and N random ca
    closer than L/4000 in s are dropped, as at the ends, where the TCP is at rest), plus a
    virtual 7th joint equal to s. Constraints (toppra JointVelocityConstraint and
    JointAccelerationConstraint, interpolation scheme, 801 gridpoints): each axis's URDF
-   velocity limit and acceleration limit (none of the built-in URDFs gives one, so
-   velocity / 0.3 s where a URDF gives none, docs/models.md), and for s the programmed TCP
+   velocity limit and acceleration limit (velocity / 0.3 s where a URDF gives none;
+   the built-in arms give theirs, docs/models.md), and for s the programmed TCP
    speed V (at most the model's `<tcp_limits speed>`) and the model's TCP acceleration
    (`<tcp_limits acceleration>`; none where the model gives none: the axes alone bound the
    path, as vworks does; `tcp_accel_ratio` in the JSON is the recorded peak TCP

@@ -635,26 +635,57 @@ fn attribute<'t>(tag: &'t str, key: &str) -> Option<&'t str> {
 /// The model's TCP limits: the attributes of a `<tcp_limits>` element (a vworks extension
 /// other URDF readers ignore), each positive and finite.
 fn tcp_limits(stripped: &str, file: &str) -> Result<TcpLimits, ModelError> {
-    let Some(at) = stripped.find("<tcp_limits") else {
+    let bad = |message: String, help: &str| ModelError::Invalid {
+        problem: UrdfProblem::BadDynamicLimit,
+        file: file.to_string(),
+        element: "tcp_limits".into(),
+        message,
+        help: help.to_string(),
+    };
+    // Elements named exactly `tcp_limits` (not `<tcp_limits_note …>`).
+    let mut tags = stripped.match_indices("<tcp_limits").filter_map(|(at, _)| {
+        let rest = &stripped[at + "<tcp_limits".len()..];
+        rest.starts_with(|c: char| c.is_whitespace() || c == '/' || c == '>')
+            .then(|| &rest[..rest.find('>').unwrap_or(rest.len())])
+    });
+    let Some(tag) = tags.next() else {
         return Ok(TcpLimits::default());
     };
-    let tag = &stripped[at..];
-    let tag = &tag[..tag.find('>').unwrap_or(tag.len())];
+    if tags.next().is_some() {
+        return Err(bad(
+            "is given twice".into(),
+            "give the robot one <tcp_limits speed=\"…\" acceleration=\"…\"/>",
+        ));
+    }
+    // Every attribute is one vworks knows.
+    let mut rest = tag.trim_start();
+    while let Some(eq) = rest.find('=') {
+        let key = rest[..eq].trim();
+        if !key.is_empty() && key != "speed" && key != "acceleration" {
+            return Err(bad(
+                format!("has an attribute `{key}` vworks does not know"),
+                "write speed=\"…\" (m/s) and acceleration=\"…\" (m/s²)",
+            ));
+        }
+        let after = rest[eq + 1..].trim_start();
+        let Some(q) = after.chars().next().filter(|c| *c == '"' || *c == '\'') else {
+            break;
+        };
+        let Some(close) = after[1..].find(q) else {
+            break;
+        };
+        rest = &after[close + 2..];
+    }
     let value = |key: &str, unit: &str| -> Result<Option<f64>, ModelError> {
         let Some(text) = attribute(tag, key) else {
             return Ok(None);
         };
         match text.trim().parse::<f64>() {
             Ok(v) if v.is_finite() && v > 0.0 => Ok(Some(v)),
-            _ => Err(ModelError::Invalid {
-                problem: UrdfProblem::BadDynamicLimit,
-                file: file.to_string(),
-                element: "tcp_limits".into(),
-                message: format!("its {key} is `{text}`"),
-                help: format!(
-                    "write {key}=\"…\" as a number of {unit} greater than 0, or leave it out"
-                ),
-            }),
+            _ => Err(bad(
+                format!("its {key} is `{text}`"),
+                &format!("write {key}=\"…\" as a number of {unit} greater than 0, or leave it out"),
+            )),
         }
     };
     Ok(TcpLimits {

@@ -83,9 +83,13 @@ fn a_urdf_gives_either_tcp_limit_or_both_or_none() {
             accel: Some(12.0)
         }
     );
-    // In a comment it is not there.
+    // In a comment it is not there; nor is an element whose name only starts the same.
     assert_eq!(
         load(r#"<!-- <tcp_limits speed="1.5"/> -->"#).unwrap(),
+        TcpLimits::default()
+    );
+    assert_eq!(
+        load(r#"<tcp_limits_note speed="0.5"/>"#).unwrap(),
         TcpLimits::default()
     );
 }
@@ -97,6 +101,11 @@ fn tcp_limits_that_are_not_positive_numbers_are_errors_naming_the_attribute() {
         (r#"<tcp_limits speed="fast"/>"#, "speed"),
         (r#"<tcp_limits acceleration="-3"/>"#, "acceleration"),
         (r#"<tcp_limits acceleration="inf"/>"#, "acceleration"),
+        (r#"<tcp_limits speed="1" accel="0.5"/>"#, "`accel`"),
+        (
+            r#"<tcp_limits speed="1"/><tcp_limits speed="0.5"/>"#,
+            "twice",
+        ),
     ] {
         let e = load(tcp).unwrap_err();
         let ModelError::Invalid {

@@ -198,6 +198,11 @@ fn step_lines(path: &JointPath, lim: &Limits<'_>, k: usize, out: &mut [Line]) ->
 /// a pair of lines, whose root is at or right of h's); [`largest_x_by_pairs`], every
 /// pair of a lower and an upper bound, is the fallback.
 fn largest_x(lines: &[Line]) -> f64 {
+    largest_x_by_newton(lines).unwrap_or_else(|| largest_x_by_pairs(lines))
+}
+
+/// [`largest_x`] by Newton's method; `None` where it does not settle (then every pair).
+fn largest_x_by_newton(lines: &[Line]) -> Option<f64> {
     // Lines without u bound x alone.
     let mut right = f64::INFINITY;
     for l in lines.iter().filter(|l| l.a == 0.0) {
@@ -206,7 +211,7 @@ fn largest_x(lines: &[Line]) -> f64 {
         }
     }
     if !right.is_finite() {
-        return largest_x_by_pairs(lines);
+        return None;
     }
     // The tightest lower (a < 0) and upper (a > 0) bound on u at x.
     let active = |x: f64| {
@@ -228,7 +233,7 @@ fn largest_x(lines: &[Line]) -> f64 {
     for _ in 0..NEWTON_STEPS {
         let (room, lo, hi) = active(x);
         if room >= 0.0 {
-            return x;
+            return Some(x);
         }
         let (Some(lo), Some(hi)) = (lo, hi) else {
             break;
@@ -241,11 +246,11 @@ fn largest_x(lines: &[Line]) -> f64 {
         }
         let next = (g0 / -g1).max(0.0);
         if next >= x {
-            return x.min(next);
+            return Some(x.min(next));
         }
         x = next;
     }
-    largest_x_by_pairs(lines)
+    None
 }
 
 /// Passes of [`largest_x`]'s Newton method before it falls back to every pair.

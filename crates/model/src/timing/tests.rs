@@ -340,9 +340,9 @@ fn bad_limits_are_errors() {
     ));
 }
 
-/// Newton's method on the room for u finds what every pair of bounds finds: on the lines
-/// of real steps (random paths through the feasible region) and on random line sets that
-/// rest satisfies.
+/// Newton's method on the room for u finds what every pair of bounds finds, without
+/// falling back to the pairs, on random line sets that rest satisfies (and, through the
+/// timings of the other tests, on the lines of real steps).
 #[test]
 fn newton_finds_the_largest_x_every_pair_finds() {
     let mut seed = 0x2545_f491_4f6c_dd1du64;
@@ -352,7 +352,6 @@ fn newton_finds_the_largest_x_every_pair_finds() {
         seed ^= seed << 17;
         (seed >> 11) as f64 / (1u64 << 53) as f64
     };
-    let mut compared = 0;
     for _ in 0..2000 {
         let m = 3 + (next() * 30.0) as usize;
         let mut lines = Vec::with_capacity(m + 2);
@@ -369,12 +368,11 @@ fn newton_finds_the_largest_x_every_pair_finds() {
             b: 1.0,
             c: 0.5 + next() * 10.0,
         });
-        let (newton, pairs) = (largest_x(&lines), largest_x_by_pairs(&lines));
+        let newton = largest_x_by_newton(&lines).expect("Newton's method settles");
+        let pairs = largest_x_by_pairs(&lines);
         assert!(
             (newton - pairs).abs() <= 1e-12 * pairs.max(1.0),
             "{newton} vs {pairs}: {lines:?}"
         );
-        compared += 1;
     }
-    assert_eq!(compared, 2000);
 }

@@ -95,7 +95,7 @@ pub(super) fn sample_path(
     tool: &Iso,
     (path, start, goal, from): (&Path, &Iso, &Iso, &[f64; MAX_AXES]),
     branch: Option<u8>,
-    (profile, vs, js): (&Profile, f64, f64),
+    (profile, vs, ramp): (&Profile, f64, f64),
 ) -> Result<PathSamples, PlanError> {
     let n = model.dof();
     let mut joints = JointPath::new(n);
@@ -188,7 +188,7 @@ pub(super) fn sample_path(
     let lower = lower_profile(
         &joints,
         profile,
-        (vs, js),
+        (vs, ramp),
         limits_of,
         &mut inner,
         &joints_at,
@@ -196,9 +196,11 @@ pub(super) fn sample_path(
     // No timing beats the programmed profile (nor, without an acceleration, cruising at
     // the programmed speed all the way): a trapezoid this close to it is kept without
     // the time-optimal timing.
+    // With jerk limits the trapezoid's S-curve is kept wherever it fits (the time-optimal
+    // timing keeps speeds and accelerations, not jerks).
     if let Some((lower, check)) = &lower {
         let bound = if bounded { profile.t_total } else { 1.0 / vs };
-        if lower.t_total <= bound * (1.0 + NEAR_OPTIMAL) {
+        if ramp > 0.0 || lower.t_total <= bound * (1.0 + NEAR_OPTIMAL) {
             return Ok(profile_samples(&joints, lower, check, Some(*lower), end));
         }
     }
@@ -432,7 +434,7 @@ const LOWER_ROUNDS: usize = 24;
 fn lower_profile(
     joints: &JointPath,
     profile: &Profile,
-    (vs, js): (f64, f64),
+    (vs, ramp): (f64, f64),
     limits: (&[f64], &[f64]),
     inner: &mut Inner,
     joints_at: &impl Fn(f64, &[f64; MAX_AXES]) -> Result<[f64; MAX_AXES], PlanError>,
@@ -449,23 +451,21 @@ fn lower_profile(
     if !hi.is_finite() || hi <= 0.0 {
         return Ok(None);
     }
-    // The jerk ramp keeps its time (a / j).
+    // With jerk limits, the jerk ramps as long as the slowest axis's does (a / j = ramp).
     let shaped = |a: f64| {
-        let j = if js.is_finite() && profile.a.is_finite() {
-            js * a / profile.a
-        } else {
-            f64::INFINITY
-        };
+        let j = if ramp > 0.0 { a / ramp } else { f64::INFINITY };
         Profile::with_jerk(1.0, vs, a, j)
     };
     // Bisection on the knots alone (cheap: no IK), then the full check between them; where
     // that finds an axis past a limit, a little lower.
+    let derivatives = knot_derivatives(joints);
+    let fits = |a: f64| fits_at_knots(&derivatives, joints.axes, &shaped(a), limits);
     let mut a = hi;
-    if !fits_at_knots(joints, &shaped(hi), limits) {
+    if !fits(hi) {
         let mut lo = 0.0;
         for _ in 0..LOWER_ROUNDS {
             let mid = 0.5 * (lo + a);
-            if fits_at_knots(joints, &shaped(mid), limits) {
+            if fits(mid) {
                 lo = mid;
             } else {
                 a = mid;
@@ -487,13 +487,30 @@ fn lower_profile(
     Ok(None)
 }
 
+/// Every axis's (q′, q″) at every knot, computed once for the bisection.
+type KnotDerivatives = [[(f64, f64); MAX_AXES]; KNOTS];
+
+fn knot_derivatives(joints: &JointPath) -> KnotDerivatives {
+    let mut out = [[(0.0, 0.0); MAX_AXES]; KNOTS];
+    for (k, row) in out.iter_mut().enumerate() {
+        for (i, d) in row.iter_mut().enumerate().take(joints.axes) {
+            *d = joints.derivatives(k, i);
+        }
+    }
+    out
+}
+
 /// Whether every axis keeps its speed and acceleration under `profile` at every knot.
-fn fits_at_knots(joints: &JointPath, profile: &Profile, (speed, accel): (&[f64], &[f64])) -> bool {
-    (0..KNOTS).all(|k| {
+fn fits_at_knots(
+    derivatives: &KnotDerivatives,
+    axes: usize,
+    profile: &Profile,
+    (speed, accel): (&[f64], &[f64]),
+) -> bool {
+    derivatives.iter().enumerate().all(|(k, row)| {
         let s = k as f64 / SEGMENTS as f64;
         let (v_path, a_path) = state_at_distance(profile, s * profile.dist);
-        (0..joints.axes).all(|i| {
-            let (d1, d2) = joints.derivatives(k, i);
+        row[..axes].iter().enumerate().all(|(i, &(d1, d2))| {
             let v = (d1 * v_path).abs();
             let a = (d1 * a_path + d2 * v_path * v_path).abs();
             v <= speed[i] * (1.0 + JOINT_SPEED_TOLERANCE)

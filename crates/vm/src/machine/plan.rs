@@ -736,7 +736,8 @@ fn plan_cartesian(
     let angle = vworks_model::math::norm(vworks_model::math::rotation_vector(
         &vworks_model::math::mat_mul(&vworks_model::math::transpose(&start.r), &goal.r),
     ));
-    // Orientation moves at most `orient` (180°/s without it), with the same ramp time.
+    // Orientation moves at most `orient` (180°/s without it), as fast as the axes let it
+    // accelerate (with a `duration`, in 0.3 s).
     let mut w = orient.unwrap_or(std::f64::consts::PI);
     if w.is_nan() || w <= 0.0 {
         return Err(PlanError::Orient(w));
@@ -786,7 +787,7 @@ fn plan_cartesian(
         longer = longer_than(
             lasts(k),
             t,
-            "at 7 m/s and 500°/s, the fastest TCP and orientation speeds",
+            "at the fastest TCP speed (7 m/s, or the model's TCP speed) and orientation speed (500°/s)",
         );
     }
     let wa = if duration_ns.is_some() {
@@ -839,7 +840,7 @@ fn plan_cartesian(
     let branch = model.ik_branch(&start.mul(&tool.inverse()), &start_joints[..n]);
     let sampled = memo.get_or_sample(key, || {
         let ends = (&path, &start, &goal, &start_joints);
-        sample_path(model, &tool, ends, branch, (&profile, vs, js))
+        sample_path(model, &tool, ends, branch, (&profile, vs, ramp))
     })?;
     let PathSamples {
         seeds,
