@@ -290,8 +290,11 @@ pub(super) fn sample_path(
             axis_speed: &no_speed[..n],
             ..limits
         };
-        let would = Timing::optimal(&joints, &unbound).map_or(0.0, |t| t.duration());
-        (timing.duration() > would * (1.0 + 1e-9)).then_some(would)
+        // (Without a timing to compare with, no warning.)
+        Timing::optimal(&joints, &unbound)
+            .ok()
+            .map(|t| t.duration())
+            .filter(|would| timing.duration() > would * (1.0 + 1e-9))
     };
     Ok(PathSamples {
         seeds: seeds_of(&joints),
@@ -473,6 +476,7 @@ fn lower_profile(
         }
         a = lo;
     }
+    let mut failed = None;
     for _ in 0..LOWER_RETRIES {
         if a <= 0.0 {
             break;
@@ -480,8 +484,25 @@ fn lower_profile(
         let p = shaped(a);
         let check = check_profile(joints, &p, limits, inner, joints_at)?;
         if check.fits {
-            return Ok(Some((p, check)));
+            // Between this one and the last that failed, the highest that passes.
+            let mut best = (p, check);
+            if let Some(mut hi) = failed {
+                let mut lo = a;
+                for _ in 0..LOWER_REFINE {
+                    let mid = 0.5 * (lo + hi);
+                    let p = shaped(mid);
+                    let check = check_profile(joints, &p, limits, inner, joints_at)?;
+                    if check.fits {
+                        lo = mid;
+                        best = (p, check);
+                    } else {
+                        hi = mid;
+                    }
+                }
+            }
+            return Ok(Some(best));
         }
+        failed = Some(a);
         a *= LOWER_STEP;
     }
     Ok(None)
@@ -523,6 +544,8 @@ fn fits_at_knots(
 /// [`LOWER_STEP`] of the last.
 const LOWER_RETRIES: usize = 6;
 const LOWER_STEP: f64 = 0.97;
+/// Halvings between the last step that failed and the first that passed: to 2⁻⁸ of a step.
+const LOWER_REFINE: usize = 8;
 
 /// Knots kept as IK seeds for the executed path: every 16th (0, 16, …, 256).
 pub(super) const SEEDS: usize = SEGMENTS / 16 + 1;
