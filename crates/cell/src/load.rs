@@ -184,32 +184,24 @@ pub(crate) fn load_parsed(
             }
             // The TCP's limits, replacing the model's (a payload, a process, a safety
             // configuration can lower them).
-            let tcp_keys = [
-                (
-                    &r.tcp_speed,
-                    "tcp_speed",
-                    Dim::SPEED,
-                    "\"1500mm/s\" or 1.5 (m/s)",
-                ),
-                (
-                    &r.tcp_acceleration,
-                    "tcp_acceleration",
-                    Dim::ACCEL,
-                    "\"5m/s2\" or 5 (m/s²)",
-                ),
-            ];
-            for (k, (value, name, dim, hint)) in tcp_keys.into_iter().enumerate() {
-                let Some(value) = value else { continue };
+            let tcp_limit = |value: &Option<toml::Value>, name: &str, dim, hint: &str| {
+                let Some(value) = value else { return Ok(None) };
                 let at = format!("{key}.{name}");
                 let x = cx.quantity(value, dim, &at)?;
-                if !(x.is_finite() && x > 0.0) {
-                    return Err(cx.bad(&at, format!("must be greater than 0; write {hint}")));
-                }
-                if k == 0 {
-                    model.tcp.speed = Some(x);
+                if x.is_finite() && x > 0.0 {
+                    Ok(Some(x))
                 } else {
-                    model.tcp.accel = Some(x);
+                    Err(cx.bad(&at, format!("must be greater than 0; write {hint}")))
                 }
+            };
+            let speed = "\"1500mm/s\" or 1.5 (m/s)";
+            if let Some(v) = tcp_limit(&r.tcp_speed, "tcp_speed", Dim::SPEED, speed)? {
+                model.tcp.speed = Some(v);
+            }
+            let accel = "\"5m/s2\" or 5 (m/s²)";
+            if let Some(a) = tcp_limit(&r.tcp_acceleration, "tcp_acceleration", Dim::ACCEL, accel)?
+            {
+                model.tcp.accel = Some(a);
             }
             let urdf = r.urdf.as_ref().and_then(|u| {
                 let upath = dir.join(u).display().to_string();

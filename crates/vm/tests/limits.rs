@@ -158,6 +158,11 @@ fn offset() -> impl Strategy<Value = [f64; 3]> {
     prop::array::uniform3(-250.0f64..250.0)
 }
 
+/// The TCP speeds the motions are programmed at (mm/s).
+fn tcp_speed() -> impl Strategy<Value = f64> {
+    prop::sample::select(vec![100.0, 500.0, 1000.0, 2000.0, 4000.0])
+}
+
 proptest! {
     // 40 motions that run per arm; at most 40 refused on the way (out of reach, a
     // singularity), so that the property is never checked on too few.
@@ -172,7 +177,7 @@ proptest! {
     #[test]
     fn irb120_motions_keep_every_axis_within_its_limits(
         j in jitter(), o in offset(), side in -1.0f64..1.0, kind in 0u8..3,
-        speed in prop::sample::select(vec![100.0, 500.0, 1000.0, 2000.0, 4000.0]),
+        speed in tcp_speed(),
     ) {
         prop_assume!(check("irb120", j, o, side, kind, speed));
     }
@@ -180,7 +185,7 @@ proptest! {
     #[test]
     fn kr6r900_motions_keep_every_axis_within_its_limits(
         j in jitter(), o in offset(), side in -1.0f64..1.0, kind in 0u8..3,
-        speed in prop::sample::select(vec![100.0, 500.0, 1000.0, 2000.0, 4000.0]),
+        speed in tcp_speed(),
     ) {
         prop_assume!(check("kr6r900", j, o, side, kind, speed));
     }
@@ -188,7 +193,7 @@ proptest! {
     #[test]
     fn lrmate200id_motions_keep_every_axis_within_its_limits(
         j in jitter(), o in offset(), side in -1.0f64..1.0, kind in 0u8..3,
-        speed in prop::sample::select(vec![100.0, 500.0, 1000.0, 2000.0, 4000.0]),
+        speed in tcp_speed(),
     ) {
         prop_assume!(check("lrmate200id", j, o, side, kind, speed));
     }
@@ -196,7 +201,7 @@ proptest! {
     #[test]
     fn ur5_motions_keep_every_axis_within_its_limits(
         j in jitter(), o in offset(), side in -1.0f64..1.0, kind in 0u8..3,
-        speed in prop::sample::select(vec![100.0, 500.0, 1000.0, 2000.0, 4000.0]),
+        speed in tcp_speed(),
     ) {
         prop_assume!(check("ur5", j, o, side, kind, speed));
     }

@@ -39,7 +39,7 @@ pub struct JointPath {
     /// [`Timing::slower`] for the last resort).
     pub room: [f64; SEGMENTS],
     /// Per end (start, end) and axis, the steepest `q'` found close to it (by the caller,
-    /// e.g. from points 1/64 of a step in): where a path starts or ends near a singularity
+    /// e.g. from points 1/4 to 1/4096 of a step in): where a path starts or ends near a singularity
     /// its slope there is steeper than the knots show. 0 where not known.
     pub end_slopes: [[f64; MAX_AXES]; 2],
 }
@@ -203,13 +203,7 @@ fn largest_x(lines: &[Line]) -> f64 {
 
 /// [`largest_x`] by Newton's method; `None` where it does not settle (then every pair).
 fn largest_x_by_newton(lines: &[Line]) -> Option<f64> {
-    // Lines without u bound x alone.
-    let mut right = f64::INFINITY;
-    for l in lines.iter().filter(|l| l.a == 0.0) {
-        if l.b > 0.0 {
-            right = right.min(l.c / l.b);
-        }
-    }
+    let right = x_bound(lines);
     if !right.is_finite() {
         return None;
     }
@@ -253,18 +247,21 @@ fn largest_x_by_newton(lines: &[Line]) -> Option<f64> {
     None
 }
 
+/// The bound the lines without u put on x alone (`f64::INFINITY` if none does).
+fn x_bound(lines: &[Line]) -> f64 {
+    lines
+        .iter()
+        .filter(|l| l.a == 0.0 && l.b > 0.0)
+        .map(|l| l.c / l.b)
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// Passes of [`largest_x`]'s Newton method before it falls back to every pair.
 const NEWTON_STEPS: usize = 64;
 
 /// [`largest_x`] by every pair of a lower and an upper bound on u.
 fn largest_x_by_pairs(lines: &[Line]) -> f64 {
-    let mut best = f64::INFINITY;
-    // Lines without u bound x alone.
-    for l in lines.iter().filter(|l| l.a == 0.0) {
-        if l.b > 0.0 {
-            best = best.min(l.c / l.b);
-        }
-    }
+    let mut best = x_bound(lines);
     // A lower bound on u (a < 0) against an upper one (a > 0): u ≥ (c₁ − b₁x)/a₁ and
     // u ≤ (c₂ − b₂x)/a₂ meet where their difference, linear in x, turns negative.
     for lo in lines.iter().filter(|l| l.a < 0.0) {

@@ -86,10 +86,11 @@ impl PathMemo {
 /// Samples a Cartesian path at the timing's [`KNOTS`] from joints `from` (each knot's IK
 /// seeded from the one before, on the analytic `branch` the motion executes on, if the arm
 /// has one): every point reachable (or the error, naming where), no axis jumping to
-/// another configuration between two knots. Then
-/// checks `profile` (the path fraction against time) against every axis's speed and
-/// acceleration at the knots; if an axis would exceed one, the path's time-optimal
-/// timing within the axis limits and the profile's own speed and acceleration.
+/// another configuration between two knots. Then checks `profile` (the path fraction
+/// against time; top speed `vs`, jerk ramp `ramp` s) against every axis's speed and
+/// acceleration; if an axis would exceed one, the faster of the same profile at a lower
+/// acceleration and the path's time-optimal timing within the axis limits and the
+/// profile's own speed and acceleration.
 pub(super) fn sample_path(
     model: &RobotModel,
     tool: &Iso,
@@ -169,13 +170,21 @@ pub(super) fn sample_path(
         accel[i] = j.max_accel;
     }
     let end = joints.q[SEGMENTS];
+    let derivatives = knot_derivatives(&joints);
     let mut inner = Inner::new();
     let limits_of = (&speed[..n], &accel[..n]);
     // Without an acceleration of its own (no `accel`, no TCP limit in the model) the path
     // accelerates as fast as its axes let it: never the programmed profile as it is.
     let bounded = profile.a.is_finite();
     if bounded {
-        let check = check_profile(&joints, profile, limits_of, &mut inner, &joints_at)?;
+        let check = check_profile(
+            &joints,
+            &derivatives,
+            profile,
+            limits_of,
+            &mut inner,
+            &joints_at,
+        )?;
         if check.fits {
             return Ok(profile_samples(&joints, profile, &check, None, end));
         }
@@ -187,6 +196,7 @@ pub(super) fn sample_path(
     // whole ramp lies within one step. The faster of the two is the motion's.
     let lower = lower_profile(
         &joints,
+        &derivatives,
         profile,
         (vs, ramp),
         limits_of,
@@ -241,7 +251,7 @@ pub(super) fn sample_path(
             let x1 = x + 2.0 * u / SEGMENTS as f64;
             *flag = [(k, x), (k + 1, x1)].iter().any(|&(knot, x)| {
                 (0..n).any(|i| {
-                    let (d1, d2) = joints.derivatives(knot, i);
+                    let (d1, d2) = derivatives[knot][i];
                     let v = (d1 * x.max(0.0).sqrt()).abs() / speed[i];
                     let a = (d1 * u + d2 * x).abs() / accel[i];
                     v.max(a) > NEAR_LIMIT
@@ -268,20 +278,20 @@ pub(super) fn sample_path(
         }
         timing = optimal(&joints)?;
     }
-    // ṡ² is linear in s within a step: ṡ is largest at one of its ends.
-    let mut step_speed = [0.0f64; SEGMENTS];
-    for (k, v) in step_speed.iter_mut().enumerate() {
-        *v = timing.speed_at_knot(k).max(timing.speed_at_knot(k + 1));
-    }
     if let Some((lower, check)) = lower
         && lower.t_total <= timing.duration()
     {
         return Ok(profile_samples(&joints, &lower, &check, Some(lower), end));
     }
+    // ṡ² is linear in s within a step: ṡ is largest at one of its ends.
+    let mut step_speed = [0.0f64; SEGMENTS];
+    for (k, v) in step_speed.iter_mut().enumerate() {
+        *v = timing.speed_at_knot(k).max(timing.speed_at_knot(k + 1));
+    }
     // Slowed: where an axis's speed keeps the TCP below its programmed speed (the axes'
     // accelerations are the path's own dynamics, as on a controller), against the same
     // timing without the axis speeds.
-    let (worst_axis, nearest) = fastest_axis(&joints, &timing, &speed[..n]);
+    let (worst_axis, nearest) = fastest_axis(&derivatives, &timing, &speed[..n]);
     let unslowed = if nearest < SPEED_BINDS {
         None
     } else {
@@ -313,12 +323,12 @@ const SPEED_BINDS: f64 = 0.99;
 
 /// The axis that comes nearest its speed limit at a knot under `timing`, and how near
 /// (its fraction of the limit).
-fn fastest_axis(joints: &JointPath, timing: &Timing, speed: &[f64]) -> (usize, f64) {
+fn fastest_axis(derivatives: &KnotDerivatives, timing: &Timing, speed: &[f64]) -> (usize, f64) {
     let (mut best, mut axis) = (0.0f64, 0);
-    for k in 0..KNOTS {
+    for (k, row) in derivatives.iter().enumerate() {
         let sd = timing.speed_at_knot(k);
         for (i, v) in speed.iter().enumerate() {
-            let r = (joints.derivatives(k, i).0 * sd).abs() / v;
+            let r = (row[i].0 * sd).abs() / v;
             if r > best {
                 (best, axis) = (r, i);
             }
@@ -343,6 +353,7 @@ struct ProfileCheck {
 /// [`NEAR_LIMIT`] of a limit there, at the quarter points of the steps around.
 fn check_profile(
     joints: &JointPath,
+    derivatives: &KnotDerivatives,
     profile: &Profile,
     (speed, accel): (&[f64], &[f64]),
     inner: &mut Inner,
@@ -357,9 +368,7 @@ fn check_profile(
         let (v_path, a_path) = state_at_distance(profile, s * profile.dist);
         *sd_k = v_path;
         for i in 0..joints.axes {
-            let (d1, d2) = joints.derivatives(k, i);
-            let v = (d1 * v_path).abs();
-            let a = (d1 * a_path + d2 * v_path * v_path).abs();
+            let (v, a) = axis_load(derivatives[k][i], v_path, a_path);
             let ratio = (speed[i] / v).min(accel[i] / a);
             if ratio < worst {
                 worst = ratio;
@@ -436,6 +445,7 @@ const LOWER_ROUNDS: usize = 24;
 /// bisection; `None` if even a tiny one does not (an axis's speed binds at cruise).
 fn lower_profile(
     joints: &JointPath,
+    derivatives: &KnotDerivatives,
     profile: &Profile,
     (vs, ramp): (f64, f64),
     limits: (&[f64], &[f64]),
@@ -461,8 +471,7 @@ fn lower_profile(
     };
     // Bisection on the knots alone (cheap: no IK), then the full check between them; where
     // that finds an axis past a limit, a little lower.
-    let derivatives = knot_derivatives(joints);
-    let fits = |a: f64| fits_at_knots(&derivatives, joints.axes, &shaped(a), limits);
+    let fits = |a: f64| fits_at_knots(derivatives, joints.axes, &shaped(a), limits);
     let mut a = hi;
     if !fits(hi) {
         let mut lo = 0.0;
@@ -482,7 +491,7 @@ fn lower_profile(
             break;
         }
         let p = shaped(a);
-        let check = check_profile(joints, &p, limits, inner, joints_at)?;
+        let check = check_profile(joints, derivatives, &p, limits, inner, joints_at)?;
         if check.fits {
             // Between this one and the last that failed, the highest that passes.
             let mut best = (p, check);
@@ -491,7 +500,7 @@ fn lower_profile(
                 for _ in 0..LOWER_REFINE {
                     let mid = 0.5 * (lo + hi);
                     let p = shaped(mid);
-                    let check = check_profile(joints, &p, limits, inner, joints_at)?;
+                    let check = check_profile(joints, derivatives, &p, limits, inner, joints_at)?;
                     if check.fits {
                         lo = mid;
                         best = (p, check);
@@ -508,7 +517,8 @@ fn lower_profile(
     Ok(None)
 }
 
-/// Every axis's (q′, q″) at every knot, computed once for the bisection.
+/// Every axis's (q′, q″) at every knot ([`JointPath::derivatives`]), computed once per
+/// sampled path.
 type KnotDerivatives = [[(f64, f64); MAX_AXES]; KNOTS];
 
 fn knot_derivatives(joints: &JointPath) -> KnotDerivatives {
@@ -531,13 +541,18 @@ fn fits_at_knots(
     derivatives.iter().enumerate().all(|(k, row)| {
         let s = k as f64 / SEGMENTS as f64;
         let (v_path, a_path) = state_at_distance(profile, s * profile.dist);
-        row[..axes].iter().enumerate().all(|(i, &(d1, d2))| {
-            let v = (d1 * v_path).abs();
-            let a = (d1 * a_path + d2 * v_path * v_path).abs();
+        row[..axes].iter().enumerate().all(|(i, &d)| {
+            let (v, a) = axis_load(d, v_path, a_path);
             v <= speed[i] * (1.0 + JOINT_SPEED_TOLERANCE)
                 && a <= accel[i] * (1.0 + JOINT_SPEED_TOLERANCE)
         })
     })
+}
+
+/// An axis's speed and acceleration (magnitudes) where its path derivatives are `(q′, q″)`
+/// and the path moves at `ṡ`, accelerating at `s̈`: q′·ṡ and q′·s̈ + q″·ṡ².
+fn axis_load((d1, d2): (f64, f64), sd: f64, sdd: f64) -> (f64, f64) {
+    ((d1 * sd).abs(), (d1 * sdd + d2 * sd * sd).abs())
 }
 
 /// Tries of [`lower_profile`] when the check between the knots fails, each
