@@ -25,6 +25,7 @@ pub mod exec;
 pub mod machine;
 pub mod math;
 pub mod motion;
+pub mod ramps;
 pub mod types;
 
 pub use bytecode::{Instr, LoadError, Module};

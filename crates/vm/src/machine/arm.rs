@@ -203,8 +203,8 @@ impl Arm {
             default_speed,
         };
         let plan::Plan {
-            traj,
-            duration_ns: point_ns,
+            mut traj,
+            duration_ns: mut point_ns,
             longer,
             slowed,
         } = plan::plan(&self.model, &from, ops, &mut self.memo)?;
@@ -217,15 +217,29 @@ impl Arm {
         // Inside a zoned motion's corner: when this one can start, the radius it blends
         // within, and when the robot would reach that corner's point. **Choice:** a motion
         // with another tool than the zoned one does not blend: it starts at the point.
-        let tool_changed = self
-            .fading_at(time)
-            .is_some_and(|f| f.motion.tool != self.tool);
-        let corner = self.fading_at(time).map(|f| {
-            let (ts, radius) = if tool_changed {
-                (f.end(), 0.0)
-            } else {
-                blend::blend_start(model, &self.tool, time, f, &traj, point_ns)
-            };
+        let tool = self.tool;
+        let fading = self.fading.as_mut().filter(|f| time < f.end());
+        let tool_changed = fading.as_ref().is_some_and(|f| f.motion.tool != tool);
+        let corner = fading.map(|f| {
+            if tool_changed {
+                return (f.end(), 0.0, f.end(), f.pos);
+            }
+            // Two Cartesian motions fly by with ramps and look-ahead where they can;
+            // else the next is superposed on the first as it was planned.
+            if let Some(c) = blend::corner_ramps(model, time, f, &traj) {
+                let (first, next) = blend::with_corner(f, &traj, &c);
+                *f = first;
+                traj = next;
+                point_ns = (traj.path_duration() * NS).ceil() as i64;
+                return (c.start, c.radius, f.end(), f.pos);
+            }
+            // Two lines with ramp profiles turning by more than 60° whose corner with
+            // ramps would be slower than stopping stop: superposed, their ramps would
+            // add up to more than either motion's TCP acceleration.
+            if blend::sharp_ramp_corner(f, &traj) {
+                return (f.end(), 0.0, f.end(), f.pos);
+            }
+            let (ts, radius) = blend::blend_start(model, &tool, time, f, &traj, point_ns);
             (ts, radius, f.end(), f.pos)
         });
         if let Some((ts, _, point, at)) = corner
@@ -239,13 +253,13 @@ impl Arm {
             Some((ts, r, ..)) => (ts, Some(r)),
             None => (time, None),
         };
-        let (mut end_ns, zone) = match programmed {
+        let (mut end_ns, zone, entry_ns) = match programmed {
             // A TCP that does not move (a turntable's, on its axis) enters no zone.
             Some(r) => match blend::zone_entry(model, &self.tool, &self.rest, &traj, point_ns, r) {
-                (_, z) if z <= 1e-9 => (point_ns, 0.0),
+                (_, z, _) if z <= 1e-9 => (point_ns, 0.0, point_ns),
                 entry => entry,
             },
-            None => (point_ns, 0.0),
+            None => (point_ns, 0.0, point_ns),
         };
         // The next corner begins after this one has ended.
         if let Some((_, _, point, _)) = corner {
@@ -256,6 +270,7 @@ impl Arm {
             start,
             end_ns,
             point_ns,
+            entry_ns,
             zone: if end_ns < point_ns { zone } else { 0.0 },
             programmed,
             blend,

@@ -1,10 +1,16 @@
 //! Zones (fly-by points), as a controller makes them.
 //!
-//! - A zoned motion's `motion_end` happens when the TCP enters its zone (`zone_entry`):
-//!   the program runs ahead from there while the robot goes on toward the point (the
-//!   motion becomes [`Fading`]).
-//! - The next motion is planned from the corner as if from rest, and *superposed* on the
-//!   rest of the previous one: `q(t) = q₁(t) + q₂(t − t_s) − corner` in joint space, or
+//! - A zoned motion's `motion_end` happens when the TCP enters its zone (`zone_entry`) or,
+//!   for a line or arc with a trapezoid profile, earlier at its look-ahead point: the
+//!   program runs ahead from there while the robot goes on toward the point (the motion
+//!   becomes [`Fading`]).
+//! - Two lines or arcs with trapezoid profiles fly by with *corner ramps*
+//!   (`corner_ramps`, profiles in `crate::ramps`): the first holds its speed, brakes to the
+//!   corner speed and ramps out over the corner's radius while the next ramps in; their sum
+//!   is a parabola inside the zone at a constant path speed, with the TCP's acceleration
+//!   within both motions'.
+//! - Any other next motion is planned from the corner as if from rest, and *superposed* on
+//!   the rest of the previous one: `q(t) = q₁(t) + q₂(t − t_s) − corner` in joint space, or
 //!   `p(t) = p₁(t) + p₂(t − t_s) − P` (orientation `R₂·R_Pᵀ·R₁`) when both are Cartesian.
 //!   `blend_start` picks the earliest start `t_s` at which the corner stays within the zone
 //!   and the axes within their limits (`docs/engine.md`, "Zones", gives the conditions).
@@ -22,6 +28,7 @@ use super::plan::{JOINT_SPEED_TOLERANCE, Trajectory};
 use crate::MAX_AXES;
 use crate::bytecode::{Instr, SrcPos};
 use crate::motion::{NS, Path, Profile};
+use crate::ramps::Ramps;
 
 /// The rest of a zoned motion after its `motion_end`: the robot goes on along it until
 /// it reaches its point ([`Fading::end`]), and the next motion is superposed on it.
@@ -56,6 +63,9 @@ pub(super) struct Planned {
     pub(super) start: i64,
     pub(super) end_ns: i64,
     pub(super) point_ns: i64,
+    /// When it enters its zone (from its start; `point_ns` without one): its
+    /// `motion_end` is there or, with look-ahead, before.
+    pub(super) entry_ns: i64,
     /// The zone radius its `motion_end` is placed with (0: a stop point).
     pub(super) zone: f64,
     /// The zone as programmed (or the workcell's default); `None`: `fine`.
@@ -124,10 +134,14 @@ pub(super) fn blend_pose(
     }
 }
 
-/// Where a motion of `point_ns` enters the zone of radius `r` around its point: the
-/// time from its start, and the radius used. A Cartesian motion's zone is at most
-/// half its path (`s = 1 − r/L` along it); a joint motion's begins where the TCP comes
-/// within `r` of the point, and not before half its duration.
+/// Where a motion of `point_ns` enters the zone of radius `r` around its point: its
+/// look-ahead point (where its `motion_end` happens), the radius used, and the time it
+/// reaches the zone's boundary, all from its start. A Cartesian motion's zone is at most
+/// half its path (`s = 1 − r/L` along it); one that can fly by with corner ramps
+/// ([`ramp_profile`]) looks ahead from where it would have to begin braking for the
+/// sharpest corner (a reversal: `1 − s = ṡ²/2a + r/2`), if that is before the zone. A
+/// joint motion's zone begins where the TCP comes within `r` of the point, and not
+/// before half its duration.
 pub(super) fn zone_entry(
     model: &RobotModel,
     tool: &Iso,
@@ -135,17 +149,43 @@ pub(super) fn zone_entry(
     traj: &Trajectory,
     point_ns: i64,
     r: f64,
-) -> (i64, f64) {
+) -> (i64, f64, i64) {
     let total = point_ns as f64 / NS;
     let to_ns = |t: f64| ((t * NS).ceil() as i64).clamp(0, point_ns);
     if let Trajectory::Cartesian { path, profile, .. } = traj {
         let len = path.length();
         if len <= 1e-7 || profile.dist <= 0.0 {
-            return (point_ns, 0.0);
+            return (point_ns, 0.0, point_ns);
         }
         let r1 = r.min(0.5 * len);
-        let t = traj.time_at_fraction(1.0 - r1 / len);
-        return (to_ns(t), r1);
+        let boundary = traj.time_at_fraction(1.0 - r1 / len);
+        let Some(ramps) = ramp_profile(traj) else {
+            return (to_ns(boundary), r1, to_ns(boundary));
+        };
+        let (a, rf) = (ramps.accel, r1 / len);
+        let must_brake = |t: f64| {
+            let v = ramps.speed_at(t);
+            // (A millionth of the radius early: braking for a reversal stays feasible
+            // after the decision is rounded up to a whole nanosecond.)
+            1.0 - ramps.at(t) <= v * v / (2.0 * a) + 0.5 * rf * (1.0 + 1e-6)
+        };
+        let (mut lo, mut hi) = (0.0, boundary);
+        if must_brake(hi) {
+            for _ in 0..100 {
+                let mid = 0.5 * (lo + hi);
+                if mid <= lo || mid >= hi {
+                    break;
+                }
+                if must_brake(mid) {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+        }
+        // (Rounded down: the decision is never past the braking point or the zone.)
+        let decision = ((hi.min(boundary) * NS).floor() as i64).clamp(0, point_ns);
+        return (decision, r1, to_ns(boundary));
     }
     let n = model.dof();
     let point = model.tcp(&traj.end_joints()[..n], tool).t;
@@ -160,7 +200,8 @@ pub(super) fn zone_entry(
         // The TCP is within `r` all through the second half, but its distance from
         // the point need not fall all the way: the zone is the farthest it gets.
         let farthest = (0..=STEPS).map(|k| dist(at(k))).fold(0.0, f64::max);
-        return (to_ns(0.5 * total), farthest);
+        let t = to_ns(0.5 * total);
+        return (t, farthest, t);
     };
     let (mut lo, mut hi) = (at(k), at(k + 1));
     for _ in 0..60 {
@@ -171,7 +212,248 @@ pub(super) fn zone_entry(
             hi = mid;
         }
     }
-    (to_ns(hi), r)
+    (to_ns(hi), r, to_ns(hi))
+}
+
+/// The profile of a Cartesian motion that can fly by a corner with ramps (a trapezoid in
+/// path fraction, or one already changed by a corner), as [`Ramps`]; `None` for a
+/// joint motion, a time-optimal timing, an S-curve, a motion given a `duration` (a corner
+/// would change it) or a motion without a path length.
+pub(super) fn ramp_profile(traj: &Trajectory) -> Option<Ramps> {
+    let Trajectory::Cartesian {
+        path,
+        profile,
+        timing: None,
+        ramps,
+        timed: false,
+        ..
+    } = traj
+    else {
+        return None;
+    };
+    if path.length() <= 1e-7 {
+        return None;
+    }
+    if let Some(r) = ramps {
+        return Some(*r);
+    }
+    let usable = profile.dist > 0.0
+        && profile.t_jerk == 0.0
+        && profile.a.is_finite()
+        && profile.a > 0.0
+        && profile.v > 0.0;
+    usable.then(|| Ramps::trapezoid(profile.dist, profile.v, profile.a))
+}
+
+/// A corner flown with ramps: the first motion's profile from now on, the next motion's,
+/// when the next starts (the first enters the corner there) and the corner's radius.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Corner {
+    pub(super) first: Ramps,
+    pub(super) next: Ramps,
+    pub(super) start: i64,
+    pub(super) radius: f64,
+}
+
+/// The corner between the rest of `f` and `next` (both Cartesian, with
+/// [`ramp_profile`]s), decided at `time`, with look-ahead (docs/engine.md, "Zones"):
+/// radius `r ≤ min(zone, L₁/2, L₂/2)`; corner speed
+/// `v_e ≤ min(v₁, v₂, √(2r·a_c), √(2a₂·(L₂ − r)))` with the ramps' deceleration
+/// `a_c = min(a₁, a₂) / (2·sin(θ/2))` for a turn θ between the paths' directions at the
+/// point (the superposed TCP's acceleration `a_c·|u₂ − u₁|` stays within both motions').
+/// Of the radii and speeds tried ([`RADII`], [`SPEEDS`]) the one whose next motion ends
+/// first, if no later than stopping at the point would, and whose samples keep every
+/// axis within its limits ([`ramps_fit`]). `None`: no such corner (the superposition
+/// of [`blend_start`] then).
+pub(super) fn corner_ramps(
+    model: &RobotModel,
+    time: i64,
+    f: &Fading,
+    next: &Trajectory,
+) -> Option<Corner> {
+    let (p1, p2) = (ramp_profile(&f.motion.traj)?, ramp_profile(next)?);
+    let (
+        Trajectory::Cartesian {
+            path: path1,
+            cruise_rates: c1,
+            ..
+        },
+        Trajectory::Cartesian {
+            path: path2,
+            cruise_rates: c2,
+            ..
+        },
+    ) = (&f.motion.traj, next)
+    else {
+        return None;
+    };
+    // Each motion's axes within their speeds at its top speed anywhere on its path.
+    for i in 0..model.dof() {
+        if c1[i].max(c2[i]) > model.axis(i).max_velocity * (1.0 + JOINT_SPEED_TOLERANCE) {
+            return None;
+        }
+    }
+    let (l1, l2) = (path1.length(), path2.length());
+    let zone = f.motion.zone.min(0.5 * l1).min(0.5 * l2);
+    if zone <= 1e-9 {
+        return None;
+    }
+    let (u1, u2) = (path1.tangent(1.0), path2.tangent(0.0));
+    let turn = vworks_model::math::norm(vworks_model::math::sub(u2, u1));
+    let (a1, a2) = (p1.accel * l1, p2.accel * l2);
+    let a_c = if turn > 1e-12 {
+        a1.min(a2) / turn
+    } else {
+        f64::INFINITY
+    };
+    let now = (time - f.motion.start) as f64 / NS;
+    // Stopping at the point: the bound no corner may be slower than.
+    let stop_end = f.end() + (next.path_duration() * NS).ceil() as i64;
+    let mut candidates = [(0i64, 0.0f64, 0.0f64); RADII * SPEEDS];
+    let mut found = 0;
+    for k in 0..RADII {
+        let r = zone / f64::from(1u32 << k);
+        let mut v_e = (p1.top * l1)
+            .min(p2.top * l2)
+            .min((2.0 * r * a_c).sqrt())
+            .min((2.0 * a2 * (l2 - r)).sqrt());
+        for _ in 0..SPEEDS {
+            if let Some(c) = corner_at(&p1, &p2, f, time, now, (l1, l2), r, v_e)
+                && c.start + (c.next.duration() * NS).ceil() as i64 <= stop_end
+            {
+                candidates[found] = (c.start + (c.next.duration() * NS).ceil() as i64, r, v_e);
+                found += 1;
+            }
+            v_e *= 0.8;
+        }
+    }
+    // The fastest corner whose samples keep every axis within its limits.
+    let candidates = &mut candidates[..found];
+    candidates.sort_by(|x, y| x.0.cmp(&y.0).then(y.1.total_cmp(&x.1)));
+    candidates.iter().find_map(|&(_, r, v_e)| {
+        let c = corner_at(&p1, &p2, f, time, now, (l1, l2), r, v_e)?;
+        ramps_fit(model, f, next, &c).then_some(c)
+    })
+}
+
+/// True for two motions that fly by with ramps ([`ramp_profile`]) turning by more than
+/// 60° at the point (`|u₂ − u₁| > 1`): superposed as planned, their braking and
+/// accelerating would add up to more than their TCP acceleration.
+pub(super) fn sharp_ramp_corner(f: &Fading, next: &Trajectory) -> bool {
+    let (Some(_), Some(_)) = (ramp_profile(&f.motion.traj), ramp_profile(next)) else {
+        return false;
+    };
+    let (Trajectory::Cartesian { path: p1, .. }, Trajectory::Cartesian { path: p2, .. }) =
+        (&f.motion.traj, next)
+    else {
+        return false;
+    };
+    vworks_model::math::norm(vworks_model::math::sub(p2.tangent(0.0), p1.tangent(1.0))) > 1.0
+}
+
+/// Corner radii tried (the zone, then halved) and corner speeds at each (from the
+/// fastest the TCP's acceleration allows, 80 % at a time).
+const RADII: usize = 4;
+const SPEEDS: usize = 5;
+
+/// The corner of radius `r` at speed `v_e` (m, m/s) between `f` (profile `p1`, decided
+/// at `time`, `now` seconds into it) and a motion of profile `p2`, if the first can
+/// brake to it and the next reach it.
+#[allow(clippy::too_many_arguments)]
+fn corner_at(
+    p1: &Ramps,
+    p2: &Ramps,
+    f: &Fading,
+    time: i64,
+    now: f64,
+    (l1, l2): (f64, f64),
+    r: f64,
+    v_e: f64,
+) -> Option<Corner> {
+    let first = p1.with_tail(now, r / l1, v_e / l1).ok()?;
+    let next = Ramps::with_head(1.0, p2.top, p2.accel, r / l2, v_e / l2).ok()?;
+    let t_z = first.time_at(1.0 - r / l1);
+    let start = f.motion.start + (t_z * NS).ceil() as i64;
+    (start >= time).then_some(Corner {
+        first,
+        next,
+        start,
+        radius: r,
+    })
+}
+
+/// The two motions with a corner's ramps: `f` from the corner's decision on, and `next`.
+pub(super) fn with_corner(f: &Fading, next: &Trajectory, c: &Corner) -> (Fading, Trajectory) {
+    let mut f = f.clone();
+    set_ramps(&mut f.motion.traj, c.first);
+    f.motion.point_ns = (c.first.duration() * NS).ceil() as i64;
+    let mut next = next.clone();
+    set_ramps(&mut next, c.next);
+    (f, next)
+}
+
+/// A Cartesian trajectory follows `ramps` (its axis speed bound: at its top speed
+/// anywhere, which the ramps never pass).
+fn set_ramps(traj: &mut Trajectory, r: Ramps) {
+    if let Trajectory::Cartesian {
+        ramps,
+        rates,
+        cruise_rates,
+        ..
+    } = traj
+    {
+        *ramps = Some(r);
+        *rates = *cruise_rates;
+    }
+}
+
+/// Samples of a corner flown with ramps, and of the next motion's acceleration after it.
+const RAMP_SAMPLES: usize = 64;
+
+/// The corner `c` sampled at [`RAMP_SAMPLES`] instants through the overlap and as many
+/// through the next motion until it has reached its top speed: every pose reachable,
+/// every axis within its speed (chords) and acceleration (second differences).
+fn ramps_fit(model: &RobotModel, f: &Fading, next: &Trajectory, c: &Corner) -> bool {
+    let (f, next) = with_corner(f, next, c);
+    let n = model.dof();
+    let ts = c.start;
+    // The next motion at its top speed: after its ramp and acceleration phases.
+    let top = c
+        .next
+        .phases()
+        .find(|&(_, _, a)| a <= 0.0)
+        .map_or(c.next.duration(), |(t0, ..)| t0);
+    let spans = [(ts, f.end()), (f.end(), ts + (top * NS).ceil() as i64)];
+    for (from, to) in spans {
+        if to <= from {
+            continue;
+        }
+        let dt = (to - from) as f64 / NS / RAMP_SAMPLES as f64;
+        let mut q = [[0.0; MAX_AXES]; 3];
+        for k in 0..=RAMP_SAMPLES {
+            let t = from + ((to - from) as f64 * k as f64 / RAMP_SAMPLES as f64) as i64;
+            let Some(qk) = blend_joints(model, &f, &next, ts, t) else {
+                return false;
+            };
+            q = [q[1], q[2], qk];
+            let axes = q[0].iter().zip(&q[1]).zip(&q[2]).take(n).enumerate();
+            for (i, ((q0, q1), q2)) in axes {
+                let axis = model.axis(i);
+                if k >= 1
+                    && (q2 - q1).abs() / dt > axis.max_velocity * (1.0 + JOINT_SPEED_TOLERANCE)
+                {
+                    return false;
+                }
+                if k >= 2
+                    && (q2 - 2.0 * q1 + q0).abs() / (dt * dt)
+                        > axis.max_accel * (1.0 + JOINT_SPEED_TOLERANCE)
+                {
+                    return false;
+                }
+            }
+        }
+    }
+    true
 }
 
 /// The earliest start of `next` (lasting `next_ns`, planned from the corner) within
@@ -187,7 +469,8 @@ pub(super) fn blend_start(
     next: &Trajectory,
     next_ns: i64,
 ) -> (i64, f64) {
-    let lo = time.max(f.motion.start);
+    // (From the zone's boundary: a look-ahead point before it only serves corner ramps.)
+    let lo = time.max(f.motion.start + f.motion.entry_ns);
     let hi = f.end();
     if lo >= hi {
         return (hi, 0.0);

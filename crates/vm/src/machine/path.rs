@@ -46,6 +46,9 @@ pub(super) struct PathSamples {
     pub(super) unslowed: Option<f64>,
     pub(super) worst_axis: usize,
     pub(super) rates: [f64; MAX_AXES],
+    /// Per axis, a bound on its speed under any profile no faster than the executed
+    /// one's top speed anywhere (what a corner's ramps may do).
+    pub(super) cruise_rates: [f64; MAX_AXES],
     pub(super) end: [f64; MAX_AXES],
 }
 
@@ -309,6 +312,7 @@ pub(super) fn sample_path(
     Ok(PathSamples {
         seeds: seeds_of(&joints),
         rates: rate_bounds(&joints, &step_speed),
+        cruise_rates: rate_bounds(&joints, &step_speed),
         timing: Some(timing),
         executed: None,
         unslowed,
@@ -427,6 +431,7 @@ fn profile_samples(
         unslowed: None,
         worst_axis: check.worst_axis,
         rates: rate_bounds(joints, &step_speed),
+        cruise_rates: rate_bounds(joints, &[peak; SEGMENTS]),
         end,
     }
 }

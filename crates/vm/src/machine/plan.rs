@@ -14,6 +14,7 @@ use super::{span_ns, to_iso};
 use crate::MAX_AXES;
 use crate::bytecode::{Instr, MoveFlags};
 use crate::motion::{NS, Path, Profile, cartesian_at};
+use crate::ramps::Ramps;
 use crate::types::{Dim, fmt_quantity};
 use vworks_model::timing::{SEGMENTS, Timing};
 
@@ -329,12 +330,19 @@ pub(super) enum Trajectory {
         to: Iso,
         profile: Profile,
         timing: Option<Timing>,
+        /// The profile it follows instead of `profile` once it flies by a corner with
+        /// look-ahead (`blend`): corner ramps at its start, its end or both.
+        ramps: Option<Ramps>,
+        /// It was given a `duration`: a corner never changes how long it takes.
+        timed: bool,
         end_joints: [f64; MAX_AXES],
         /// The analytic IK branch the motion stays on (spherical-wrist arms).
         branch: Option<u8>,
         /// Per axis, the largest speed found at the samples the motion was checked at
         /// (rad/s or m/s).
         rates: [f64; MAX_AXES],
+        /// Per axis, a bound on its speed at the profile's top speed anywhere on the path.
+        cruise_rates: [f64; MAX_AXES],
         /// The joints at every 16th knot of the sampled path: a point's IK starts from the
         /// nearest (the path executed is the path checked).
         seeds: [[f64; MAX_AXES]; SEEDS],
@@ -452,6 +460,7 @@ impl Trajectory {
             Trajectory::Cartesian {
                 timing: Some(t), ..
             } => t.duration(),
+            Trajectory::Cartesian { ramps: Some(r), .. } => r.duration(),
             Trajectory::Cartesian { profile, .. } => profile.t_total,
             _ => 0.0,
         }
@@ -464,6 +473,7 @@ impl Trajectory {
             Trajectory::Cartesian {
                 timing: Some(t), ..
             } => t.at(dt).s,
+            Trajectory::Cartesian { ramps: Some(r), .. } => r.at(dt).min(1.0),
             Trajectory::Cartesian { profile, .. } if profile.dist > 0.0 => {
                 (profile.at(dt) / profile.dist).min(1.0)
             }
@@ -478,6 +488,7 @@ impl Trajectory {
             Trajectory::Cartesian {
                 timing: Some(t), ..
             } => t.at(dt).speed,
+            Trajectory::Cartesian { ramps: Some(r), .. } => r.speed_at(dt),
             Trajectory::Cartesian { profile, .. } if profile.dist > 0.0 => {
                 profile.speed_at(dt) / profile.dist
             }
@@ -492,6 +503,7 @@ impl Trajectory {
             Trajectory::Cartesian {
                 timing: Some(t), ..
             } => t.top_speed(),
+            Trajectory::Cartesian { ramps: Some(r), .. } => r.top,
             Trajectory::Cartesian { profile, .. } if profile.dist > 0.0 => {
                 profile.speed_at(0.5 * profile.t_total) / profile.dist
             }
@@ -505,6 +517,7 @@ impl Trajectory {
             Trajectory::Cartesian {
                 timing: Some(t), ..
             } => t.time_at(s),
+            Trajectory::Cartesian { ramps: Some(r), .. } => r.time_at(s),
             Trajectory::Cartesian { profile, .. } => profile.time_at(s * profile.dist),
             _ => 0.0,
         }
@@ -803,9 +816,12 @@ fn plan_cartesian(
             to: goal,
             profile: Profile::new(0.0, 1.0, 1.0),
             timing: None,
+            ramps: None,
+            timed: duration_ns.is_some(),
             end_joints: start_joints,
             branch: None,
             rates: [0.0; MAX_AXES],
+            cruise_rates: [0.0; MAX_AXES],
             seeds: [start_joints; SEEDS],
             tool,
         };
@@ -849,9 +865,11 @@ fn plan_cartesian(
         unslowed,
         worst_axis,
         rates,
+        cruise_rates,
         end: prev,
     } = sampled;
     let profile = executed.unwrap_or(profile);
+    let timed = duration_ns.is_some();
     let duration_ns = match &timing {
         None => profile.duration_ns(),
         Some(t) => (t.duration() * NS).ceil() as i64,
@@ -868,9 +886,12 @@ fn plan_cartesian(
             to: goal,
             profile,
             timing,
+            ramps: None,
+            timed,
             end_joints: prev,
             branch,
             rates,
+            cruise_rates,
             seeds,
             tool,
         },

@@ -718,7 +718,7 @@ impl Vm {
                 point,
                 WarningKind::Corner,
                 format!(
-                    "this motion cannot start inside the zone of the motion at line {} of {} within the zone and the axes' limits: the robot stops at that point first (a corner path failure); a larger zone, a lower speed or a jerk limit can let it fly by",
+                    "this motion cannot start inside the zone of the motion at line {} of {} within the zone and the TCP's and axes' limits (or faster than stopping): the robot stops at that point first (a corner path failure); a larger zone, a lower speed or a jerk limit can let it fly by",
                     at.line,
                     self.m.file_name_of(at)
                 ),
