@@ -210,6 +210,19 @@ fn zoned_and_fine(src: &str, jerk: Option<f64>, vel_tol: f64) -> Result<Run, Tes
     Ok(r)
 }
 
+/// The TCP at every `motion_end` of `src` with every zone `fine`: home, then its points.
+fn fine_points(src: &str, jerk: Option<f64>) -> Vec<[f64; 3]> {
+    let mut out = Vec::new();
+    let mut f = vm(&fine(src), jerk);
+    while let Next::Event(e) = f.next_event() {
+        f.perform();
+        if matches!(e.kind, EventKind::MotionEnd { .. }) {
+            out.push(f.tcp_at(e.time).t);
+        }
+    }
+    out
+}
+
 fn points() -> impl Strategy<Value = Vec<(i32, i32, i32)>> {
     prop::collection::vec((-120i32..120, -120i32..120, -100i32..100), 2..6)
 }
@@ -239,17 +252,7 @@ proptest! {
         }
 
         // The points (TCP positions at each motion_end of the fine run), then the zones.
-        let ends: Vec<[f64; 3]> = {
-            let mut out = Vec::new();
-            let mut f = vm(&fine(&src), jerk);
-            while let Next::Event(e) = f.next_event() {
-                f.perform();
-                if matches!(e.kind, EventKind::MotionEnd { .. }) {
-                    out.push(f.tcp_at(e.time).t);
-                }
-            }
-            out
-        };
+        let ends = fine_points(&src, jerk);
         // ends[0] is home; ends[k + 1] is point k.
         let starts: Vec<usize> = r.events.iter().enumerate()
             .filter(|(_, e)| matches!(e.kind, EventKind::MotionStart { .. })).map(|(i, _)| i).collect();
@@ -344,17 +347,7 @@ proptest! {
         // A corner the VM could not fly with ramps (a path timed within its axes' limits
         // is superposed as planned: the TCP's acceleration adds up there) is left out: one
         // with ramps blends within min(zone, L₂/2) or a power-of-two fraction of it.
-        let ends: Vec<[f64; 3]> = {
-            let mut out = Vec::new();
-            let mut f = vm(&fine(&src), None);
-            while let Next::Event(e) = f.next_event() {
-                f.perform();
-                if matches!(e.kind, EventKind::MotionEnd { .. }) {
-                    out.push(f.tcp_at(e.time).t);
-                }
-            }
-            out
-        };
+        let ends = fine_points(&src, None);
         let mut superposed = Vec::new();
         let (mut zone, mut k) = (0.0, 0usize);
         for (i, e) in r.events.iter().enumerate() {
