@@ -616,6 +616,27 @@ fn limits_reach_and_speed_are_checked() {
             && w.kind == WarningKind::Slowdown),
         "{w:?}"
     );
+    // The same line back and forth three times: one warning for each statement, at its
+    // first execution (a loop repeats it every round).
+    let src = "proc main() {
+        var i = 0;
+        while i < 3 {
+            move_j pose(300mm, -80mm, 400mm, 180deg, 0deg, 0deg);
+            move_l pose(300mm, 80mm, 400mm, 180deg, 0deg, 0deg) speed 2000mm/s;
+            i = i + 1;
+        }
+    }";
+    let mut v = vm(src, "irb120", VmConfig::default());
+    let ev = run(&mut v);
+    assert_eq!(ev.len(), 13, "{ev:?}");
+    let w = v.take_warnings();
+    let slowed: Vec<_> = w
+        .iter()
+        .filter(|w| w.kind == WarningKind::Slowdown)
+        .collect();
+    assert_eq!(slowed.len(), 1, "{w:?}");
+    assert_eq!(slowed[0].pos.line, 5);
+    assert_eq!(slowed[0].time, ev[2].time, "{w:?}");
     // Where only the axes' accelerations bind (the IRB 120 cannot give this line its TCP's
     // 28 m/s² at the start), the motion accelerates as fast as the axes let it, slower
     // than 28 m/s² would, and that is its dynamics, not a slowdown: no warning.

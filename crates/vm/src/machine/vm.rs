@@ -49,8 +49,8 @@ pub struct Vm {
     source: Source,
     /// Warnings to report (e.g. a move slowed by an axis speed limit).
     warnings: Vec<Warning>,
-    /// Statements already warned about their zoned points (`warn_once`).
-    warned: Vec<u32>,
+    /// Statements already warned about, and what about (`warn_once`).
+    warned: Vec<(u32, WarningKind)>,
 }
 
 /// A [`Sight`] of the VM's parts, borrowed field by field (so that the interpreter's
@@ -697,20 +697,17 @@ impl Vm {
                 ),
             });
         }
+        // (Once per statement: a loop repeats the motion every round.)
         if let Some(s) = notes.slowed {
             let j = self.arm.model().axis(s.axis);
-            self.warnings.push(Warning {
-                time: self.time,
-                pos,
-                kind: WarningKind::Slowdown,
-                message: format!(
-                    "axis {} `{}` reaches its speed limit and slows the TCP below its programmed speed: the motion takes {}, {} without that limit",
-                    s.axis + 1,
-                    j.name,
-                    fmt_quantity(s.lasts as f64 / NS, Dim::TIME),
-                    fmt_quantity(s.would as f64 / NS, Dim::TIME),
-                ),
-            });
+            let message = format!(
+                "axis {} `{}` reaches its speed limit and slows the TCP below its programmed speed: the motion takes {}, {} without that limit",
+                s.axis + 1,
+                j.name,
+                fmt_quantity(s.lasts as f64 / NS, Dim::TIME),
+                fmt_quantity(s.would as f64 / NS, Dim::TIME),
+            );
+            self.warn_once(self.main.pc, self.time, WarningKind::Slowdown, message);
         }
         if let Some((point, at)) = notes.corner_failure {
             self.warn_once(
@@ -733,10 +730,10 @@ impl Vm {
     /// A warning about the statement at `pc`, at `time`, once per statement (a loop
     /// repeats it every round).
     fn warn_once(&mut self, pc: u32, time: i64, kind: WarningKind, message: String) {
-        if self.warned.contains(&pc) {
+        if self.warned.contains(&(pc, kind)) {
             return;
         }
-        self.warned.push(pc);
+        self.warned.push((pc, kind));
         self.warnings.push(Warning {
             time,
             pos: self.m.pos_of(pc),
