@@ -9,7 +9,9 @@
 //!   corners, checked by the VM at 32 instants, 0.1 mm).
 //! - Joint-space programs never exceed an axis's speed or acceleration (first and second
 //!   differences at 1 kHz; a second difference is a weighted mean of the acceleration);
-//!   Cartesian ones, whose axis speeds are checked at samples, stay within 1 % of them.
+//!   Cartesian ones, whose corners are checked at samples, stay within 1 % of the speeds
+//!   and within twice the accelerations (a superposed corner that cannot keep them adds
+//!   both motions' up).
 //! - Position and velocity are continuous at every event: the joints and their one-sided
 //!   finite-difference velocities agree before and after the event is performed.
 //! - A zoned program is never slower than the same program with `fine` points, and a
@@ -248,6 +250,18 @@ proptest! {
             for i in 0..6 {
                 let ratio = (w[1].1[i] - w[0].1[i]).abs() / 1e-3 / model.axis(i).max_velocity;
                 prop_assert!(ratio <= 1.01, "axis {i} at {}: {ratio} × its speed limit\n{src}", w[1].0);
+            }
+        }
+        // Axis accelerations: a superposed corner's are checked at 64 even steps (second
+        // differences); where no start keeps them (both motions brake and accelerate at an
+        // axis's limit at the point) the corner keeps the speeds only, and each motion's
+        // acceleration, within its own limit, adds up: at most twice the limit, plus what
+        // 1 kHz second differences see of a timing's steps.
+        for w in r.samples.windows(3) {
+            for i in 0..6 {
+                let acc = (w[2].1[i] - 2.0 * w[1].1[i] + w[0].1[i]).abs() / 1e-6;
+                let ratio = acc / model.axis(i).max_accel;
+                prop_assert!(ratio <= 2.2, "axis {i} at {}: {ratio} × its acceleration limit\n{src}", w[1].0);
             }
         }
 

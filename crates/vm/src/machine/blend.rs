@@ -78,7 +78,7 @@ pub(super) struct Planned {
 
 /// Samples of the corner checked for reachability, axis speeds and (joint-space corners)
 /// the zone.
-const CORNER_SAMPLES: usize = 32;
+const CORNER_SAMPLES: usize = 64;
 
 /// The joints at `t` of motion `next` starting at `ts` superposed on the rest of `f`
 /// (in Cartesian space when both are Cartesian); `None` where IK fails.
@@ -497,18 +497,40 @@ pub(super) fn blend_start(
     if ts >= f.end() {
         return (f.end(), 0.0);
     }
-    // The sampled checks (inverse kinematics, axis speeds, the zone of a joint-space
-    // corner) cost more: at the start found, and only if they fail, searched again.
-    if let Some(r) = corner_samples(model, tool, f, next, ts) {
+    // The sampled checks (inverse kinematics, axis speeds and accelerations, the zone of
+    // a joint-space corner) cost more: at the start found, and only if they fail, searched
+    // again.
+    if let Some(r) = corner_samples(model, tool, f, next, ts, Accelerations::Checked) {
         return (ts, radius.max(r));
     }
-    search(
-        &|t| {
-            let a = corner_bounds(model, f, next, next_ns, t)?;
-            Some(a.max(corner_samples(model, tool, f, next, t)?))
-        },
-        ts,
-    )
+    let with = |check: Accelerations| {
+        search(
+            &|t| {
+                let a = corner_bounds(model, f, next, next_ns, t)?;
+                Some(a.max(corner_samples(model, tool, f, next, t, check)?))
+            },
+            ts,
+        )
+    };
+    // (The least overlap first: if even that breaks an acceleration, no start keeps them.)
+    let least = corner_samples(model, tool, f, next, f.end() - 1, Accelerations::Checked);
+    if least.is_some() {
+        let found = with(Accelerations::Checked);
+        if found.0 < f.end() {
+            return found;
+        }
+    }
+    // Two motions that both brake and accelerate at an axis's limit at the point cannot
+    // overlap there at all: rather than stop, such a corner keeps the axes' speeds only
+    // (its accelerations add up: docs/engine.md, "Zones").
+    with(Accelerations::Unchecked)
+}
+
+/// Whether [`corner_samples`] checks the axes' accelerations.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Accelerations {
+    Checked,
+    Unchecked,
 }
 
 /// The exact conditions of a corner starting at `ts`; the radius it stays within (a
@@ -612,16 +634,18 @@ fn corner_bounds(
     }
 }
 
-/// The corner starting at `ts`, sampled: every pose reachable (Cartesian corners), no
-/// axis faster than its limit between samples, and for joint-space corners every axis
-/// within its range and the TCP within the zone. The largest distance from the point
-/// seen, if all hold.
+/// The corner starting at `ts`, sampled at [`CORNER_SAMPLES`] even steps (and one step
+/// before and after it): every pose reachable (Cartesian corners), no axis faster than
+/// its limit between samples nor accelerating harder (second differences), and for
+/// joint-space corners every axis within its range and the TCP within the zone. The
+/// largest distance from the point seen, if all hold.
 fn corner_samples(
     model: &RobotModel,
     tool: &Iso,
     f: &Fading,
     next: &Trajectory,
     ts: i64,
+    check: Accelerations,
 ) -> Option<f64> {
     let n = model.dof();
     let span = f.end() - ts;
@@ -629,36 +653,41 @@ fn corner_samples(
         return Some(0.0);
     }
     let joint_space = !(f.motion.traj.is_cartesian() && next.is_cartesian());
-    let mut prev = blend_joints(model, f, next, ts, ts)?;
-    let mut prev_t = ts;
+    // Evenly spaced from a step before the corner to a step after it: the accelerations
+    // of its start and end are where the two motions' add up or stop adding up.
+    let step = (span / CORNER_SAMPLES as i64).max(1);
+    let dt = step as f64 / NS;
+    let mut q = [[0.0; MAX_AXES]; 3];
     let mut farthest = 0.0f64;
-    for k in 1..=CORNER_SAMPLES {
-        let t = ts + span * k as i64 / CORNER_SAMPLES as i64;
-        if t <= prev_t {
-            continue;
-        }
-        let q = blend_joints(model, f, next, ts, t)?;
-        if joint_space && !model.within_limits(&q[..n]) {
+    for k in 0..=CORNER_SAMPLES as i64 + 2 {
+        let t = ts + (k - 1) * step;
+        q = [q[1], q[2], blend_joints(model, f, next, ts, t)?];
+        let inside = t > ts && t <= f.end();
+        if inside && joint_space && !model.within_limits(&q[2][..n]) {
             return None;
         }
-        let dt = (t - prev_t) as f64 / NS;
-        for i in 0..n {
-            if (q[i] - prev[i]).abs() / dt
-                > model.axis(i).max_velocity * (1.0 + JOINT_SPEED_TOLERANCE)
+        let axes = q[0].iter().zip(&q[1]).zip(&q[2]).take(n).enumerate();
+        for (i, ((q0, q1), q2)) in axes {
+            let axis = model.axis(i);
+            if k >= 1 && (q2 - q1).abs() / dt > axis.max_velocity * (1.0 + JOINT_SPEED_TOLERANCE) {
+                return None;
+            }
+            if k >= 2
+                && check == Accelerations::Checked
+                && (q2 - 2.0 * q1 + q0).abs() / (dt * dt)
+                    > axis.max_accel * (1.0 + JOINT_SPEED_TOLERANCE)
             {
                 return None;
             }
         }
-        if joint_space {
-            let p = model.tcp(&q[..n], tool).t;
+        if inside && joint_space {
+            let p = model.tcp(&q[2][..n], tool).t;
             let d = vworks_model::math::norm(vworks_model::math::sub(p, f.corner_pose.t));
             if d > f.motion.zone {
                 return None;
             }
             farthest = farthest.max(d);
         }
-        prev = q;
-        prev_t = t;
     }
     Some(farthest)
 }

@@ -698,7 +698,9 @@ impl Vm {
             });
         }
         // (Once per statement: a loop repeats the motion every round.)
-        if let Some(s) = notes.slowed {
+        if let Some(s) = notes.slowed
+            && !self.warned(self.main.pc, WarningKind::Slowdown)
+        {
             let j = self.arm.model().axis(s.axis);
             let message = format!(
                 "axis {} `{}` reaches its speed limit and slows the TCP below its programmed speed: the motion takes {}, {} without that limit",
@@ -709,7 +711,9 @@ impl Vm {
             );
             self.warn_once(self.main.pc, self.time, WarningKind::Slowdown, message);
         }
-        if let Some((point, at)) = notes.corner_failure {
+        if let Some((point, at)) = notes.corner_failure
+            && !self.warned(self.main.pc, WarningKind::Corner)
+        {
             self.warn_once(
                 self.main.pc,
                 point,
@@ -725,6 +729,12 @@ impl Vm {
             return Err("the motion would end after the last instant the simulator can represent (2^62 ns, about 146 years); check its speed".into());
         }
         Ok(kind)
+    }
+
+    /// Whether the statement at `pc` was warned about already for `kind` (so that a
+    /// repeated statement does not even format its message again).
+    fn warned(&self, pc: u32, kind: WarningKind) -> bool {
+        self.warned.contains(&(pc, kind))
     }
 
     /// A warning about the statement at `pc`, at `time`, once per statement (a loop
@@ -754,6 +764,9 @@ impl Vm {
             return t;
         };
         // Warned at the stop point's time, where the trace shows the statement's event.
+        if self.warned(pc, WarningKind::StopPoint) {
+            return end;
+        }
         self.warn_once(
             pc,
             end,
