@@ -8,12 +8,13 @@
 //!   speed, brakes at its own acceleration to the corner speed `v_e` where it enters the
 //!   corner, and then runs out over the corner's radius `r` with a *corner ramp*
 //!   (constant deceleration `v_e²/2r` to rest at its point): [`Ramps::with_tail`];
-//! - the next starts at its point with the mirror ramp (from rest to `v_e` over `r`, in
-//!   the same time `2r/v_e`) and goes on as a trapezoid: [`Ramps::with_head`].
+//! - the next starts at its point with a ramp from rest (to its own corner speed over its
+//!   own length, in the same time) and goes on as a trapezoid: [`Ramps::with_head`].
 //!
-//! Superposed, the two ramps move the TCP along a parabola inside the zone at a constant
-//! path speed `v_e` (the two speeds add to it) with a constant acceleration vector. Every
-//! function here is pure and works in the motion's path fraction (distance 1).
+//! Superposed, the two ramps move the TCP along a parabola inside the zone with a constant
+//! acceleration vector (with equal ramps, at a constant path speed: the two speeds add up
+//! to it). Every function here is pure and works in the motion's path fraction (distance
+//! 1).
 
 /// The most phases a profile has: a head ramp, accelerate, cruise, accelerate again
 /// after a hold, brake, a tail ramp — with room to spare.

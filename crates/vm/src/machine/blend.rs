@@ -1,14 +1,13 @@
 //! Zones (fly-by points), as a controller makes them.
 //!
 //! - A zoned motion's `motion_end` happens when the TCP enters its zone (`zone_entry`) or,
-//!   for a line or arc with a trapezoid profile, earlier at its look-ahead point: the
+//!   for a line with a trapezoid profile, earlier at its look-ahead point: the
 //!   program runs ahead from there while the robot goes on toward the point (the motion
 //!   becomes [`Fading`]).
-//! - Two lines or arcs with trapezoid profiles fly by with *corner ramps*
-//!   (`corner_ramps`, profiles in `crate::ramps`): the first holds its speed, brakes to the
-//!   corner speed and ramps out over the corner's radius while the next ramps in; their sum
-//!   is a parabola inside the zone at a constant path speed, with the TCP's acceleration
-//!   within both motions'.
+//! - Two lines with trapezoid profiles fly by with *corner ramps* (`corner_ramps`,
+//!   profiles in `crate::ramps`): the first holds its speed, brakes and ramps out to rest
+//!   at its point while the next ramps in, both in the same time; their sum is a parabola
+//!   inside the zone with a constant acceleration within both motions'.
 //! - Any other next motion is planned from the corner as if from rest, and *superposed* on
 //!   the rest of the previous one: `q(t) = q₁(t) + q₂(t − t_s) − corner` in joint space, or
 //!   `p(t) = p₁(t) + p₂(t − t_s) − P` (orientation `R₂·R_Pᵀ·R₁`) when both are Cartesian.
@@ -215,8 +214,8 @@ pub(super) fn zone_entry(
     (to_ns(hi), r, to_ns(hi))
 }
 
-/// The profile of a Cartesian motion that can fly by a corner with ramps (a trapezoid in
-/// path fraction, or one already changed by a corner), as [`Ramps`]; `None` for a
+/// The profile of a straight line that can fly by a corner with ramps (a trapezoid in
+/// path fraction, or one already changed by a corner), as [`Ramps`]; `None` for an arc, a
 /// joint motion, a time-optimal timing, an S-curve, a motion given a `duration` (a corner
 /// would change it) or a motion without a path length.
 pub(super) fn ramp_profile(traj: &Trajectory) -> Option<Ramps> {
@@ -231,7 +230,9 @@ pub(super) fn ramp_profile(traj: &Trajectory) -> Option<Ramps> {
     else {
         return None;
     };
-    if path.length() <= 1e-7 {
+    // (Lines only: on an arc the direction turns inside the ramps, which the corner's
+    // acceleration bound does not see.)
+    if path.length() <= 1e-7 || !matches!(path, Path::Line { .. }) {
         return None;
     }
     if let Some(r) = ramps {
@@ -255,16 +256,14 @@ pub(super) struct Corner {
     pub(super) radius: f64,
 }
 
-/// The corner between the rest of `f` and `next` (both Cartesian, with
-/// [`ramp_profile`]s), decided at `time`, with look-ahead (docs/engine.md, "Zones"):
-/// radius `r ≤ min(zone, L₁/2, L₂/2)`; corner speed
-/// `v_e ≤ min(v₁, v₂, √(2r·a_c), √(2a₂·(L₂ − r)))` with the ramps' deceleration
-/// `a_c = min(a₁, a₂) / (2·sin(θ/2))` for a turn θ between the paths' directions at the
-/// point (the superposed TCP's acceleration `a_c·|u₂ − u₁|` stays within both motions').
-/// Of the radii and speeds tried ([`RADII`], [`SPEEDS`]) the one whose next motion ends
-/// first, if no later than stopping at the point would, and whose samples keep every
-/// axis within its limits ([`ramps_fit`]). `None`: no such corner (the superposition
-/// of [`blend_start`] then).
+/// The corner between the rest of `f` and `next` (two lines with [`ramp_profile`]s),
+/// decided at `time`, with look-ahead (docs/engine.md, "Zones"): at radius
+/// `r ≤ min(zone, L₁/2, L₂/2)`, ramps lasting w over `rᵢ = min(r, vᵢ·w/2)` (vᵢ each
+/// motion's top speed), w the shortest at which the TCP's acceleration in the corner,
+/// `(2r₂·u₂ − 2r₁·u₁)/w²`, is within both motions'. Of the radii and durations tried
+/// ([`RADII`], [`SPEEDS`]) the one whose next motion ends first, if no later than stopping
+/// at the point would, and whose samples keep every axis within its limits
+/// ([`ramps_fit`]). `None`: no such corner (the superposition of [`blend_start`] then).
 pub(super) fn corner_ramps(
     model: &RobotModel,
     time: i64,
@@ -299,12 +298,19 @@ pub(super) fn corner_ramps(
         return None;
     }
     let (u1, u2) = (path1.tangent(1.0), path2.tangent(0.0));
-    let turn = vworks_model::math::norm(vworks_model::math::sub(u2, u1));
-    let (a1, a2) = (p1.accel * l1, p2.accel * l2);
-    let a_c = if turn > 1e-12 {
-        a1.min(a2) / turn
-    } else {
-        f64::INFINITY
+    let a_lim = (p1.accel * l1).min(p2.accel * l2);
+    let (v1, v2) = (p1.top * l1, p2.top * l2);
+    // Ramps lasting w at radius r: each as long as its motion's top speed allows, at most
+    // r; the TCP's acceleration in the corner is (2r₂·u₂ − 2r₁·u₁)/w².
+    let lengths = |w: f64, r: f64| (r.min(0.5 * v1 * w), r.min(0.5 * v2 * w));
+    let accel_at = |w: f64, r: f64| {
+        let (r1, r2) = lengths(w, r);
+        let d = [
+            r2 * u2[0] - r1 * u1[0],
+            r2 * u2[1] - r1 * u1[1],
+            r2 * u2[2] - r1 * u1[2],
+        ];
+        2.0 * vworks_model::math::norm(d) / (w * w)
     };
     let now = (time - f.motion.start) as f64 / NS;
     // Stopping at the point: the bound no corner may be slower than.
@@ -313,25 +319,55 @@ pub(super) fn corner_ramps(
     let mut found = 0;
     for k in 0..RADII {
         let r = zone / f64::from(1u32 << k);
-        let mut v_e = (p1.top * l1)
-            .min(p2.top * l2)
-            .min((2.0 * r * a_c).sqrt())
-            .min((2.0 * a2 * (l2 - r)).sqrt());
+        // The shortest ramps: the faster motion's over the whole radius, longer while the
+        // TCP's acceleration would be above both motions' (it falls as w grows).
+        let mut w = 2.0 * r / v1.max(v2);
+        // Both ramps over the whole radius: w = √(2r·|u₂ − u₁| / a), in closed form.
+        let turn = vworks_model::math::norm(vworks_model::math::sub(u2, u1));
+        let whole = (2.0 * r * turn / a_lim).sqrt();
+        if whole >= 2.0 * r / v1.min(v2) {
+            w = w.max(whole);
+        } else if accel_at(w, r) > a_lim {
+            let mut hi = w;
+            for _ in 0..64 {
+                hi *= 2.0;
+                if accel_at(hi, r) <= a_lim {
+                    break;
+                }
+            }
+            let mut lo = w;
+            for _ in 0..64 {
+                let mid = 0.5 * (lo + hi);
+                if mid <= lo || mid >= hi {
+                    break;
+                }
+                if accel_at(mid, r) > a_lim {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            w = hi;
+        }
         for _ in 0..SPEEDS {
-            if let Some(c) = corner_at(&p1, &p2, f, time, now, (l1, l2), r, v_e)
+            let (r1, r2) = lengths(w, r);
+            let ends = ((r1, 2.0 * r1 / w), (r2, 2.0 * r2 / w));
+            if let Some(c) = corner_at(&p1, &p2, f, time, now, (l1, l2), ends)
                 && c.start + (c.next.duration() * NS).ceil() as i64 <= stop_end
             {
-                candidates[found] = (c.start + (c.next.duration() * NS).ceil() as i64, r, v_e);
+                candidates[found] = (c.start + (c.next.duration() * NS).ceil() as i64, r, w);
                 found += 1;
             }
-            v_e *= 0.8;
+            w *= 1.25;
         }
     }
     // The fastest corner whose samples keep every axis within its limits.
     let candidates = &mut candidates[..found];
     candidates.sort_by(|x, y| x.0.cmp(&y.0).then(y.1.total_cmp(&x.1)));
-    candidates.iter().find_map(|&(_, r, v_e)| {
-        let c = corner_at(&p1, &p2, f, time, now, (l1, l2), r, v_e)?;
+    candidates.iter().find_map(|&(_, r, w)| {
+        let (r1, r2) = lengths(w, r);
+        let ends = ((r1, 2.0 * r1 / w), (r2, 2.0 * r2 / w));
+        let c = corner_at(&p1, &p2, f, time, now, (l1, l2), ends)?;
         ramps_fit(model, f, next, &c).then_some(c)
     })
 }
@@ -351,15 +387,15 @@ pub(super) fn sharp_ramp_corner(f: &Fading, next: &Trajectory) -> bool {
     vworks_model::math::norm(vworks_model::math::sub(p2.tangent(0.0), p1.tangent(1.0))) > 1.0
 }
 
-/// Corner radii tried (the zone, then halved) and corner speeds at each (from the
-/// fastest the TCP's acceleration allows, 80 % at a time).
+/// Corner radii tried (the zone, then halved) and ramp durations at each (from the
+/// shortest the TCP's acceleration allows, 25 % longer at a time).
 const RADII: usize = 4;
 const SPEEDS: usize = 5;
 
-/// The corner of radius `r` at speed `v_e` (m, m/s) between `f` (profile `p1`, decided
-/// at `time`, `now` seconds into it) and a motion of profile `p2`, if the first can
-/// brake to it and the next reach it.
-#[allow(clippy::too_many_arguments)]
+/// The corner between `f` (profile `p1`, decided at `time`, `now` seconds into it) and a
+/// motion of profile `p2`: the first runs out over `r₁` from `v₁ₑ`, the next ramps up over
+/// `r₂` to `v₂ₑ` (m, m/s; both ramps lasting `2r₁/v₁ₑ = 2r₂/v₂ₑ`), if the first can brake
+/// to it and the next can still stop.
 fn corner_at(
     p1: &Ramps,
     p2: &Ramps,
@@ -367,18 +403,17 @@ fn corner_at(
     time: i64,
     now: f64,
     (l1, l2): (f64, f64),
-    r: f64,
-    v_e: f64,
+    ((r1, v1e), (r2, v2e)): ((f64, f64), (f64, f64)),
 ) -> Option<Corner> {
-    let first = p1.with_tail(now, r / l1, v_e / l1).ok()?;
-    let next = Ramps::with_head(1.0, p2.top, p2.accel, r / l2, v_e / l2).ok()?;
-    let t_z = first.time_at(1.0 - r / l1);
+    let first = p1.with_tail(now, r1 / l1, v1e / l1).ok()?;
+    let next = Ramps::with_head(1.0, p2.top, p2.accel, r2 / l2, v2e / l2).ok()?;
+    let t_z = first.time_at(1.0 - r1 / l1);
     let start = f.motion.start + (t_z * NS).ceil() as i64;
     (start >= time).then_some(Corner {
         first,
         next,
         start,
-        radius: r,
+        radius: r1.max(r2),
     })
 }
 
@@ -594,7 +629,9 @@ fn corner_bounds(
             if radius > f.motion.zone.min(0.5 * l2) + 1e-12 {
                 return None;
             }
-            if t1.is_none() && t2.is_none() {
+            // (Exact on the trapezoids; a motion following corner ramps is sampled.)
+            let ramped = |t: &Trajectory| matches!(t, Trajectory::Cartesian { ramps: Some(_), .. });
+            if t1.is_none() && t2.is_none() && !ramped(first) && !ramped(next) {
                 let k1 = if s1.dist > 0.0 { l1 / s1.dist } else { 0.0 };
                 let k2 = if s2.dist > 0.0 { l2 / s2.dist } else { 0.0 };
                 let vmax = (k1 * s1.v).max(k2 * s2.v);
