@@ -368,7 +368,7 @@ pub(super) fn corner_ramps(
         let (r1, r2) = lengths(w, r);
         let ends = ((r1, 2.0 * r1 / w), (r2, 2.0 * r2 / w));
         let c = corner_at(&p1, &p2, f, time, now, (l1, l2), ends)?;
-        ramps_fit(model, f, next, &c).then_some(c)
+        ramps_fit(model, time, f, next, &c).then_some(c)
     })
 }
 
@@ -445,10 +445,11 @@ fn set_ramps(traj: &mut Trajectory, r: Ramps) {
 /// Samples of a corner flown with ramps, and of the next motion's acceleration after it.
 const RAMP_SAMPLES: usize = 64;
 
-/// The corner `c` sampled at [`RAMP_SAMPLES`] instants through the overlap and as many
+/// The corner `c` decided at `time` sampled at [`RAMP_SAMPLES`] instants through the
+/// first motion's changed approach (from `time`), as many through the overlap and as many
 /// through the next motion until it has reached its top speed: every pose reachable,
 /// every axis within its speed (chords) and acceleration (second differences).
-fn ramps_fit(model: &RobotModel, f: &Fading, next: &Trajectory, c: &Corner) -> bool {
+fn ramps_fit(model: &RobotModel, time: i64, f: &Fading, next: &Trajectory, c: &Corner) -> bool {
     let (f, next) = with_corner(f, next, c);
     let n = model.dof();
     let ts = c.start;
@@ -458,7 +459,11 @@ fn ramps_fit(model: &RobotModel, f: &Fading, next: &Trajectory, c: &Corner) -> b
         .phases()
         .find(|&(_, _, a)| a <= 0.0)
         .map_or(c.next.duration(), |(t0, ..)| t0);
-    let spans = [(ts, f.end()), (f.end(), ts + (top * NS).ceil() as i64)];
+    let spans = [
+        (time, ts),
+        (ts, f.end()),
+        (f.end(), ts + (top * NS).ceil() as i64),
+    ];
     for (from, to) in spans {
         if to <= from {
             continue;
