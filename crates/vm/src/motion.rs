@@ -405,27 +405,6 @@ impl Path {
         }
     }
 
-    /// The unit direction of travel at fraction `s` (zero for a line of no length).
-    pub fn tangent(&self, s: f64) -> V3 {
-        let d = match self {
-            Path::Line { from, to } => sub(*to, *from),
-            Path::Arc { u, v, sweep, .. } => {
-                let (sn, c) = (sweep * s).sin_cos();
-                [
-                    v[0] * c - u[0] * sn,
-                    v[1] * c - u[1] * sn,
-                    v[2] * c - u[2] * sn,
-                ]
-            }
-        };
-        let n = norm(d);
-        if n > 0.0 {
-            [d[0] / n, d[1] / n, d[2] / n]
-        } else {
-            [0.0; 3]
-        }
-    }
-
     /// The circle through three points, or `None` if they are (nearly) collinear.
     pub fn arc(p0: V3, via: V3, p1: V3) -> Option<Path> {
         use vworks_model::math::cross;

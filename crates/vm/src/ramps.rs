@@ -261,14 +261,6 @@ impl Ramps {
         (self.v[k] + self.a[k] * (t - self.t[k])).max(0.0)
     }
 
-    /// Acceleration at `t` (s); at a phase boundary, the phase that starts there.
-    pub fn accel_at(&self, t: f64) -> f64 {
-        if t < 0.0 || t >= self.duration() || self.phases == 0 {
-            return 0.0;
-        }
-        self.a[self.phase(t)]
-    }
-
     /// The time the profile has covered `d` (clamped to [0, duration]).
     pub fn time_at(&self, d: f64) -> f64 {
         if d <= 0.0 {
@@ -290,16 +282,6 @@ impl Ramps {
             2.0 * x / (v + disc)
         };
         (self.t[k] + dt).clamp(self.t[k], self.t[k + 1])
-    }
-
-    /// The speed where distance `d` is covered.
-    pub fn speed_at_distance(&self, d: f64) -> f64 {
-        self.speed_at(self.time_at(d))
-    }
-
-    /// The times where a phase begins or ends.
-    pub fn breakpoints(&self) -> &[f64] {
-        &self.t[..=self.phases]
     }
 
     /// The times and accelerations of the phases.
@@ -347,7 +329,7 @@ mod tests {
         let cruise_end = 0.9 - 0.08;
         let t_brake = 0.5 + (cruise_end - 0.125) / 0.5;
         assert!((r.time_at(cruise_end) - t_brake).abs() < 1e-12);
-        assert!((r.speed_at_distance(0.9) - 0.3).abs() < 1e-9);
+        assert!((r.speed_at(r.time_at(0.9)) - 0.3).abs() < 1e-9);
         assert!((r.duration() - (t_brake + 0.2 + 2.0 * 0.1 / 0.3)).abs() < 1e-12);
         assert_eq!(r.dist(), 1.0);
         // Before `now` nothing changed.

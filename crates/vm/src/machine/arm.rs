@@ -224,20 +224,19 @@ impl Arm {
             if tool_changed {
                 return (f.end(), 0.0, f.end(), f.pos);
             }
-            // Two Cartesian motions fly by with ramps and look-ahead where they can;
-            // else the next is superposed on the first as it was planned.
-            if let Some(c) = blend::corner_ramps(model, time, f, &traj) {
-                let (first, next) = blend::with_corner(f, &traj, &c);
-                *f = first;
-                traj = next;
-                point_ns = (traj.path_duration() * NS).ceil() as i64;
-                return (c.start, c.radius, f.end(), f.pos);
-            }
-            // Two lines with ramp profiles turning by more than 60° whose corner with
-            // ramps would be slower than stopping stop: superposed, their ramps would
-            // add up to more than either motion's TCP acceleration.
-            if blend::sharp_ramp_corner(f, &traj) {
-                return (f.end(), 0.0, f.end(), f.pos);
+            // Two lines fly by with ramps and look-ahead where they can (or stop, where
+            // that cannot beat stopping and superposing them would break their TCP
+            // acceleration); else the next is superposed on the first as it was planned.
+            match blend::corner_ramps(model, time, f, &traj) {
+                Some(blend::RampCorner::Flies(c)) => {
+                    let (first, next) = blend::with_corner(f, &traj, &c);
+                    *f = first;
+                    traj = next;
+                    point_ns = (traj.path_duration() * NS).ceil() as i64;
+                    return (c.start, c.radius, f.end(), f.pos);
+                }
+                Some(blend::RampCorner::Stops) => return (f.end(), 0.0, f.end(), f.pos),
+                None => {}
             }
             let (ts, radius) = blend::blend_start(model, &tool, time, f, &traj, point_ns);
             (ts, radius, f.end(), f.pos)

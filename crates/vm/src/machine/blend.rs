@@ -21,7 +21,7 @@
 //! model, the motions and the times in, a time or a radius out.
 
 use vworks_model::RobotModel;
-use vworks_model::math::Iso;
+use vworks_model::math::{Iso, V3, axpy, norm, sub};
 
 use super::plan::{JOINT_SPEED_TOLERANCE, Trajectory};
 use crate::MAX_AXES;
@@ -190,7 +190,7 @@ pub(super) fn zone_entry(
     let point = model.tcp(&traj.end_joints()[..n], tool).t;
     let dist = |t: f64| {
         let q = traj.joints_at(model, t).unwrap_or(*rest);
-        vworks_model::math::norm(vworks_model::math::sub(model.tcp(&q[..n], tool).t, point))
+        norm(sub(model.tcp(&q[..n], tool).t, point))
     };
     const STEPS: usize = 32;
     let at = |k: usize| 0.5 * total + 0.5 * total * k as f64 / STEPS as f64;
@@ -256,6 +256,18 @@ pub(super) struct Corner {
     pub(super) radius: f64,
 }
 
+/// What a corner between two lines with [`ramp_profile`]s comes to.
+// One per corner planned, never stored: boxing would add an allocation per corner.
+#[allow(clippy::large_enum_variant)]
+pub(super) enum RampCorner {
+    /// It flies by with ramps.
+    Flies(Corner),
+    /// No corner with ramps beats stopping, and the lines turn by more than 60°
+    /// (`|u₂ − u₁| > 1`): superposed as planned, their braking and accelerating would add
+    /// up to more than their TCP acceleration, so the robot stops at the point.
+    Stops,
+}
+
 /// The corner between the rest of `f` and `next` (two lines with [`ramp_profile`]s),
 /// decided at `time`, with look-ahead (docs/engine.md, "Zones"): at radius
 /// `r ≤ min(zone, L₁/2, L₂/2)`, ramps lasting w over `rᵢ = min(r, vᵢ·w/2)` (vᵢ each
@@ -263,13 +275,14 @@ pub(super) struct Corner {
 /// `(2r₂·u₂ − 2r₁·u₁)/w²`, is within both motions'. Of the radii and durations tried
 /// ([`RADII`], [`SPEEDS`]) the one whose next motion ends first, if no later than stopping
 /// at the point would, and whose samples keep every axis within its limits
-/// ([`ramps_fit`]). `None`: no such corner (the superposition of [`blend_start`] then).
+/// ([`ramps_fit`]). `None`: not two such lines, or no such corner and a turn of at most
+/// 60° (the superposition of [`blend_start`] then).
 pub(super) fn corner_ramps(
     model: &RobotModel,
     time: i64,
     f: &Fading,
     next: &Trajectory,
-) -> Option<Corner> {
+) -> Option<RampCorner> {
     let (p1, p2) = (ramp_profile(&f.motion.traj)?, ramp_profile(next)?);
     let (
         Trajectory::Cartesian {
@@ -286,18 +299,20 @@ pub(super) fn corner_ramps(
     else {
         return None;
     };
+    let (u1, u2) = (line_direction(path1), line_direction(path2));
+    let turn = norm(sub(u2, u1));
+    let fallback = (turn > 1.0).then_some(RampCorner::Stops);
     // Each motion's axes within their speeds at its top speed anywhere on its path.
     for i in 0..model.dof() {
         if c1[i].max(c2[i]) > model.axis(i).max_velocity * (1.0 + JOINT_SPEED_TOLERANCE) {
-            return None;
+            return fallback;
         }
     }
     let (l1, l2) = (path1.length(), path2.length());
     let zone = f.motion.zone.min(0.5 * l1).min(0.5 * l2);
     if zone <= 1e-9 {
-        return None;
+        return fallback;
     }
-    let (u1, u2) = (path1.tangent(1.0), path2.tangent(0.0));
     let a_lim = (p1.accel * l1).min(p2.accel * l2);
     let (v1, v2) = (p1.top * l1, p2.top * l2);
     // Ramps lasting w at radius r: each as long as its motion's top speed allows, at most
@@ -305,17 +320,12 @@ pub(super) fn corner_ramps(
     let lengths = |w: f64, r: f64| (r.min(0.5 * v1 * w), r.min(0.5 * v2 * w));
     let accel_at = |w: f64, r: f64| {
         let (r1, r2) = lengths(w, r);
-        let d = [
-            r2 * u2[0] - r1 * u1[0],
-            r2 * u2[1] - r1 * u1[1],
-            r2 * u2[2] - r1 * u1[2],
-        ];
-        2.0 * vworks_model::math::norm(d) / (w * w)
+        2.0 * norm(axpy(r2, u2, axpy(-r1, u1, [0.0; 3]))) / (w * w)
     };
     let now = (time - f.motion.start) as f64 / NS;
     // Stopping at the point: the bound no corner may be slower than.
     let stop_end = f.end() + (next.path_duration() * NS).ceil() as i64;
-    let mut candidates = [(0i64, 0.0f64, 0.0f64); RADII * SPEEDS];
+    let mut candidates: [Option<(i64, Corner)>; RADII * SPEEDS] = [None; RADII * SPEEDS];
     let mut found = 0;
     for k in 0..RADII {
         let r = zone / f64::from(1u32 << k);
@@ -323,7 +333,6 @@ pub(super) fn corner_ramps(
         // TCP's acceleration would be above both motions' (it falls as w grows).
         let mut w = 2.0 * r / v1.max(v2);
         // Both ramps over the whole radius: w = √(2r·|u₂ − u₁| / a), in closed form.
-        let turn = vworks_model::math::norm(vworks_model::math::sub(u2, u1));
         let whole = (2.0 * r * turn / a_lim).sqrt();
         if whole >= 2.0 * r / v1.min(v2) {
             w = w.max(whole);
@@ -352,39 +361,43 @@ pub(super) fn corner_ramps(
         for _ in 0..SPEEDS {
             let (r1, r2) = lengths(w, r);
             let ends = ((r1, 2.0 * r1 / w), (r2, 2.0 * r2 / w));
-            if let Some(c) = corner_at(&p1, &p2, f, time, now, (l1, l2), ends)
-                && c.start + (c.next.duration() * NS).ceil() as i64 <= stop_end
-            {
-                candidates[found] = (c.start + (c.next.duration() * NS).ceil() as i64, r, w);
-                found += 1;
+            if let Some(c) = corner_at(&p1, &p2, f, time, now, (l1, l2), ends) {
+                let end = c.start + (c.next.duration() * NS).ceil() as i64;
+                if end <= stop_end {
+                    candidates[found] = Some((end, c));
+                    found += 1;
+                }
             }
             w *= 1.25;
         }
     }
-    // The fastest corner whose samples keep every axis within its limits.
+    // The fastest corner whose samples keep every axis within its limits (of two that end
+    // together, the larger radius).
     let candidates = &mut candidates[..found];
-    candidates.sort_by(|x, y| x.0.cmp(&y.0).then(y.1.total_cmp(&x.1)));
-    candidates.iter().find_map(|&(_, r, w)| {
-        let (r1, r2) = lengths(w, r);
-        let ends = ((r1, 2.0 * r1 / w), (r2, 2.0 * r2 / w));
-        let c = corner_at(&p1, &p2, f, time, now, (l1, l2), ends)?;
-        ramps_fit(model, time, f, next, &c).then_some(c)
-    })
+    candidates.sort_by(|x, y| match (x, y) {
+        (Some((ex, cx)), Some((ey, cy))) => ex.cmp(ey).then(cy.radius.total_cmp(&cx.radius)),
+        _ => std::cmp::Ordering::Equal,
+    });
+    candidates
+        .iter()
+        .flatten()
+        .find(|(_, c)| ramps_fit(model, time, f, next, c))
+        .map(|(_, c)| RampCorner::Flies(*c))
+        .or(fallback)
 }
 
-/// True for two motions that fly by with ramps ([`ramp_profile`]) turning by more than
-/// 60° at the point (`|u₂ − u₁| > 1`): superposed as planned, their braking and
-/// accelerating would add up to more than their TCP acceleration.
-pub(super) fn sharp_ramp_corner(f: &Fading, next: &Trajectory) -> bool {
-    let (Some(_), Some(_)) = (ramp_profile(&f.motion.traj), ramp_profile(next)) else {
-        return false;
+/// The unit direction of a line (zero for one of no length, or an arc).
+fn line_direction(path: &Path) -> V3 {
+    let Path::Line { from, to } = path else {
+        return [0.0; 3];
     };
-    let (Trajectory::Cartesian { path: p1, .. }, Trajectory::Cartesian { path: p2, .. }) =
-        (&f.motion.traj, next)
-    else {
-        return false;
-    };
-    vworks_model::math::norm(vworks_model::math::sub(p2.tangent(0.0), p1.tangent(1.0))) > 1.0
+    let d = sub(*to, *from);
+    let n = norm(d);
+    if n > 0.0 {
+        axpy(1.0 / n, d, [0.0; 3])
+    } else {
+        [0.0; 3]
+    }
 }
 
 /// Corner radii tried (the zone, then halved) and ramp durations at each (from the
@@ -451,7 +464,6 @@ const RAMP_SAMPLES: usize = 64;
 /// every axis within its speed (chords) and acceleration (second differences).
 fn ramps_fit(model: &RobotModel, time: i64, f: &Fading, next: &Trajectory, c: &Corner) -> bool {
     let (f, next) = with_corner(f, next, c);
-    let n = model.dof();
     let ts = c.start;
     // The next motion at its top speed: after its ramp and acceleration phases.
     let top = c
@@ -476,20 +488,8 @@ fn ramps_fit(model: &RobotModel, time: i64, f: &Fading, next: &Trajectory, c: &C
                 return false;
             };
             q = [q[1], q[2], qk];
-            let axes = q[0].iter().zip(&q[1]).zip(&q[2]).take(n).enumerate();
-            for (i, ((q0, q1), q2)) in axes {
-                let axis = model.axis(i);
-                if k >= 1
-                    && (q2 - q1).abs() / dt > axis.max_velocity * (1.0 + JOINT_SPEED_TOLERANCE)
-                {
-                    return false;
-                }
-                if k >= 2
-                    && (q2 - 2.0 * q1 + q0).abs() / (dt * dt)
-                        > axis.max_accel * (1.0 + JOINT_SPEED_TOLERANCE)
-                {
-                    return false;
-                }
+            if !axes_within(model, &q, k, dt, Accelerations::Checked) {
+                return false;
             }
         }
     }
@@ -619,7 +619,6 @@ fn corner_bounds(
             let b = l2 * next.fraction_at(window);
             let radius = match (p1, p2) {
                 (Path::Line { from, to }, Path::Line { to: to2, .. }) if l1 > 0.0 && l2 > 0.0 => {
-                    use vworks_model::math::{norm, sub};
                     let u1 = sub(*to, *from);
                     let u2 = sub(*to2, *to);
                     let v = [
@@ -708,23 +707,12 @@ fn corner_samples(
         if inside && joint_space && !model.within_limits(&q[2][..n]) {
             return None;
         }
-        let axes = q[0].iter().zip(&q[1]).zip(&q[2]).take(n).enumerate();
-        for (i, ((q0, q1), q2)) in axes {
-            let axis = model.axis(i);
-            if k >= 1 && (q2 - q1).abs() / dt > axis.max_velocity * (1.0 + JOINT_SPEED_TOLERANCE) {
-                return None;
-            }
-            if k >= 2
-                && check == Accelerations::Checked
-                && (q2 - 2.0 * q1 + q0).abs() / (dt * dt)
-                    > axis.max_accel * (1.0 + JOINT_SPEED_TOLERANCE)
-            {
-                return None;
-            }
+        if !axes_within(model, &q, k as usize, dt, check) {
+            return None;
         }
         if inside && joint_space {
             let p = model.tcp(&q[2][..n], tool).t;
-            let d = vworks_model::math::norm(vworks_model::math::sub(p, f.corner_pose.t));
+            let d = norm(sub(p, f.corner_pose.t));
             if d > f.motion.zone {
                 return None;
             }
@@ -732,6 +720,29 @@ fn corner_samples(
         }
     }
     Some(farthest)
+}
+
+/// Every axis within its speed between the last two of three samples `dt` apart (when
+/// there are two: sample `k` ≥ 1) and, when `check`ed, within its acceleration by their
+/// second difference (`k` ≥ 2), less [`JOINT_SPEED_TOLERANCE`].
+fn axes_within(
+    model: &RobotModel,
+    q: &[[f64; MAX_AXES]; 3],
+    k: usize,
+    dt: f64,
+    check: Accelerations,
+) -> bool {
+    let axes = q[0].iter().zip(&q[1]).zip(&q[2]).take(model.dof());
+    axes.enumerate().all(|(i, ((q0, q1), q2))| {
+        let axis = model.axis(i);
+        let speed =
+            k < 1 || (q2 - q1).abs() / dt <= axis.max_velocity * (1.0 + JOINT_SPEED_TOLERANCE);
+        let accel = k < 2
+            || check == Accelerations::Unchecked
+            || (q2 - 2.0 * q1 + q0).abs() / (dt * dt)
+                <= axis.max_accel * (1.0 + JOINT_SPEED_TOLERANCE);
+        speed && accel
+    })
 }
 
 /// What makes a zoned point still ahead a stop point, named for the warning: the main

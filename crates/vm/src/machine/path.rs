@@ -309,10 +309,12 @@ pub(super) fn sample_path(
             .map(|t| t.duration())
             .filter(|would| timing.duration() > would * (1.0 + 1e-9))
     };
+    // (A timed path never flies with corner ramps: its cruise bound is its bound.)
+    let rates = rate_bounds(&joints, &step_speed);
     Ok(PathSamples {
         seeds: seeds_of(&joints),
-        rates: rate_bounds(&joints, &step_speed),
-        cruise_rates: rate_bounds(&joints, &step_speed),
+        rates,
+        cruise_rates: rates,
         timing: Some(timing),
         executed: None,
         unslowed,

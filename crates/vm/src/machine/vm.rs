@@ -698,32 +698,25 @@ impl Vm {
             });
         }
         // (Once per statement: a loop repeats the motion every round.)
-        if let Some(s) = notes.slowed
-            && !self.warned(self.main.pc, WarningKind::Slowdown)
-        {
-            let j = self.arm.model().axis(s.axis);
-            let message = format!(
-                "axis {} `{}` reaches its speed limit and slows the TCP below its programmed speed: the motion takes {}, {} without that limit",
-                s.axis + 1,
-                j.name,
-                fmt_quantity(s.lasts as f64 / NS, Dim::TIME),
-                fmt_quantity(s.would as f64 / NS, Dim::TIME),
-            );
-            self.warn_once(self.main.pc, self.time, WarningKind::Slowdown, message);
+        if let Some(s) = notes.slowed {
+            self.warn_once(self.main.pc, self.time, WarningKind::Slowdown, |vm| {
+                format!(
+                    "axis {} `{}` reaches its speed limit and slows the TCP below its programmed speed: the motion takes {}, {} without that limit",
+                    s.axis + 1,
+                    vm.arm.model().axis(s.axis).name,
+                    fmt_quantity(s.lasts as f64 / NS, Dim::TIME),
+                    fmt_quantity(s.would as f64 / NS, Dim::TIME),
+                )
+            });
         }
-        if let Some((point, at)) = notes.corner_failure
-            && !self.warned(self.main.pc, WarningKind::Corner)
-        {
-            self.warn_once(
-                self.main.pc,
-                point,
-                WarningKind::Corner,
+        if let Some((point, at)) = notes.corner_failure {
+            self.warn_once(self.main.pc, point, WarningKind::Corner, |vm| {
                 format!(
                     "this motion cannot start inside the zone of the motion at line {} of {} within the zone and the TCP's and axes' limits (or faster than stopping): the robot stops at that point first (a corner path failure); a larger zone, a lower speed or a jerk limit can let it fly by",
                     at.line,
-                    self.m.file_name_of(at)
-                ),
-            );
+                    vm.m.file_name_of(at)
+                )
+            });
         }
         if point_ns < 0 || point_ns > TIME_LIMIT_NS - start {
             return Err("the motion would end after the last instant the simulator can represent (2^62 ns, about 146 years); check its speed".into());
@@ -731,18 +724,19 @@ impl Vm {
         Ok(kind)
     }
 
-    /// Whether the statement at `pc` was warned about already for `kind` (so that a
-    /// repeated statement does not even format its message again).
-    fn warned(&self, pc: u32, kind: WarningKind) -> bool {
-        self.warned.contains(&(pc, kind))
-    }
-
-    /// A warning about the statement at `pc`, at `time`, once per statement (a loop
-    /// repeats it every round).
-    fn warn_once(&mut self, pc: u32, time: i64, kind: WarningKind, message: String) {
+    /// A warning about the statement at `pc`, at `time`, once per statement and kind (a
+    /// loop repeats it every round); its `message` is made only the first time.
+    fn warn_once(
+        &mut self,
+        pc: u32,
+        time: i64,
+        kind: WarningKind,
+        message: impl FnOnce(&Self) -> String,
+    ) {
         if self.warned.contains(&(pc, kind)) {
             return;
         }
+        let message = message(self);
         self.warned.push((pc, kind));
         self.warnings.push(Warning {
             time,
@@ -764,19 +758,13 @@ impl Vm {
             return t;
         };
         // Warned at the stop point's time, where the trace shows the statement's event.
-        if self.warned(pc, WarningKind::StopPoint) {
-            return end;
-        }
-        self.warn_once(
-            pc,
-            end,
-            WarningKind::StopPoint,
+        self.warn_once(pc, end, WarningKind::StopPoint, |vm| {
             format!(
                 "{what} makes the zoned point of the motion at line {} of {} a stop point: the robot reaches it first; make that motion stop at its point to say so (`zone fine`; in RAPID, `fine`)",
                 at.line,
-                self.m.file_name_of(at)
-            ),
-        );
+                vm.m.file_name_of(at)
+            )
+        });
         end
     }
 
