@@ -124,7 +124,7 @@ def test_the_handoff_report_renders_with_a_visible_gantt_chart(browser, tmp_path
     assert "<title>vworks report: handoff</title>" in dom
     cycle_times = table(browser, "#cycle-times")
     assert cycle_times[0][:2] == ["robot", "cycle time"], cycle_times
-    assert [row[:2] for row in cycle_times[1:]] == [["r1", "46.498 s"], ["r2", "41.209 s"]]
+    assert [row[:2] for row in cycle_times[1:]] == [["r1", "46.491 s"], ["r2", "41.203 s"]]
     assert dom.count('<g class="row"') == 2
     assert dom.count('class="moving"') > 20 and dom.count('class="waiting"') > 5
     assert dom.count('class="signal"') >= 5

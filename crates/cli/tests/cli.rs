@@ -192,9 +192,9 @@ fn run_prints_a_summary_and_exits_by_outcome() {
     // The programs' two `log` lines as they happened (r2's at 35.4 s, r1's last, at its
     // end), then the summary.
     let lines: Vec<&str> = s.lines().collect();
-    assert!(lines[0].starts_with("[35.447 s] r2: "), "{s}");
-    assert!(lines[1].starts_with("[46.498 s] r1: r1 done"), "{s}");
-    assert_eq!(lines[2], "cell handoff: completed at 46.498 s", "{s}");
+    assert!(lines[0].starts_with("[35.441 s] r2: "), "{s}");
+    assert!(lines[1].starts_with("[46.491 s] r1: r1 done"), "{s}");
+    assert_eq!(lines[2], "cell handoff: completed at 46.491 s", "{s}");
     assert!(
         s.contains("r1") && s.contains("ended at") && s.contains("globals: handed=3"),
         "{s}"
@@ -557,7 +557,7 @@ fn a_log_that_cannot_be_written_fails_the_run_and_says_why() {
     let out = vworks(&["run", &workcell("handoff"), "--log", "/dev/full"]);
     assert_eq!(out.status.code(), Some(1));
     let (stdout, stderr) = (text(&out.stdout), text(&out.stderr));
-    assert!(stdout.contains("completed at 46.498 s"), "{stdout}");
+    assert!(stdout.contains("completed at 46.491 s"), "{stdout}");
     assert!(stdout.contains("log /dev/full: not written"), "{stdout}");
     assert!(
         stderr.contains("cannot write the log `/dev/full`") && stderr.contains("No space left"),
@@ -770,7 +770,7 @@ fn run_takes_a_workcells_folder() {
     let out = vworks(&["run", folder.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     assert!(
-        text(&out.stdout).contains("\ncell handoff: completed at 46.498 s\n"),
+        text(&out.stdout).contains("\ncell handoff: completed at 46.491 s\n"),
         "{}",
         text(&out.stdout)
     );

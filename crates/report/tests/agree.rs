@@ -62,8 +62,8 @@ fn the_report_gives_the_runs_own_statistics() {
 
 /// The defect of issue 15: `vworks run` gave r2 of handoff 8.720 s idle and the report
 /// 1.500 s, because the report stopped counting idle time at the robot's own end. By
-/// docs/engine.md idle runs to the run's end: r2 ends at 41.209 s in a run of 46.498 s,
-/// so its 1.500 s of delays and the 5.289 s after its end make 6.789 s in both.
+/// docs/engine.md idle runs to the run's end: r2 ends at 41.203 s in a run of 46.491 s,
+/// so its 1.500 s of delays and the 5.288 s after its end make 6.788 s in both.
 #[test]
 fn handoff_idle_time_is_one_number() {
     let c = Arc::new(vworks_cell::load(&root().join("workcells/handoff/cell.toml")).unwrap());
@@ -87,5 +87,5 @@ fn handoff_idle_time_is_one_number() {
         let run = (&s.name, s.end_time_ns, s.moving_ns, s.waiting_ns, s.idle_ns);
         assert_eq!(shown, run);
     }
-    assert_eq!((r.robots[1].idle_ns as f64 / 1e6).round(), 6789.0);
+    assert_eq!((r.robots[1].idle_ns as f64 / 1e6).round(), 6788.0);
 }

@@ -6,7 +6,8 @@
 //! The method is the reachability analysis of TOPP-RA (Pham & Pham, "A New Approach to
 //! Time-Optimal Path Parameterization Based on Reachability Analysis", IEEE T-RO 2018;
 //! PyPI `toppra`), in the state `x = ṡ²` and control `u = s̈`: the path is cut into
-//! [`SEGMENTS`] equal steps of `s`, `u` is constant on each (so `x` is linear in `s`
+//! [`SEGMENTS`] steps of `s` (equal, or *graded*: finer where the joints' slopes change
+//! fast, see [`JointPath::grade`]), `u` is constant on each (so `x` is linear in `s`
 //! and `s(t)` is a parabola), and every limit holds at both ends of every step with that
 //! step's `u` (TOPP-RA's "interpolation" scheme). With the axis's speed `q'(s)·ṡ` and
 //! acceleration `q'(s)·s̈ + q''(s)·ṡ²`, each limit is linear in `(u, x)`:
@@ -27,7 +28,8 @@ pub const SEGMENTS: usize = 256;
 /// Points where the limits hold: the ends of the steps.
 pub const KNOTS: usize = SEGMENTS + 1;
 
-/// The joints along a path at the knots: `q[k]` at `s = k / SEGMENTS`, axes first.
+/// The joints along a path at the knots: `q[k]` at `s = k / SEGMENTS` (or at the graded
+/// knots, [`JointPath::knot`]), axes first.
 #[derive(Clone, Debug)]
 pub struct JointPath {
     /// How many axes move.
@@ -42,6 +44,9 @@ pub struct JointPath {
     /// e.g. from points 1/4 to 1/4096 of a step in): where a path starts or ends near a singularity
     /// its slope there is steeper than the knots show. 0 where not known.
     pub end_slopes: [[f64; MAX_AXES]; 2],
+    /// Where each knot is (`s`, 0 to 1): `k / SEGMENTS` unless graded.
+    knots: [f64; KNOTS],
+    graded: bool,
 }
 
 impl JointPath {
@@ -52,7 +57,102 @@ impl JointPath {
             q: [[0.0; MAX_AXES]; KNOTS],
             room: [1.0; SEGMENTS],
             end_slopes: [[0.0; MAX_AXES]; 2],
+            knots: std::array::from_fn(|k| k as f64 / SEGMENTS as f64),
+            graded: false,
         }
+    }
+
+    /// Where knot `k` is on the path (`s`, 0 to 1).
+    pub fn knot(&self, k: usize) -> f64 {
+        self.knots[k.min(SEGMENTS)]
+    }
+
+    /// Every knot's place on the path.
+    pub fn knots(&self) -> &[f64; KNOTS] {
+        &self.knots
+    }
+
+    /// How long step `k` (from knot `k` to `k + 1`) is, in `s`.
+    pub fn step(&self, k: usize) -> f64 {
+        let k = k.min(SEGMENTS - 1);
+        self.knots[k + 1] - self.knots[k]
+    }
+
+    /// Whether the knots are graded (not equal steps).
+    pub fn graded(&self) -> bool {
+        self.graded
+    }
+
+    /// The knots that grade a path whose joints are known at equal steps (`self.q` at
+    /// `k / SEGMENTS`): each step's share of the knots grows with how fast the axes'
+    /// slopes `q'` change across it, relative to their size: from 1 where they change by at
+    /// most [`GRADE_CHANGE`] of themselves to [`GRADE_MAX`] times as many (only where an
+    /// axis's slope is at least [`GRADE_FLOOR`] of its steepest). A timing with
+    /// one `s̈` per step keeps an axis's acceleration at the step's steeper end, so where a
+    /// path nears a singularity (a slope growing fivefold over a few steps) equal steps
+    /// lose up to a few per cent of its time. `None` where equal steps serve (no step's
+    /// slopes change by more than [`GRADE_START`] × [`GRADE_CHANGE`]). The caller samples the joints at the
+    /// knots given and sets them with [`JointPath::set_knots`].
+    pub fn grade(&self) -> Option<[f64; KNOTS]> {
+        if self.graded {
+            return None;
+        }
+        let mut slope = [[0.0f64; MAX_AXES]; KNOTS];
+        let mut largest = [0.0f64; MAX_AXES];
+        for (k, row) in slope.iter_mut().enumerate() {
+            for (i, d) in row.iter_mut().enumerate().take(self.axes) {
+                *d = self.derivatives(k, i).0;
+                largest[i] = largest[i].max(d.abs());
+            }
+        }
+        // Per step, its density of knots.
+        let mut density = [1.0f64; SEGMENTS];
+        let mut graded = false;
+        for (k, rho) in density.iter_mut().enumerate() {
+            for i in 0..self.axes {
+                let (a, b) = (slope[k][i], slope[k + 1][i]);
+                // (Only where the axis is near its steepest can it bind.)
+                let size = a.abs().max(b.abs());
+                if size > 0.0 && size >= GRADE_FLOOR * largest[i] {
+                    let change = (b - a).abs() / size / GRADE_CHANGE;
+                    *rho = rho.max(change.min(GRADE_MAX));
+                }
+            }
+            graded |= *rho > GRADE_START;
+        }
+        if !graded {
+            return None;
+        }
+        // Neighbouring steps differ by at most GRADE_GROWTH: finite differences across a
+        // sudden change of step lose their accuracy.
+        for k in 1..SEGMENTS {
+            density[k] = density[k].max(density[k - 1] / GRADE_GROWTH);
+        }
+        for k in (0..SEGMENTS - 1).rev() {
+            density[k] = density[k].max(density[k + 1] / GRADE_GROWTH);
+        }
+        // Knots at equal shares of the density's integral (linear within each step).
+        let total: f64 = density.iter().sum();
+        let mut out = [0.0f64; KNOTS];
+        out[SEGMENTS] = 1.0;
+        let (mut step, mut before) = (0usize, 0.0f64);
+        for (j, s) in out.iter_mut().enumerate().take(SEGMENTS).skip(1) {
+            let want = total * j as f64 / SEGMENTS as f64;
+            while step < SEGMENTS - 1 && before + density[step] < want {
+                before += density[step];
+                step += 1;
+            }
+            let within = ((want - before) / density[step]).clamp(0.0, 1.0);
+            *s = (step as f64 + within) / SEGMENTS as f64;
+        }
+        Some(out)
+    }
+
+    /// Puts the knots at `s` (increasing, from 0 to 1); the joints `q` are then the
+    /// caller's to sample there.
+    pub fn set_knots(&mut self, s: &[f64; KNOTS]) {
+        self.knots = *s;
+        self.graded = true;
     }
 
     /// Axis `i`'s derivatives `(q', q'')` at knot `k` by finite differences (central
@@ -65,6 +165,23 @@ impl JointPath {
             let s = self.end_slopes[end][i];
             if s.abs() > d1.abs() { s } else { d1 }
         };
+        if self.graded {
+            // Three knots around k (the first or last three at the ends), by the
+            // derivatives of the parabola through them.
+            let c = k.clamp(1, SEGMENTS - 1);
+            let (s0, s1, s2) = (self.knots[c - 1], self.knots[c], self.knots[c + 1]);
+            let (h1, h2) = (s1 - s0, s2 - s1);
+            let (d01, d12) = ((q(c) - q(c - 1)) / h1, (q(c + 1) - q(c)) / h2);
+            let d2 = 2.0 * (d12 - d01) / (h1 + h2);
+            // The slope at knot k: the parabola's, at s_k.
+            let mid = 0.5 * (s0 + s1);
+            let d1 = d01 + d2 * (self.knots[k] - mid);
+            return match k {
+                0 => (steeper(d1, 0), d2),
+                SEGMENTS => (steeper(d1, 1), d2),
+                _ => (d1, d2),
+            };
+        }
         if k == 0 {
             let d1 = (-3.0 * q(0) + 4.0 * q(1) - q(2)) * 0.5 * n;
             let d2 = (2.0 * q(0) - 5.0 * q(1) + 4.0 * q(2) - q(3)) * n * n;
@@ -80,6 +197,20 @@ impl JointPath {
         }
     }
 }
+
+/// How much of itself an axis's slope may change across one step before the path is
+/// graded ([`JointPath::grade`]): 1 %.
+pub const GRADE_CHANGE: f64 = 0.01;
+/// The most a graded step may be finer than the rest.
+pub const GRADE_MAX: f64 = 12.0;
+/// Steps where an axis's slope is below this fraction of its steepest do not grade the
+/// path for that axis.
+const GRADE_FLOOR: f64 = 0.5;
+/// The most two neighbouring steps of a graded path differ by (a ratio).
+const GRADE_GROWTH: f64 = 1.15;
+/// A path is graded only where some step's slopes change by more than this many times
+/// [`GRADE_CHANGE`].
+const GRADE_START: f64 = 5.0;
 
 /// The limits a path's timing keeps.
 #[derive(Clone, Copy, Debug)]
@@ -123,6 +254,8 @@ pub enum TimingError {
 pub struct Timing {
     x: [f64; KNOTS],
     t: [f64; KNOTS],
+    /// The path's knots ([`JointPath::knots`]).
+    s: [f64; KNOTS],
 }
 
 /// Where on the path, how fast and how it accelerates at a time.
@@ -148,8 +281,14 @@ struct Line {
 /// both knots and halfway, `x = x_k + 2Δ·u·(s − s_k)/Δ` along the step. Halfway the
 /// speed `q'` is the exact central difference of the two knots. `out` holds at most
 /// `6·axes + 5` lines.
-fn step_lines(path: &JointPath, lim: &Limits<'_>, k: usize, out: &mut [Line]) -> usize {
-    let delta = 1.0 / SEGMENTS as f64;
+fn step_lines(
+    path: &JointPath,
+    slopes: &KnotSlopes,
+    lim: &Limits<'_>,
+    k: usize,
+    out: &mut [Line],
+) -> usize {
+    let delta = path.step(k);
     let mut m = 0;
     let mut push = |a: f64, b: f64, c: f64| {
         out[m] = Line { a, b, c };
@@ -163,13 +302,14 @@ fn step_lines(path: &JointPath, lim: &Limits<'_>, k: usize, out: &mut [Line]) ->
     // (where, x there = x_k + shift·u)
     for (point, shift) in [(0u8, 0.0), (1, delta), (2, 2.0 * delta)] {
         let mut x_max = lim.path_speed * lim.path_speed;
+        #[allow(clippy::needless_range_loop)] // (axis i of the knots, the joints and the limits)
         for i in 0..path.axes {
             let (d1, d2) = match point {
-                0 => path.derivatives(k, i),
-                2 => path.derivatives(k + 1, i),
+                0 => slopes[k][i],
+                2 => slopes[k + 1][i],
                 _ => (
-                    (path.q[k + 1][i] - path.q[k][i]) * SEGMENTS as f64,
-                    0.5 * (path.derivatives(k, i).1 + path.derivatives(k + 1, i).1),
+                    (path.q[k + 1][i] - path.q[k][i]) / delta,
+                    0.5 * (slopes[k][i].1 + slopes[k + 1][i].1),
                 ),
             };
             let amax = lim.axis_accel[i] * path.room[k];
@@ -189,6 +329,9 @@ fn step_lines(path: &JointPath, lim: &Limits<'_>, k: usize, out: &mut [Line]) ->
     }
     m
 }
+
+/// Every axis's `(q', q'')` at every knot ([`JointPath::derivatives`]).
+type KnotSlopes = [[(f64, f64); MAX_AXES]; KNOTS];
 
 /// The largest `x ≥ 0` for which some `u` satisfies every line. Rest (`u = 0, x = 0`)
 /// satisfies them all, so the feasible `x` are an interval from 0: below the lines that
@@ -308,7 +451,12 @@ impl Timing {
                 return Err(TimingError::NotFinite { knot, axis });
             }
         }
-        let two_delta = 2.0 / SEGMENTS as f64;
+        let mut slopes = [[(0.0, 0.0); MAX_AXES]; KNOTS];
+        for (k, row) in slopes.iter_mut().enumerate() {
+            for (i, d) in row.iter_mut().enumerate().take(path.axes) {
+                *d = path.derivatives(k, i);
+            }
+        }
         let mut lines = [Line {
             a: 0.0,
             b: 0.0,
@@ -318,7 +466,8 @@ impl Timing {
         let mut reach = [0.0f64; KNOTS];
         reach[SEGMENTS] = 0.0;
         for k in (0..SEGMENTS).rev() {
-            let mut m = step_lines(path, limits, k, &mut lines);
+            let two_delta = 2.0 * path.step(k);
+            let mut m = step_lines(path, &slopes, limits, k, &mut lines);
             // x_{k+1} = x + 2Δu within [0, K_{k+1}].
             lines[m] = Line {
                 a: two_delta,
@@ -348,7 +497,8 @@ impl Timing {
         let mut x = [0.0f64; KNOTS];
         let mut t = [0.0f64; KNOTS];
         for k in 0..SEGMENTS {
-            let m = step_lines(path, limits, k, &mut lines);
+            let two_delta = 2.0 * path.step(k);
+            let m = step_lines(path, &slopes, limits, k, &mut lines);
             let u_max = largest_u(&lines[..m], x[k]);
             let u = u_max.min((reach[k + 1] - x[k]) / two_delta);
             x[k + 1] = (x[k] + two_delta * u).clamp(0.0, reach[k + 1]);
@@ -367,7 +517,11 @@ impl Timing {
                 .map_or(0, |p| p + 1);
             return Err(TimingError::Stuck { knot, axis: 0 });
         }
-        Ok(Timing { x, t })
+        Ok(Timing {
+            x,
+            t,
+            s: path.knots,
+        })
     }
 
     /// The same timing `factor` (≥ 1) times slower: every speed divided by it, every
@@ -387,7 +541,7 @@ impl Timing {
     /// `k + 1`): the timing's state anywhere on the step is `x_k + 2·s̈·(s − s_k)`.
     pub fn step_state(&self, k: usize) -> (f64, f64) {
         let k = k.min(SEGMENTS - 1);
-        let delta = 1.0 / SEGMENTS as f64;
+        let delta = self.s[k + 1] - self.s[k];
         (self.x[k], (self.x[k + 1] - self.x[k]) / (2.0 * delta))
     }
 
@@ -433,10 +587,9 @@ impl Timing {
             };
         }
         let (k, tau) = self.step_of(time);
-        let delta = 1.0 / SEGMENTS as f64;
-        let u = (self.x[k + 1] - self.x[k]) / (2.0 * delta);
+        let (_, u) = self.step_state(k);
         let v0 = self.x[k].sqrt();
-        let s = (k as f64 * delta + v0 * tau + 0.5 * u * tau * tau).clamp(0.0, 1.0);
+        let s = (self.s[k] + v0 * tau + 0.5 * u * tau * tau).clamp(0.0, 1.0);
         PathState {
             s,
             speed: (v0 + u * tau).max(0.0),
@@ -452,10 +605,12 @@ impl Timing {
         if s >= 1.0 {
             return self.duration();
         }
-        let delta = 1.0 / SEGMENTS as f64;
-        let k = ((s * SEGMENTS as f64) as usize).min(SEGMENTS - 1);
-        let ds = s - k as f64 * delta;
-        let u = (self.x[k + 1] - self.x[k]) / (2.0 * delta);
+        // The last knot at or before s.
+        let k = self.s[..SEGMENTS]
+            .partition_point(|sk| *sk <= s)
+            .saturating_sub(1);
+        let ds = s - self.s[k];
+        let (_, u) = self.step_state(k);
         let v0 = self.x[k].sqrt();
         // ½u·τ² + v0·τ = ds, in the form that does not cancel.
         let root = (v0 * v0 + 2.0 * u * ds).max(0.0).sqrt();

@@ -128,12 +128,13 @@ pub(super) fn sample_path(
     };
     for k in 1..KNOTS {
         let prev = joints.q[k - 1];
-        joints.q[k] = joints_at(k as f64 / SEGMENTS as f64, &prev)?;
+        joints.q[k] = joints_at(joints.knot(k), &prev)?;
     }
+    check_turns(&joints)?;
     // Close to each end, the steepest slope of points 1/4 to 1/4096 of a step in: a
     // path that starts or ends near a singularity is steeper there than the knots show.
-    let delta = 1.0 / SEGMENTS as f64;
     for (end, (s0, sign)) in [(0.0, 1.0), (1.0, -1.0)].into_iter().enumerate() {
+        let delta = joints.step(end * (SEGMENTS - 1));
         let q0 = joints.q[end * SEGMENTS];
         for frac in [
             0.25,
@@ -153,18 +154,6 @@ pub(super) fn sample_path(
             }
         }
     }
-    for k in 1..KNOTS {
-        for i in 0..n {
-            let turn = (joints.q[k][i] - joints.q[k - 1][i]).abs();
-            if turn > MAX_KNOT_TURN {
-                return Err(PlanError::ConfigurationJump {
-                    axis: i,
-                    at_percent: k as f64 * 100.0 / SEGMENTS as f64,
-                    turn_deg: turn.to_degrees(),
-                });
-            }
-        }
-    }
     let mut speed = [0.0f64; MAX_AXES];
     let mut accel = [0.0f64; MAX_AXES];
     for i in 0..n {
@@ -173,7 +162,7 @@ pub(super) fn sample_path(
         accel[i] = j.max_accel;
     }
     let end = joints.q[SEGMENTS];
-    let derivatives = knot_derivatives(&joints);
+    let mut derivatives = knot_derivatives(&joints);
     let mut inner = Inner::new();
     let limits_of = (&speed[..n], &accel[..n]);
     // Without an acceleration of its own (no `accel`, no TCP limit in the model) the path
@@ -217,6 +206,19 @@ pub(super) fn sample_path(
             return Ok(profile_samples(&joints, lower, check, Some(*lower), end));
         }
     }
+    // Where the axes' slopes change fast (near a singularity), the timing takes finer
+    // steps there: the path is sampled again at graded knots (only paths that are timed:
+    // a profile that fits needs no steps).
+    if let Some(knots) = joints.grade() {
+        joints.set_knots(&knots);
+        for (k, s) in knots.iter().enumerate().skip(1) {
+            let prev = joints.q[k - 1];
+            joints.q[k] = joints_at(*s, &prev)?;
+        }
+        check_turns(&joints)?;
+        derivatives = knot_derivatives(&joints);
+        inner = Inner::new();
+    }
     // The timing keeps a margin below the limits the checks measure against.
     let speed_timed = speed.map(|v| v * (1.0 - TIMING_MARGIN));
     let accel_timed = accel.map(|a| a * (1.0 - TIMING_MARGIN));
@@ -231,7 +233,7 @@ pub(super) fn sample_path(
             TimingError::Stuck { knot, axis } | TimingError::NotFinite { knot, axis } => {
                 PlanError::Singular {
                     axis,
-                    at_percent: knot as f64 * 100.0 / SEGMENTS as f64,
+                    at_percent: joints.knot(knot) * 100.0,
                 }
             }
             // (The limits come from a checked model and a checked profile.)
@@ -251,7 +253,7 @@ pub(super) fn sample_path(
         let mut near = [false; SEGMENTS];
         for (k, flag) in near.iter_mut().enumerate() {
             let (x, u) = timing.step_state(k);
-            let x1 = x + 2.0 * u / SEGMENTS as f64;
+            let x1 = x + 2.0 * u * joints.step(k);
             *flag = [(k, x), (k + 1, x1)].iter().any(|&(knot, x)| {
                 (0..n).any(|i| {
                     let (d1, d2) = derivatives[knot][i];
@@ -264,7 +266,7 @@ pub(super) fn sample_path(
         inner.fill(&joints, &near, joints_at)?;
         let state = |k: usize, s: f64| {
             let (x, u) = timing.step_state(k);
-            (x + 2.0 * u * (s - k as f64 / SEGMENTS as f64), u)
+            (x + 2.0 * u * (s - joints.knot(k)), u)
         };
         let (rv, ra) = inner.ratios(&joints, &speed[..n], &accel[..n], state, &mut ratios);
         if rv.max(ra) <= 1.0 {
@@ -323,6 +325,24 @@ pub(super) fn sample_path(
     })
 }
 
+/// No axis turns more than [`MAX_KNOT_TURN`] between two knots (else the arm changes
+/// configuration there).
+fn check_turns(joints: &JointPath) -> Result<(), PlanError> {
+    for k in 1..KNOTS {
+        for i in 0..joints.axes {
+            let turn = (joints.q[k][i] - joints.q[k - 1][i]).abs();
+            if turn > MAX_KNOT_TURN {
+                return Err(PlanError::ConfigurationJump {
+                    axis: i,
+                    at_percent: joints.knot(k) * 100.0,
+                    turn_deg: turn.to_degrees(),
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
 /// How near its speed limit (its fraction) an axis must come under a timing for the
 /// timing to be compared with one without the axis speeds (a `slowdown` warning).
 const SPEED_BINDS: f64 = 0.99;
@@ -370,7 +390,7 @@ fn check_profile(
     let mut sd = [0.0f64; KNOTS];
     let mut near = [false; SEGMENTS];
     for (k, sd_k) in sd.iter_mut().enumerate() {
-        let s = k as f64 / SEGMENTS as f64;
+        let s = joints.knot(k);
         let (v_path, a_path) = state_at_distance(profile, s * profile.dist);
         *sd_k = v_path;
         for i in 0..joints.axes {
@@ -417,7 +437,9 @@ fn profile_samples(
     // at most that fast.
     let peak_s = profile.at(0.5 * profile.t_total) / profile.dist.max(f64::MIN_POSITIVE);
     let peak = profile.speed_at(0.5 * profile.t_total);
-    let peak_step = ((peak_s * SEGMENTS as f64) as usize).min(SEGMENTS - 1);
+    let peak_step = joints.knots()[..SEGMENTS]
+        .partition_point(|s| *s <= peak_s)
+        .saturating_sub(1);
     let mut step_speed = [0.0f64; SEGMENTS];
     for (k, v) in step_speed.iter_mut().enumerate() {
         *v = if k == peak_step {
@@ -478,7 +500,7 @@ fn lower_profile(
     };
     // Bisection on the knots alone (cheap: no IK), then the full check between them; where
     // that finds an axis past a limit, a little lower.
-    let fits = |a: f64| fits_at_knots(derivatives, joints.axes, &shaped(a), limits);
+    let fits = |a: f64| fits_at_knots(joints, derivatives, &shaped(a), limits);
     let mut a = hi;
     if !fits(hi) {
         let mut lo = 0.0;
@@ -540,15 +562,15 @@ fn knot_derivatives(joints: &JointPath) -> KnotDerivatives {
 
 /// Whether every axis keeps its speed and acceleration under `profile` at every knot.
 fn fits_at_knots(
+    joints: &JointPath,
     derivatives: &KnotDerivatives,
-    axes: usize,
     profile: &Profile,
     (speed, accel): (&[f64], &[f64]),
 ) -> bool {
     derivatives.iter().enumerate().all(|(k, row)| {
-        let s = k as f64 / SEGMENTS as f64;
+        let s = joints.knot(k);
         let (v_path, a_path) = state_at_distance(profile, s * profile.dist);
-        row[..axes].iter().enumerate().all(|(i, &d)| {
+        row[..joints.axes].iter().enumerate().all(|(i, &d)| {
             let (v, a) = axis_load(d, v_path, a_path);
             v <= speed[i] * (1.0 + JOINT_SPEED_TOLERANCE)
                 && a <= accel[i] * (1.0 + JOINT_SPEED_TOLERANCE)
@@ -572,11 +594,24 @@ const LOWER_REFINE: usize = 8;
 /// Knots kept as IK seeds for the executed path: every 16th (0, 16, …, 256).
 pub(super) const SEEDS: usize = SEGMENTS / 16 + 1;
 
-/// The seeds of a sampled path: its joints at every 16th knot.
+/// The seeds of a sampled path: its joints at every 16th knot (at the knots nearest
+/// every 16th of the path where they are graded).
 fn seeds_of(joints: &JointPath) -> [[f64; MAX_AXES]; SEEDS] {
     let mut out = [[0.0; MAX_AXES]; SEEDS];
-    for (j, s) in out.iter_mut().enumerate() {
-        *s = joints.q[j * 16];
+    for (j, seed) in out.iter_mut().enumerate() {
+        let k = if joints.graded() {
+            let s = j as f64 / (SEEDS - 1) as f64;
+            let knots = joints.knots();
+            let after = knots.partition_point(|v| *v < s).min(SEGMENTS);
+            if after > 0 && s - knots[after - 1] < knots[after] - s {
+                after - 1
+            } else {
+                after
+            }
+        } else {
+            j * 16
+        };
+        *seed = joints.q[k];
     }
     out
 }
@@ -618,7 +653,7 @@ impl Inner {
             self.filled[k] = true;
             let mut prev = joints.q[k];
             for (j, q) in quarters.iter_mut().enumerate() {
-                let s = (k as f64 + (j + 1) as f64 / 4.0) / SEGMENTS as f64;
+                let s = joints.knot(k) + (j + 1) as f64 / 4.0 * joints.step(k);
                 *q = joints_at(s, &prev)?;
                 prev = *q;
             }
@@ -638,9 +673,9 @@ impl Inner {
         state: impl Fn(usize, f64) -> (f64, f64),
         out: &mut [f64; SEGMENTS],
     ) -> (f64, f64) {
-        let h = 0.25 / SEGMENTS as f64;
         let (mut rv, mut ra) = (0.0f64, 0.0f64);
         for (k, r) in out.iter_mut().enumerate() {
+            let h = 0.25 * joints.step(k);
             let p = |j: usize| match j {
                 0 => &joints.q[k],
                 4 => &joints.q[k + 1],
@@ -651,7 +686,7 @@ impl Inner {
                 continue;
             }
             for j in 1..4 {
-                let s = (k as f64 + j as f64 / 4.0) / SEGMENTS as f64;
+                let s = joints.knot(k) + j as f64 * h;
                 let (x, u) = state(k, s);
                 let sd = x.max(0.0).sqrt();
                 for i in 0..joints.axes {
@@ -696,7 +731,7 @@ fn rate_bounds(joints: &JointPath, step_speed: &[f64; SEGMENTS]) -> [f64; MAX_AX
     let mut rates = [0.0f64; MAX_AXES];
     for (k, v) in step_speed.iter().enumerate() {
         for (i, r) in rates.iter_mut().enumerate().take(joints.axes) {
-            let chord = (joints.q[k + 1][i] - joints.q[k][i]).abs() * SEGMENTS as f64;
+            let chord = (joints.q[k + 1][i] - joints.q[k][i]).abs() / joints.step(k);
             let d = chord
                 .max(joints.derivatives(k, i).0.abs())
                 .max(joints.derivatives(k + 1, i).0.abs());
