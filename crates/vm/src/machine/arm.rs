@@ -11,7 +11,7 @@ use vworks_model::math::Iso;
 
 use super::blend::{self, Fading, Planned};
 use super::path::PathMemo;
-use super::plan::{self, Longer, MotionOperands, PlanError, PlanFrom, Slowed, Trajectory};
+use super::plan::{self, Capped, Longer, MotionOperands, PlanError, PlanFrom, Slowed, Trajectory};
 use crate::MAX_AXES;
 use crate::bytecode::SrcPos;
 use crate::motion::NS;
@@ -42,6 +42,8 @@ pub(super) struct PlanNotes {
     pub(super) longer: Option<Longer>,
     /// It was slowed to keep an axis within its speed limit.
     pub(super) slowed: Option<Slowed>,
+    /// Its programmed TCP speed or acceleration was above the model's.
+    pub(super) capped: Option<Capped>,
     /// It cannot start inside the zone of the motion at this statement: the robot stops at
     /// that point (at this time) first.
     pub(super) corner_failure: Option<(i64, SrcPos)>,
@@ -207,10 +209,12 @@ impl Arm {
             duration_ns: mut point_ns,
             longer,
             slowed,
+            capped,
         } = plan::plan(&self.model, &from, ops, &mut self.memo)?;
         let mut notes = PlanNotes {
             longer,
             slowed,
+            capped,
             corner_failure: None,
         };
         let model = &*self.model;

@@ -282,6 +282,16 @@ pub(super) struct Plan {
     pub(super) longer: Option<Longer>,
     /// It was slowed to keep an axis within its speed limit.
     pub(super) slowed: Option<Slowed>,
+    /// Its programmed TCP speed or acceleration was above the model's.
+    pub(super) capped: Option<Capped>,
+}
+
+/// A Cartesian motion asked to move faster than the model's TCP limits allow: the TCP
+/// speed (asked, the model's) and the acceleration (asked, the model's), where above.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Capped {
+    pub(super) speed: Option<(f64, f64)>,
+    pub(super) accel: Option<(f64, f64)>,
 }
 
 /// A motion that takes `lasts` ns where `want` were asked, the fastest it can (`how`).
@@ -695,6 +705,7 @@ fn plan_move_j(
         duration_ns,
         longer,
         slowed: None,
+        capped: None,
     })
 }
 
@@ -743,6 +754,14 @@ fn plan_cartesian(
     let tcp = model.tcp;
     let tcp_speed = tcp.speed.unwrap_or(f64::INFINITY);
     let tcp_accel = tcp.accel.unwrap_or(f64::INFINITY);
+    // (Said once per statement: a `slowdown` warning.)
+    let mut capped = None;
+    if duration_ns.is_none() && (v > tcp_speed || accel.is_some_and(|a| a > tcp_accel)) {
+        capped = Some(Capped {
+            speed: (v > tcp_speed).then_some((v, tcp_speed)),
+            accel: accel.filter(|a| *a > tcp_accel).map(|a| (a, tcp_accel)),
+        });
+    }
     v = v.min(tcp_speed);
     let mut a = accel.unwrap_or(f64::INFINITY).min(tcp_accel);
     let len = path.length();
@@ -830,6 +849,7 @@ fn plan_cartesian(
             duration_ns: 0,
             longer,
             slowed: None,
+            capped,
         });
     }
     // Joints along the path: reachable, and within every axis's speed and acceleration
@@ -898,6 +918,7 @@ fn plan_cartesian(
         duration_ns,
         longer,
         slowed,
+        capped,
     })
 }
 

@@ -14,7 +14,7 @@ use super::blend::stop_point_reason;
 use super::describe::{self, describe};
 use super::handlers::Handlers;
 use super::interp::{self, Interp};
-use super::plan::MotionOperands;
+use super::plan::{Capped, MotionOperands};
 use super::pulses::Pulses;
 use super::remote::{Remote, Request};
 use super::state::{Source, State};
@@ -698,15 +698,34 @@ impl Vm {
             });
         }
         // (Once per statement: a loop repeats the motion every round.)
-        if let Some(s) = notes.slowed {
+        if notes.slowed.is_some() || notes.capped.is_some() {
+            let (slowed, capped) = (notes.slowed, notes.capped);
             self.warn_once(self.main.pc, self.time, WarningKind::Slowdown, |vm| {
-                format!(
-                    "axis {} `{}` reaches its speed limit and slows the TCP below its programmed speed: the motion takes {}, {} without that limit",
-                    s.axis + 1,
-                    vm.arm.model().axis(s.axis).name,
-                    fmt_quantity(s.lasts as f64 / NS, Dim::TIME),
-                    fmt_quantity(s.would as f64 / NS, Dim::TIME),
-                )
+                let mut parts = Vec::new();
+                if let Some(Capped { speed: Some((asked, max)), .. }) = capped {
+                    parts.push(format!(
+                        "the programmed TCP speed {} is above the robot's TCP speed {} (its model's `<tcp_limits speed>` or the workcell's `tcp_speed`): the TCP moves at most that fast",
+                        fmt_quantity(asked, Dim::SPEED),
+                        fmt_quantity(max, Dim::SPEED),
+                    ));
+                }
+                if let Some(Capped { accel: Some((asked, max)), .. }) = capped {
+                    parts.push(format!(
+                        "the programmed acceleration {} is above the robot's TCP acceleration {} (its model's `<tcp_limits acceleration>` or the workcell's `tcp_acceleration`): the TCP accelerates at most that hard",
+                        fmt_quantity(asked, Dim::ACCEL),
+                        fmt_quantity(max, Dim::ACCEL),
+                    ));
+                }
+                if let Some(s) = slowed {
+                    parts.push(format!(
+                        "axis {} `{}` reaches its speed limit and slows the TCP below its programmed speed: the motion takes {}, {} without that limit",
+                        s.axis + 1,
+                        vm.arm.model().axis(s.axis).name,
+                        fmt_quantity(s.lasts as f64 / NS, Dim::TIME),
+                        fmt_quantity(s.would as f64 / NS, Dim::TIME),
+                    ));
+                }
+                parts.join("; ")
             });
         }
         if let Some((point, at)) = notes.corner_failure {
