@@ -34,8 +34,10 @@ For each built-in 6-axis arm (irb120, kr6r900, lrmate200id, ur5) and N random ca
    the built-in arms give theirs, docs/models.md), and for s the programmed TCP
    speed V (at most the model's `<tcp_limits speed>`) and the model's TCP acceleration
    (`<tcp_limits acceleration>`; none where the model gives none: the axes alone bound the
-   path, as vworks does; `tcp_accel_ratio` in the JSON is the recorded peak TCP
-   acceleration over that limit). toppra's duration is
+   path, as vworks does; on an arc the TCP's whole acceleration, along it and towards
+   its centre, through three more virtual joints, the TCP's position, and a
+   SecondOrderConstraint; `tcp_accel_ratio` in the JSON is the recorded peak TCP
+   acceleration, as a vector, over that limit). toppra's duration is
    sum 2 ds / (sd_i + sd_i+1) over its grid (piecewise-constant path acceleration).
 4. From the recorded joints: peak joint speed and peak joint acceleration as ratios of
    the limits (largest over the axes), by finite differences on the ~1 ms grid (first
@@ -238,23 +240,40 @@ def path_samples(q, p):
             keep.append(i)
     if keep[-1] != len(s) - 1:
         keep[-1] = len(s) - 1
-    return s[keep], q[keep]
+    return s[keep], q[keep], p[keep]
 
 
-def toppra_time(s, q, vlim, alim, speed, accel=float("inf")):
+def toppra_time(s, q, vlim, alim, speed, accel=float("inf"), plane=None):
     """Time-optimal duration along q(s) (cubic spline), joints within vlim/alim, the
-    virtual joint s within speed and accel (inf: none). None if toppra finds no profile."""
+    virtual joint s within speed and accel (inf: none). An arc (`plane`: the TCP's
+    positions at the knots and two unit vectors spanning the arc's plane) also keeps the
+    TCP's whole acceleration (along the arc and towards its centre) within accel: three
+    more virtual joints, the TCP's position, whose acceleration stays inside a 64-sided
+    polygon around that disk (at most 0.12 % outside it: this oracle is, if anything,
+    faster than the disk allows). None if toppra finds no profile."""
     import toppra as ta
     import toppra.algorithm as algo
     import toppra.constraint as constraint
 
-    way = np.column_stack([q, s])
+    curved = plane is not None and np.isfinite(accel)
+    way = np.column_stack([q, s] + ([plane[0] - plane[0][0]] if curved else []))
     path = ta.SplineInterpolator(s, way)
     v = np.append(vlim, speed)
     a = np.append(alim, accel if np.isfinite(accel) else UNBOUNDED)
+    if curved:
+        v = np.append(v, [UNBOUNDED] * 3)
+        a = np.append(a, [UNBOUNDED] * 3)
     cons = [constraint.JointVelocityConstraint(np.column_stack([-v, v])),
             constraint.JointAccelerationConstraint(
                 np.column_stack([-a, a]), discretization_scheme=constraint.DiscretizationType.Interpolation)]
+    if curved:
+        e1, e2 = plane[1], plane[2]
+        phi = np.arange(64) * 2.0 * np.pi / 64
+        faces = np.outer(np.cos(phi), e1) + np.outer(np.sin(phi), e2)
+        g = np.full(64, accel)
+        cons.append(constraint.SecondOrderConstraint(
+            lambda q_, qd_, qdd_: qdd_[-3:], lambda q_: faces, lambda q_: g, dof=way.shape[1],
+            discretization_scheme=constraint.DiscretizationType.Interpolation))
     # Uniform, and dense near both ends: a ramp shorter than one uniform step (a slow, long
     # line) would otherwise cost toppra up to a step's time at each end.
     ends = (s[-1] - s[0]) * np.geomspace(1e-6, 2.0 / (GRIDPOINTS - 1), END_GRIDPOINTS)
@@ -269,16 +288,22 @@ def toppra_time(s, q, vlim, alim, speed, accel=float("inf")):
     return float(np.sum(2.0 * np.diff(grid) / mean))
 
 
-def peaks(t, q, s, limits, speed, accel=float("inf")):
+def peaks(t, q, s, limits, speed, accel=float("inf"), p=None):
     """Peak joint speed and acceleration ratios (largest over the axes, and which axis),
-    and the TCP's, by finite differences on the recorded grid."""
+    and the TCP's, by finite differences on the recorded grid (the TCP's acceleration as
+    a vector from its positions `p`, so an arc's centripetal part counts; along the path
+    without them)."""
     dt = np.diff(t)
     qd = np.diff(q, axis=0) / dt[:, None]
     qdd = np.diff(qd, axis=0) / (0.5 * (t[2:] - t[:-2]))[:, None]
     v_ratio = np.abs(qd).max(axis=0) / limits[:, 2]
     a_ratio = np.abs(qdd).max(axis=0) / limits[:, 3]
     sd = np.diff(s) / dt
-    sdd = np.diff(sd) / (0.5 * (t[2:] - t[:-2]))
+    if p is None:
+        sdd = np.diff(sd) / (0.5 * (t[2:] - t[:-2]))
+    else:
+        pd = np.diff(p, axis=0) / dt[:, None]
+        sdd = np.linalg.norm(np.diff(pd, axis=0) / (0.5 * (t[2:] - t[:-2]))[:, None], axis=1)
     return {
         "peak_joint_speed_ratio": float(v_ratio.max()), "peak_speed_axis": int(v_ratio.argmax()) + 1,
         "peak_joint_accel_ratio": float(a_ratio.max()), "peak_accel_axis": int(a_ratio.argmax()) + 1,
@@ -332,7 +357,7 @@ def run_case(vworks, folder, model, index, case, seed, limits, kind="line"):
         row["via_miss_mm"] = polyline_distance(p[0] + via, p) * 1000
     row["end_error_mm"] = float(np.linalg.norm(p[-1] - p[0] - offset) * 1000)
     s_all = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
-    row.update(peaks(t, q, s_all, limits, speed, tcp_accel))
+    row.update(peaks(t, q, s_all, limits, speed, tcp_accel, p))
     if row["peak_joint_speed_ratio"] > JUMP:
         step = np.abs(np.diff(q, axis=0))
         i, j = np.unravel_index(step.argmax(), step.shape)
@@ -340,11 +365,15 @@ def run_case(vworks, folder, model, index, case, seed, limits, kind="line"):
                        "path_fraction": float(s_all[i + 1] / s_all[-1])}
         return row  # no smooth path for toppra: left out of the ratios
 
-    s, qk = path_samples(q, p)
+    s, qk, pk = path_samples(q, p)
     row["knots"] = len(s)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        best = toppra_time(s, qk, limits[:, 2], limits[:, 3], speed, tcp_accel)
+        plane = None
+        if via is not None:
+            e1 = (p[0] - centre) / np.linalg.norm(p[0] - centre)
+            plane = (pk, e1, np.cross(normal, e1))
+        best = toppra_time(s, qk, limits[:, 2], limits[:, 3], speed, tcp_accel, plane)
     if best is None:
         row["skipped"] = "toppra found no profile"
         return row

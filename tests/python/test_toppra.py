@@ -50,6 +50,9 @@ def check_cases(model, kind, cases):
             assert 0.999 <= row["ratio"] <= 1.01, where
             assert row["peak_joint_accel_ratio"] <= 1.001, where
             assert row["peak_joint_speed_ratio"] <= 1.001, where
+            # The TCP's whole acceleration (an arc's centripetal part too), where the model
+            # has a TCP acceleration.
+            assert (row["tcp_accel_ratio"] or 0.0) <= 1.001, where
             assert row["path_error_mm"] < 1e-3 and row["end_error_mm"] < 1e-3, where
     assert compared >= 2, f"{model}: only {compared} of {cases} {kind} cases ran"
 

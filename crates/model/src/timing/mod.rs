@@ -224,7 +224,20 @@ pub struct Limits<'a> {
     pub path_speed: f64,
     /// The largest path acceleration `|s̈|` (1/s²).
     pub path_accel: f64,
+    /// The path's normal acceleration per `ṡ²` (for an arc of length L and radius R,
+    /// the TCP's centripetal acceleration L²ṡ²/R over L: L/R, its swept angle; 0 for a
+    /// line).
+    pub path_normal: f64,
+    /// The largest whole acceleration of the path (1/s²), tangential `s̈` and normal
+    /// `path_normal·ṡ²` together (`f64::INFINITY`: none): they stay inside a polygon of
+    /// [`NORMAL_FACES`] sides inscribed in that half disk (at most 0.5 % inside it, never
+    /// outside).
+    pub path_whole: f64,
 }
+
+/// Sides of the polygon that bounds a curved path's whole acceleration
+/// ([`Limits::path_normal`]).
+pub const NORMAL_FACES: usize = 16;
 
 /// Why a path has no timing.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -280,7 +293,7 @@ struct Line {
 /// The constraints of step `k` (from knot `k` to `k + 1`) on `(u, x_k)`: every limit at
 /// both knots and halfway, `x = x_k + 2Δ·u·(s − s_k)/Δ` along the step. Halfway the
 /// speed `q'` is the exact central difference of the two knots. `out` holds at most
-/// `6·axes + 5` lines.
+/// `6·axes + 5 + 3·NORMAL_FACES` lines.
 fn step_lines(
     path: &JointPath,
     slopes: &KnotSlopes,
@@ -295,6 +308,7 @@ fn step_lines(
         m += 1;
     };
     // The path's own acceleration, on u alone (none: the axes alone bound it).
+    let curved = lim.path_whole.is_finite() && lim.path_normal > 0.0;
     if lim.path_accel.is_finite() {
         push(1.0, 0.0, lim.path_accel);
         push(-1.0, 0.0, lim.path_accel);
@@ -325,6 +339,19 @@ fn step_lines(
         // x + shift·u ≤ x_max.
         if x_max.is_finite() {
             push(shift, 1.0, x_max);
+        }
+        // A curved path: (u, w = path_normal·x) within the polygon inscribed in the half
+        // disk of radius path_whole (w ≥ 0), vertices at angles jπ/M, each side's
+        // normal halfway: cos α·u + sin α·w ≤ path_whole·cos(π/2M).
+        if curved {
+            let m = NORMAL_FACES as f64;
+            let c = lim.path_whole * (std::f64::consts::PI / (2.0 * m)).cos();
+            for j in 0..NORMAL_FACES {
+                let alpha = (j as f64 + 0.5) * std::f64::consts::PI / m;
+                let (sin, cos) = alpha.sin_cos();
+                let w = sin * lim.path_normal;
+                push(cos + w * shift, w, c);
+            }
         }
     }
     m
@@ -461,7 +488,7 @@ impl Timing {
             a: 0.0,
             b: 0.0,
             c: 0.0,
-        }; 6 * MAX_AXES + 8];
+        }; 6 * MAX_AXES + 8 + 3 * NORMAL_FACES];
         // Backward: the controllable sets [0, K_k].
         let mut reach = [0.0f64; KNOTS];
         reach[SEGMENTS] = 0.0;

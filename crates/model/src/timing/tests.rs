@@ -35,6 +35,8 @@ fn limits<'a>(speed: &'a [f64], accel: &'a [f64], ps: f64, pa: f64) -> Limits<'a
         axis_accel: accel,
         path_speed: ps,
         path_accel: pa,
+        path_normal: 0.0,
+        path_whole: f64::INFINITY,
     }
 }
 
@@ -413,4 +415,54 @@ fn newton_finds_the_largest_x_every_pair_finds() {
             "{newton} vs {pairs}: {lines:?}"
         );
     }
+}
+
+/// An arc's whole acceleration, tangential s̈ and centripetal κ·ṡ² (κ its swept angle),
+/// stays within the path's whole acceleration A. With every other limit out of the way the
+/// fastest motion accelerates with s̈ = √(A² − κ²ṡ⁴) to the middle and brakes the same
+/// way. By hand (x = ṡ², dx/ds = 2s̈, x = (A/κ)·sin θ): θ = 2κ·s, so at the middle θ = κ,
+/// and dt = dθ / (2√(Aκ·sin θ)): T = ∫₀^κ dθ/√(Aκ·sin θ), by quadrature below. The
+/// timing's polygon lies inside the disk (at most 0.5 %), so it is slower, by little
+/// (measured: 1.453069 s against 1.450372 s, 0.19 %).
+#[test]
+fn an_arc_keeps_its_whole_acceleration_within_the_path_acceleration() {
+    let (a, kappa) = (2.0f64, 1.2f64);
+    // T with θ = φ²: ∫₀^√κ 2φ dφ / √(Aκ·sin φ²), Simpson's rule on 20,000 steps.
+    let f = |phi: f64| {
+        if phi == 0.0 {
+            2.0 / (a * kappa).sqrt()
+        } else {
+            2.0 * phi / (a * kappa * (phi * phi).sin()).sqrt()
+        }
+    };
+    let (n, end) = (20_000, kappa.sqrt());
+    let h = end / n as f64;
+    let mut sum = f(0.0) + f(end);
+    for i in 1..n {
+        sum += if i % 2 == 1 { 4.0 } else { 2.0 } * f(i as f64 * h);
+    }
+    let exact = sum * h / 3.0;
+    // (Without the centripetal part: 2√(1/A) = 1.414214 s.)
+    assert!(exact > 2.0 * (1.0 / a).sqrt());
+    let p = path(1, |s, _| s);
+    let lim = Limits {
+        path_normal: kappa,
+        path_whole: a,
+        ..limits(&[BIG], &[BIG], BIG, a)
+    };
+    let t = Timing::optimal(&p, &lim).unwrap();
+    assert_within(&p, &lim, &t);
+    for k in 0..SEGMENTS {
+        let (x, u) = t.step_state(k);
+        for x in [x, x + 2.0 * u * p.step(k)] {
+            let whole = (u * u + (kappa * x) * (kappa * x)).sqrt();
+            assert!(whole <= a * (1.0 + 1e-12), "step {k}: {whole}");
+        }
+    }
+    let ratio = t.duration() / exact;
+    assert!(
+        (1.0..1.01).contains(&ratio),
+        "{} against {exact}",
+        t.duration()
+    );
 }

@@ -25,9 +25,9 @@ const TIMING_MARGIN: f64 = 5e-4;
 /// Sampled paths a VM remembers (the oldest goes first).
 pub(super) const PATH_MEMO: usize = 32;
 /// A sampled path's key: the bits of the start joints, the start and goal poses (rotation,
-/// translation), the via point (NaN for a line), the path's speed, acceleration and jerk,
-/// and the tool.
-pub(super) const PATH_KEY: usize = MAX_AXES + 12 + 12 + 3 + 3 + 12;
+/// translation), the via point (NaN for a line), the path's speed, acceleration, jerk
+/// and whole acceleration, and the tool.
+pub(super) const PATH_KEY: usize = MAX_AXES + 12 + 12 + 3 + 4 + 12;
 
 /// What sampling a Cartesian path found: its time-optimal timing where the planned profile
 /// would take an axis past its speed or acceleration limit (`None`: the profile keeps
@@ -99,7 +99,7 @@ pub(super) fn sample_path(
     tool: &Iso,
     (path, start, goal, from): (&Path, &Iso, &Iso, &[f64; MAX_AXES]),
     branch: Option<u8>,
-    (profile, vs, ramp): (&Profile, f64, f64),
+    (profile, vs, ramp, whole): (&Profile, f64, f64, f64),
 ) -> Result<PathSamples, PlanError> {
     let n = model.dof();
     let mut joints = JointPath::new(n);
@@ -168,7 +168,17 @@ pub(super) fn sample_path(
     // Without an acceleration of its own (no `accel`, no TCP limit in the model) the path
     // accelerates as fast as its axes let it: never the programmed profile as it is.
     let bounded = profile.a.is_finite();
-    if bounded {
+    // An arc's TCP accelerates towards its centre too (v²/R, per ṡ² its swept angle): the
+    // programmed profile fits only if its acceleration along the path and the
+    // centripetal one at cruise stay within the whole acceleration (never where the
+    // path's acceleration is the TCP's: only a `duration`'s slower ramps).
+    let normal = match path {
+        Path::Arc { sweep, .. } if whole.is_finite() => *sweep,
+        _ => 0.0,
+    };
+    let centripetal = normal * vs * vs;
+    let room = profile.a * profile.a + centripetal * centripetal <= whole * whole;
+    if bounded && (normal == 0.0 || room) {
         let check = check_profile(
             &joints,
             &derivatives,
@@ -190,7 +200,7 @@ pub(super) fn sample_path(
         &joints,
         &derivatives,
         profile,
-        (vs, ramp),
+        (vs, ramp, normal, whole),
         limits_of,
         &mut inner,
         &joints_at,
@@ -227,6 +237,8 @@ pub(super) fn sample_path(
         axis_accel: &accel_timed[..n],
         path_speed: vs,
         path_accel: profile.a,
+        path_normal: normal,
+        path_whole: whole,
     };
     let optimal = |joints: &JointPath| {
         Timing::optimal(joints, &limits).map_err(|e| match e {
@@ -471,18 +483,24 @@ const LOWER_ROUNDS: usize = 24;
 /// The programmed profile's shape (speed `vs`, jerk ramp kept) at the highest path
 /// acceleration below the programmed one (and below what the axes allow at the path's
 /// ends, where it starts from rest) at which every axis keeps its limits, found by
-/// bisection; `None` if even a tiny one does not (an axis's speed binds at cruise).
+/// bisection; `None` if even a tiny one does not (an axis's speed binds at cruise). On
+/// an arc (`normal`: its swept angle) the tangential acceleration `a` leaves room for the
+/// centripetal one at cruise: √(a² + (normal·vs²)²) within `whole`.
 fn lower_profile(
     joints: &JointPath,
     derivatives: &KnotDerivatives,
     profile: &Profile,
-    (vs, ramp): (f64, f64),
+    (vs, ramp, normal, whole): (f64, f64, f64, f64),
     limits: (&[f64], &[f64]),
     inner: &mut Inner,
     joints_at: &impl Fn(f64, &[f64; MAX_AXES]) -> Result<[f64; MAX_AXES], PlanError>,
 ) -> Result<Option<(Profile, ProfileCheck)>, PlanError> {
     // At rest at either end the axis accelerations are q′·s̈: a bound in closed form.
     let mut hi = profile.a;
+    if normal > 0.0 {
+        let centripetal = normal * vs * vs;
+        hi = hi.min((whole * whole - centripetal * centripetal).max(0.0).sqrt());
+    }
     for slopes in &joints.end_slopes {
         for (slope, a) in slopes.iter().zip(limits.1) {
             if *slope != 0.0 {

@@ -828,6 +828,13 @@ fn plan_cartesian(
         f64::INFINITY
     };
     let (vs, as_, js) = limits(v, a, w, wa);
+    // The TCP's whole acceleration (on an arc, along it and towards its centre) within
+    // the `accel` asked or the model's (per unit of the path's fraction).
+    let whole = if len > 1e-7 {
+        accel.unwrap_or(f64::INFINITY).min(tcp_accel) / len
+    } else {
+        f64::INFINITY
+    };
     if !vs.is_finite() {
         let traj = Trajectory::Cartesian {
             path,
@@ -865,7 +872,7 @@ fn plan_cartesian(
         .chain(goal.r.iter().flatten())
         .chain(&goal.t)
         .chain(&via_or_none)
-        .chain([&vs, &as_, &js])
+        .chain([&vs, &as_, &js, &whole])
         .chain(tool.r.iter().flatten())
         .chain(&tool.t)
         .enumerate()
@@ -876,7 +883,7 @@ fn plan_cartesian(
     let branch = model.ik_branch(&start.mul(&tool.inverse()), &start_joints[..n]);
     let sampled = memo.get_or_sample(key, || {
         let ends = (&path, &start, &goal, &start_joints);
-        sample_path(model, &tool, ends, branch, (&profile, vs, ramp))
+        sample_path(model, &tool, ends, branch, (&profile, vs, ramp, whole))
     })?;
     let PathSamples {
         seeds,
