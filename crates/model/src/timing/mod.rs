@@ -205,12 +205,12 @@ pub const GRADE_CHANGE: f64 = 0.01;
 pub const GRADE_MAX: f64 = 12.0;
 /// Steps where an axis's slope is below this fraction of its steepest do not grade the
 /// path for that axis.
-const GRADE_FLOOR: f64 = 0.5;
+pub const GRADE_FLOOR: f64 = 0.5;
 /// The most two neighbouring steps of a graded path differ by (a ratio).
-const GRADE_GROWTH: f64 = 1.15;
+pub const GRADE_GROWTH: f64 = 1.15;
 /// A path is graded only where some step's slopes change by more than this many times
 /// [`GRADE_CHANGE`].
-const GRADE_START: f64 = 5.0;
+pub const GRADE_START: f64 = 5.0;
 
 /// The limits a path's timing keeps.
 #[derive(Clone, Copy, Debug)]

@@ -196,7 +196,7 @@ pub(super) fn sample_path(
     // high acceleration), as fast as a timing can be — the time-optimal timing below
     // changes speed only at its knots, and loses up to a step's time at each end when the
     // whole ramp lies within one step. The faster of the two is the motion's.
-    let lower = lower_profile(
+    let mut lower = lower_profile(
         &joints,
         &derivatives,
         profile,
@@ -205,14 +205,65 @@ pub(super) fn sample_path(
         &mut inner,
         &joints_at,
     )?;
-    // No timing beats the programmed profile (nor, without an acceleration, cruising at
-    // the programmed speed all the way): a trapezoid this close to it is kept without
-    // the time-optimal timing.
-    // With jerk limits the trapezoid's S-curve is kept wherever it fits (the time-optimal
-    // timing keeps speeds and accelerations, not jerks).
-    if let Some((lower, check)) = &lower {
+    // With jerk limits the motion keeps an S-curve: the faster of the programmed speed at
+    // the highest acceleration that fits (above) and a lower speed at the highest
+    // acceleration that fits there. Where an axis's speed binds, a lower acceleration
+    // keeps the axis within it only by never reaching the speed (a slow triangle); a
+    // lower speed reaches its cruise sooner. The best speed by golden-section search
+    // between 1/64 of the programmed one and all of it; a slower speed than programmed
+    // is a `slowdown` (against the programmed profile).
+    if ramp > 0.0 {
+        let mut at = |f: f64| {
+            lower_profile(
+                &joints,
+                &derivatives,
+                profile,
+                (f * vs, ramp, normal, whole),
+                limits_of,
+                &mut inner,
+                &joints_at,
+            )
+        };
+        let lasts = |found: &Option<(Profile, ProfileCheck)>| {
+            found.as_ref().map_or(f64::INFINITY, |(p, _)| p.t_total)
+        };
+        // (Taken: with none found here, there was none at the programmed speed either.)
+        let mut best = (lasts(&lower), 1.0, lower.take());
+        let ratio = 0.5 * (5f64.sqrt() - 1.0);
+        let (mut lo, mut hi) = (SLOWEST_S_CURVE, 1.0);
+        let (mut x1, mut x2) = (hi - ratio * (hi - lo), lo + ratio * (hi - lo));
+        let (mut f1, mut f2) = (at(x1)?, at(x2)?);
+        for _ in 0..SPEED_ROUNDS {
+            if lasts(&f1) <= lasts(&f2) {
+                hi = x2;
+                (x2, f2) = (x1, f1);
+                x1 = hi - ratio * (hi - lo);
+                f1 = at(x1)?;
+            } else {
+                lo = x1;
+                (x1, f1) = (x2, f2);
+                x2 = lo + ratio * (hi - lo);
+                f2 = at(x2)?;
+            }
+        }
+        for (x, found) in [(x1, f1), (x2, f2)] {
+            if lasts(&found) < best.0 {
+                best = (lasts(&found), x, found);
+            }
+        }
+        if let (_, f, Some((p, check))) = best {
+            let mut samples = profile_samples(&joints, &p, &check, Some(p), end);
+            if f < 1.0 {
+                samples.unslowed = Some(profile.t_total).filter(|t| t.is_finite());
+            }
+            return Ok(samples);
+        }
+    } else if let Some((lower, check)) = &lower {
+        // No timing beats the programmed profile (nor, without an acceleration, cruising
+        // at the programmed speed all the way): a trapezoid this close to it is kept
+        // without the time-optimal timing.
         let bound = if bounded { profile.t_total } else { 1.0 / vs };
-        if ramp > 0.0 || lower.t_total <= bound * (1.0 + NEAR_OPTIMAL) {
+        if lower.t_total <= bound * (1.0 + NEAR_OPTIMAL) {
             return Ok(profile_samples(&joints, lower, check, Some(*lower), end));
         }
     }
@@ -601,6 +652,13 @@ fn fits_at_knots(
 fn axis_load((d1, d2): (f64, f64), sd: f64, sdd: f64) -> (f64, f64) {
     ((d1 * sd).abs(), (d1 * sdd + d2 * sd * sd).abs())
 }
+
+/// The slowest fraction of the programmed speed a jerk-limited path tries (below, the
+/// time-optimal timing without its jerk ramps, if no S-curve fits at all).
+const SLOWEST_S_CURVE: f64 = 1.0 / 64.0;
+/// Rounds of the golden-section search for a jerk-limited path's speed: to 0.618²⁴ of
+/// the interval (about 1e-5).
+const SPEED_ROUNDS: usize = 24;
 
 /// Tries of [`lower_profile`] when the check between the knots fails, each
 /// [`LOWER_STEP`] of the last.
