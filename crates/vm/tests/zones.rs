@@ -278,7 +278,9 @@ proptest! {
                 .filter(|e| matches!(e.kind, EventKind::MotionEnd { .. })).nth(k + 1).unwrap().kind.clone()
             else { continue };
             let (p, next) = (ends[k + 1], ends[k + 2]);
-            let (from, to) = (motion_ends[k + 1], motion_ends[k + 2]);
+            // From the next motion's start (the corner's): between a look-ahead
+            // `motion_end` and it the TCP is still on its own line, outside the zone.
+            let (from, to) = (r.events[starts[k + 2]].time, motion_ends[k + 2]);
             for (t, _, tcp) in r.samples.iter().filter(|(t, ..)| *t >= from && *t <= to) {
                 let d = norm(sub(*tcp, p));
                 // Or on the next line: distance to the segment p → next.
