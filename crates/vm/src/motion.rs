@@ -329,6 +329,20 @@ impl Profile {
         hi
     }
 
+    /// The same profile `f` (≥ 1) times slower: the same shape stretched in time (speed
+    /// over f, acceleration over f², jerk over f³).
+    pub fn stretched(&self, f: f64) -> Profile {
+        Profile {
+            v: self.v / f,
+            a: self.a / (f * f),
+            j: self.j / (f * f * f),
+            t_jerk: self.t_jerk * f,
+            t_acc: self.t_acc * f,
+            t_total: self.t_total * f,
+            ..*self
+        }
+    }
+
     /// Duration rounded up to whole nanoseconds.
     pub fn duration_ns(&self) -> i64 {
         (self.t_total * NS).ceil() as i64

@@ -763,24 +763,23 @@ fn plan_cartesian(
         });
     }
     v = v.min(tcp_speed);
-    let mut a = accel.unwrap_or(f64::INFINITY).min(tcp_accel);
+    let a = accel.unwrap_or(f64::INFINITY).min(tcp_accel);
     let len = path.length();
     let angle = vworks_model::math::norm(vworks_model::math::rotation_vector(
         &vworks_model::math::mat_mul(&vworks_model::math::transpose(&start.r), &goal.r),
     ));
     // Orientation moves at most `orient` (180°/s without it), as fast as the axes let it
-    // accelerate (with a `duration`, in 0.3 s).
-    let mut w = orient.unwrap_or(std::f64::consts::PI);
+    // accelerate.
+    let w = orient.unwrap_or(std::f64::consts::PI);
     if w.is_nan() || w <= 0.0 {
         return Err(PlanError::Orient(w));
     }
     // With jerk limits, the path's jerk ramps as long as the slowest axis's does.
     let ramp = jerk_ramp_time(model);
     // The profile's limits along the path (per unit of its fraction) at TCP speed `v`
-    // and acceleration `a`, orientation speed `w`.
-    // The orientation's acceleration: none of its own (the wrist axes bound it, as the
-    // TCP's), but with a `duration`, where speed and acceleration scale together.
-    let limits = |v: f64, a: f64, w: f64, wa: f64| {
+    // and orientation speed `w`, the TCP's acceleration `a`. The orientation has no
+    // acceleration of its own: the wrist axes bound it, as they do the TCP's without one.
+    let limits = |v: f64, w: f64| {
         let (mut vs, mut as_, mut js) = (f64::INFINITY, f64::INFINITY, f64::INFINITY);
         // Below 0.1 µm and 0.1 µrad a move is a rounding error, not a motion.
         if len > 1e-7 {
@@ -790,44 +789,11 @@ fn plan_cartesian(
         }
         if angle > 1e-7 {
             vs = vs.min(w / angle);
-            as_ = as_.min(wa / angle);
-            js = js.min(wa / ramp / angle);
         }
         (vs, as_, js)
     };
     let mut longer = None;
-    if let Some(t) = duration_ns
-        && (len > 1e-7 || angle > 1e-7)
-    {
-        // The slowest fraction of the fastest TCP and orientation speeds (the TCP's
-        // acceleration with them, unless given; `orient`, if given, stays the
-        // orientation's bound) at which the motion takes at most the duration.
-        let at = |k: f64| {
-            let v = k * MAX_TCP_SPEED.min(tcp_speed);
-            let a = accel
-                .unwrap_or(v / vworks_model::model::DEFAULT_ACCEL_TIME)
-                .min(tcp_accel);
-            (v, a, orient.unwrap_or(k * MAX_ORIENT_SPEED))
-        };
-        let lasts = |k: f64| {
-            let (v, a, w) = at(k);
-            let (vs, as_, js) = limits(v, a, w, w / vworks_model::model::DEFAULT_ACCEL_TIME);
-            Profile::with_jerk(1.0, vs, as_, js).duration_ns()
-        };
-        let k = slowest_within(t, 1e-12, 1.0, lasts);
-        (v, a, w) = at(k);
-        longer = longer_than(
-            lasts(k),
-            t,
-            "at the fastest TCP speed (7 m/s, or the model's TCP speed) and orientation speed (500°/s)",
-        );
-    }
-    let wa = if duration_ns.is_some() {
-        w / vworks_model::model::DEFAULT_ACCEL_TIME
-    } else {
-        f64::INFINITY
-    };
-    let (vs, as_, js) = limits(v, a, w, wa);
+    let (vs, as_, js) = limits(v, w);
     // The TCP's whole acceleration (on an arc, along it and towards its centre) within
     // the `accel` asked or the model's (per unit of the path's fraction).
     let whole = if len > 1e-7 {
@@ -879,12 +845,65 @@ fn plan_cartesian(
     {
         key[k] = x.to_bits();
     }
-    let profile = Profile::with_jerk(1.0, vs, as_, js);
     let branch = model.ik_branch(&start.mul(&tool.inverse()), &start_joints[..n]);
+    let ends = (&path, &start, &goal, &start_joints);
+    // The path sampled at TCP speed `v` and orientation speed `w` (its limits there), and
+    // how long it then lasts (ns).
+    let sample_at = |v: f64, w: f64| -> Result<(PathSamples, Profile, f64), PlanError> {
+        let (vs, as_, js) = limits(v, w);
+        let profile = Profile::with_jerk(1.0, vs, as_, js);
+        let s = sample_path(model, &tool, ends, branch, (&profile, vs, ramp, whole))?;
+        let lasts = match (&s.timing, &s.executed) {
+            (Some(t), _) => t.duration(),
+            (None, Some(p)) => p.t_total,
+            (None, None) => profile.t_total,
+        };
+        Ok((s, profile, lasts * NS))
+    };
+    if let Some(want) = duration_ns
+        && (len > 1e-7 || angle > 1e-7)
+    {
+        // The fastest TCP and orientation speeds (`orient`, if given, stays the
+        // orientation's bound), scaled together by k.
+        let (v_top, w_top) = (MAX_TCP_SPEED.min(tcp_speed), MAX_ORIENT_SPEED);
+        let at = |k: f64| sample_at(k * v_top, orient.unwrap_or(k * w_top));
+        let cruise = (len / v_top).max(if orient.is_some() { 0.0 } else { angle / w_top });
+        let (samples, profile, lasts) = duration_search(want, cruise, at)?;
+        longer = longer_than(
+            lasts.ceil() as i64,
+            want,
+            "at the fastest TCP speed (7 m/s, or the model's TCP speed) and orientation speed (500°/s)",
+        );
+        return Ok(cartesian_plan(
+            (path, start, goal, tool, branch),
+            samples,
+            profile,
+            true,
+            (longer, capped),
+        ));
+    }
+    let profile = Profile::with_jerk(1.0, vs, as_, js);
     let sampled = memo.get_or_sample(key, || {
-        let ends = (&path, &start, &goal, &start_joints);
         sample_path(model, &tool, ends, branch, (&profile, vs, ramp, whole))
     })?;
+    Ok(cartesian_plan(
+        (path, start, goal, tool, branch),
+        sampled,
+        profile,
+        false,
+        (longer, capped),
+    ))
+}
+
+/// The plan of a Cartesian motion from its sampled path (`profile`: the programmed one;
+/// `timed`: it was given a duration, so a slower speed than the fastest is no slowdown).
+fn cartesian_plan(
+    (path, start, goal, tool, branch): (Path, Iso, Iso, Iso, Option<u8>),
+    sampled: PathSamples,
+    profile: Profile,
+    timed: bool,
+    (longer, capped): (Option<Longer>, Option<Capped>),
+) -> Plan {
     let PathSamples {
         seeds,
         timing,
@@ -896,17 +915,16 @@ fn plan_cartesian(
         end: prev,
     } = sampled;
     let profile = executed.unwrap_or(profile);
-    let timed = duration_ns.is_some();
     let duration_ns = match &timing {
         None => profile.duration_ns(),
         Some(t) => (t.duration() * NS).ceil() as i64,
     };
-    let slowed = unslowed.map(|would| Slowed {
+    let slowed = unslowed.filter(|_| !timed).map(|would| Slowed {
         axis: worst_axis,
         lasts: duration_ns,
         would: (would * NS).ceil() as i64,
     });
-    Ok(Plan {
+    Plan {
         traj: Trajectory::Cartesian {
             path,
             from: start,
@@ -926,7 +944,94 @@ fn plan_cartesian(
         longer,
         slowed,
         capped,
-    })
+    }
+}
+
+/// Rounds of the search for a `duration` motion's speed (regula falsi, Illinois): it
+/// usually settles to the nanosecond in a few.
+const DURATION_ROUNDS: usize = 40;
+
+/// A `duration` motion: the path sampled at the lowest fraction k of the fastest speeds
+/// (`at(k)`: its samples, programmed profile and duration in ns) at which it lasts at most
+/// `want` ns, then stretched in time to last exactly that (every speed over f ≥ 1, every
+/// acceleration over f²: within the limits); at full speed if it cannot be that fast.
+/// `cruise`: how long the path takes cruising at full speed all the way (s), so at k it
+/// takes at least cruise/k: no k below cruise/want can do.
+fn duration_search(
+    want: i64,
+    cruise: f64,
+    at: impl Fn(f64) -> Result<(PathSamples, Profile, f64), PlanError>,
+) -> Result<(PathSamples, Profile, f64), PlanError> {
+    let goal = want as f64;
+    let full = at(1.0)?;
+    if full.2 > goal {
+        return Ok(full);
+    }
+    let k0 = (cruise * NS / goal).min(1.0);
+    let low = at(k0)?;
+    if low.2 <= goal {
+        return Ok(stretch(low, want));
+    }
+    // A bracket [ka, kb]: too slow at ka, fast enough at kb.
+    let (mut ka, mut fa) = (k0, low.2 - goal);
+    let (mut kb, mut fb, mut best) = (1.0, full.2 - goal, full);
+    let mut kept = 0i8;
+    for _ in 0..DURATION_ROUNDS {
+        if fb > -1.0 || kb - ka <= 1e-14 * kb {
+            break;
+        }
+        let mut k = kb - fb * (kb - ka) / (fb - fa);
+        if !(k > ka && k < kb) {
+            k = 0.5 * (ka + kb);
+        }
+        let found = at(k)?;
+        let f = found.2 - goal;
+        if f <= 0.0 {
+            (kb, fb, best) = (k, f, found);
+            // (The same end kept twice: its weight halved, the Illinois step.)
+            if kept == -1 {
+                fa *= 0.5;
+            }
+            kept = -1;
+        } else {
+            (ka, fa) = (k, f);
+            if kept == 1 {
+                fb *= 0.5;
+            }
+            kept = 1;
+        }
+    }
+    Ok(stretch(best, want))
+}
+
+/// A sampled path that lasts at most `want` ns, stretched in time to last exactly that
+/// (to the nanosecond: a hair less where rounding would go past).
+fn stretch(
+    (mut samples, profile, lasts): (PathSamples, Profile, f64),
+    want: i64,
+) -> (PathSamples, Profile, f64) {
+    if lasts <= 0.0 || lasts >= want as f64 {
+        return (samples, profile, lasts);
+    }
+    let mut f = want as f64 / lasts;
+    for _ in 0..8 {
+        let stretched = match (&samples.timing, &samples.executed) {
+            (Some(t), _) => (Some(t.slower(f)), samples.executed),
+            (None, Some(p)) => (None, Some(p.stretched(f))),
+            (None, None) => (None, Some(profile.stretched(f))),
+        };
+        let ns = match &stretched {
+            (Some(t), _) => (t.duration() * NS).ceil() as i64,
+            (None, Some(p)) => p.duration_ns(),
+            (None, None) => 0,
+        };
+        if ns <= want {
+            (samples.timing, samples.executed) = stretched;
+            return (samples, profile, ns as f64);
+        }
+        f *= 1.0 - 1e-15;
+    }
+    (samples, profile, lasts)
 }
 
 /// The time a jerk-limited axis takes to ramp its acceleration up (`a/j`), the longest
