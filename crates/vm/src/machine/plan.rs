@@ -829,6 +829,8 @@ fn plan_cartesian(
     // under the profile; where they are not, the time-optimal timing along the path.
     // The same path from the same joints with the same limits samples the same: a
     // program repeating its moves samples each once (`memo`, exact: keyed by the bits).
+    // (A motion with a duration is keyed by it, as minus its nanoseconds: never a speed.)
+    let vs_key = duration_ns.map_or(vs, |t| -(t as f64));
     let mut key = [0u64; PATH_KEY];
     let via_or_none = via_t.unwrap_or([f64::NAN; 3]);
     for (k, x) in start_joints
@@ -838,7 +840,7 @@ fn plan_cartesian(
         .chain(goal.r.iter().flatten())
         .chain(&goal.t)
         .chain(&via_or_none)
-        .chain([&vs, &as_, &js, &whole])
+        .chain([&vs_key, &as_, &js, &whole])
         .chain(tool.r.iter().flatten())
         .chain(&tool.t)
         .enumerate()
@@ -860,37 +862,41 @@ fn plan_cartesian(
         };
         Ok((s, profile, lasts * NS))
     };
-    if let Some(want) = duration_ns
-        && (len > 1e-7 || angle > 1e-7)
-    {
-        // The fastest TCP and orientation speeds (`orient`, if given, stays the
-        // orientation's bound), scaled together by k.
-        let (v_top, w_top) = (MAX_TCP_SPEED.min(tcp_speed), MAX_ORIENT_SPEED);
-        let at = |k: f64| sample_at(k * v_top, orient.unwrap_or(k * w_top));
-        let cruise = (len / v_top).max(if orient.is_some() { 0.0 } else { angle / w_top });
-        let (samples, profile, lasts) = duration_search(want, cruise, at)?;
+    let profile = Profile::with_jerk(1.0, vs, as_, js);
+    // (A path that goes nowhere has returned above: a duration's path moves.)
+    let sampled = memo.get_or_sample(key, || match duration_ns {
+        Some(want) => {
+            // The fastest TCP and orientation speeds (`orient`, if given, stays the
+            // orientation's bound), scaled together by k.
+            let (v_top, w_top) = (MAX_TCP_SPEED.min(tcp_speed), MAX_ORIENT_SPEED);
+            let at = |k: f64| sample_at(k * v_top, orient.unwrap_or(k * w_top));
+            let cruise = (len / v_top).max(if orient.is_some() { 0.0 } else { angle / w_top });
+            let (mut samples, profile, _) = duration_search(want, cruise, at)?;
+            // (Its profile with it: not the programmed one of this motion's speed.)
+            if samples.timing.is_none() && samples.executed.is_none() {
+                samples.executed = Some(profile);
+            }
+            Ok(samples)
+        }
+        None => sample_path(model, &tool, ends, branch, (&profile, vs, ramp, whole)),
+    })?;
+    if let Some(want) = duration_ns {
+        let lasts = match (&sampled.timing, &sampled.executed) {
+            (Some(t), _) => (t.duration() * NS).ceil() as i64,
+            (None, Some(p)) => p.duration_ns(),
+            (None, None) => profile.duration_ns(),
+        };
         longer = longer_than(
-            lasts.ceil() as i64,
+            lasts,
             want,
             "at the fastest TCP speed (7 m/s, or the model's TCP speed) and orientation speed (500°/s)",
         );
-        return Ok(cartesian_plan(
-            (path, start, goal, tool, branch),
-            samples,
-            profile,
-            true,
-            (longer, capped),
-        ));
     }
-    let profile = Profile::with_jerk(1.0, vs, as_, js);
-    let sampled = memo.get_or_sample(key, || {
-        sample_path(model, &tool, ends, branch, (&profile, vs, ramp, whole))
-    })?;
     Ok(cartesian_plan(
         (path, start, goal, tool, branch),
         sampled,
         profile,
-        false,
+        duration_ns.is_some(),
         (longer, capped),
     ))
 }
