@@ -168,14 +168,14 @@ def test_compile_files_makes_one_program_of_a_tasks_modules():
 def test_a_rapid_cell_runs_from_python():
     r = vworks.load_cell(str(ROOT / "workcells/rapid_handoff/cell.toml")).run()
     assert r.outcome == "completed"
-    assert r.end_time == pytest.approx(45.460, abs=5e-4)
+    assert r.end_time == pytest.approx(45.461, abs=5e-4)
 
 
 # --- load_cell and run --------------------------------------------------------------------
 
 
 def test_the_readme_line():
-    assert vworks.load_cell(str(HANDOFF)).run().end_time == pytest.approx(46.49088562)
+    assert vworks.load_cell(str(HANDOFF)).run().end_time == pytest.approx(46.491262735)
 
 
 def test_cell_properties():
@@ -204,7 +204,7 @@ def test_result_fields():
     assert r.cycles > 11000
     r1, r2 = r.robots
     assert (r1.name, r2.name) == ("r1", "r2")
-    assert r1.end_time == pytest.approx(46.49088562) and r1.ended == "ended"
+    assert r1.end_time == pytest.approx(46.491262735) and r1.ended == "ended"
     assert r1.moving + r1.waiting + r1.idle == pytest.approx(r.end_time, abs=1e-6)
     assert r1.motions == 41 and not hasattr(r1, "handler")
     assert r.globals == {"handed": 3}
@@ -424,7 +424,7 @@ def test_stepping_gives_the_same_run_as_run():
     stepped = [e.trace_line() for e in sim.events_since()]
     assert stepped == golden("handoff")[0]
     r = sim.result()
-    assert r.outcome == "completed" and r.end_time_ns == 46_490_885_620
+    assert r.outcome == "completed" and r.end_time_ns == 46_491_262_735
     assert sim.result() is r
     with pytest.raises(vworks.Error, match="ended"):
         sim.step_event()
@@ -433,7 +433,7 @@ def test_stepping_gives_the_same_run_as_run():
 
 def test_simulation_run_and_early_result():
     cell = vworks.load_cell(HANDOFF)
-    assert cell.simulation().run().end_time_ns == 46_490_885_620
+    assert cell.simulation().run().end_time_ns == 46_491_262_735
     sim = cell.simulation()
     sim.run_until(10)
     early = sim.result()

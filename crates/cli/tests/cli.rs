@@ -192,7 +192,7 @@ fn run_prints_a_summary_and_exits_by_outcome() {
     // The programs' two `log` lines as they happened (r2's at 35.4 s, r1's last, at its
     // end), then the summary.
     let lines: Vec<&str> = s.lines().collect();
-    assert!(lines[0].starts_with("[35.441 s] r2: "), "{s}");
+    assert!(lines[0].starts_with("[35.442 s] r2: "), "{s}");
     assert!(lines[1].starts_with("[46.491 s] r1: r1 done"), "{s}");
     assert_eq!(lines[2], "cell handoff: completed at 46.491 s", "{s}");
     assert!(

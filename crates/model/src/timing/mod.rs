@@ -18,8 +18,8 @@
 //! - a forward pass from rest takes the largest `u` that stays within them.
 //!
 //! The result is exact arithmetic on the samples: no iteration, no tolerance, the same
-//! bits for the same inputs. Nothing allocates: a [`Timing`] is two arrays of [`KNOTS`]
-//! numbers.
+//! bits for the same inputs. Nothing allocates: a [`Timing`] is three arrays of [`KNOTS`]
+//! numbers (the path speed squared, the time and the place of each knot).
 
 use crate::ik::MAX_AXES;
 
@@ -131,6 +131,16 @@ impl JointPath {
         for k in (0..SEGMENTS - 1).rev() {
             density[k] = density[k].max(density[k + 1] / GRADE_GROWTH);
         }
+        // The rest of the path no coarser than GRADE_COARSEST equal steps: the extra
+        // density scaled down where it would take more knots than that leaves.
+        let extra: f64 = density.iter().map(|d| d - 1.0).sum();
+        let allowed = (GRADE_COARSEST - 1.0) * SEGMENTS as f64;
+        if extra > allowed {
+            let scale = allowed / extra;
+            for d in &mut density {
+                *d = 1.0 + (*d - 1.0) * scale;
+            }
+        }
         // Knots at equal shares of the density's integral (linear within each step).
         let total: f64 = density.iter().sum();
         let mut out = [0.0f64; KNOTS];
@@ -206,6 +216,9 @@ pub const GRADE_MAX: f64 = 12.0;
 /// Steps where an axis's slope is below this fraction of its steepest do not grade the
 /// path for that axis.
 pub const GRADE_FLOOR: f64 = 0.5;
+/// The longest a step of a graded path may be, in equal steps (the knots it gives the
+/// steep stretch are taken from the rest of the path).
+pub const GRADE_COARSEST: f64 = 1.5;
 /// The most two neighbouring steps of a graded path differ by (a ratio).
 pub const GRADE_GROWTH: f64 = 1.15;
 /// A path is graded only where some step's slopes change by more than this many times
@@ -472,6 +485,19 @@ impl Timing {
         }
         if limits.axis_speed.len() < path.axes || limits.axis_accel.len() < path.axes {
             return Err(TimingError::BadLimit(f64::NAN));
+        }
+        // A curved path's bounds; knots that increase (a step of no length has no slope).
+        if limits.path_normal.is_nan()
+            || limits.path_normal < 0.0
+            || limits.path_normal.is_infinite()
+        {
+            return Err(TimingError::BadLimit(limits.path_normal));
+        }
+        if limits.path_whole.is_nan() || limits.path_whole <= 0.0 {
+            return Err(TimingError::BadLimit(limits.path_whole));
+        }
+        if let Some(k) = (0..SEGMENTS).find(|&k| path.step(k).is_nan() || path.step(k) <= 0.0) {
+            return Err(TimingError::Stuck { knot: k, axis: 0 });
         }
         for (knot, q) in path.q.iter().enumerate() {
             if let Some(axis) = q[..path.axes].iter().position(|v| !v.is_finite()) {

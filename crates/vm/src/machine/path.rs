@@ -26,8 +26,8 @@ const TIMING_MARGIN: f64 = 5e-4;
 pub(super) const PATH_MEMO: usize = 32;
 /// A sampled path's key: the bits of the start joints, the start and goal poses (rotation,
 /// translation), the via point (NaN for a line), the path's speed, acceleration, jerk
-/// and whole acceleration, and the tool.
-pub(super) const PATH_KEY: usize = MAX_AXES + 12 + 12 + 3 + 4 + 12;
+/// and whole acceleration, the orientation speed asked (NaN: none), and the tool.
+pub(super) const PATH_KEY: usize = MAX_AXES + 12 + 12 + 3 + 5 + 12;
 
 /// What sampling a Cartesian path found: its time-optimal timing where the planned profile
 /// would take an axis past its speed or acceleration limit (`None`: the profile keeps
@@ -169,16 +169,14 @@ pub(super) fn sample_path(
     // accelerates as fast as its axes let it: never the programmed profile as it is.
     let bounded = profile.a.is_finite();
     // An arc's TCP accelerates towards its centre too (v²/R, per ṡ² its swept angle): the
-    // programmed profile fits only if its acceleration along the path and the
-    // centripetal one at cruise stay within the whole acceleration (never where the
-    // path's acceleration is the TCP's: only a `duration`'s slower ramps).
+    // programmed profile fits only if its peak acceleration along the path and the
+    // centripetal one at its peak speed stay within the whole acceleration (never for a
+    // trapezoid at the TCP's acceleration; an S-curve too short to reach it can).
     let normal = match path {
         Path::Arc { sweep, .. } if whole.is_finite() => *sweep,
         _ => 0.0,
     };
-    let centripetal = normal * vs * vs;
-    let room = profile.a * profile.a + centripetal * centripetal <= whole * whole;
-    if bounded && (normal == 0.0 || room) {
+    if bounded && within_whole(profile, normal, whole) {
         let check = check_profile(
             &joints,
             &derivatives,
@@ -346,9 +344,13 @@ pub(super) fn sample_path(
         }
         timing = optimal(&joints)?;
     }
-    if let Some((lower, check)) = lower
+    if let Some((lower, mut check)) = lower
         && lower.t_total <= timing.duration()
     {
+        // (Checked on the equal knots: its path speeds at the graded ones, where graded.)
+        for (k, sd) in check.sd.iter_mut().enumerate() {
+            *sd = state_at_distance(&lower, joints.knot(k) * lower.dist).0;
+        }
         return Ok(profile_samples(&joints, &lower, &check, Some(lower), end));
     }
     // ṡ² is linear in s within a step: ṡ is largest at one of its ends.
@@ -548,10 +550,6 @@ fn lower_profile(
 ) -> Result<Option<(Profile, ProfileCheck)>, PlanError> {
     // At rest at either end the axis accelerations are q′·s̈: a bound in closed form.
     let mut hi = profile.a;
-    if normal > 0.0 {
-        let centripetal = normal * vs * vs;
-        hi = hi.min((whole * whole - centripetal * centripetal).max(0.0).sqrt());
-    }
     for slopes in &joints.end_slopes {
         for (slope, a) in slopes.iter().zip(limits.1) {
             if *slope != 0.0 {
@@ -569,7 +567,12 @@ fn lower_profile(
     };
     // Bisection on the knots alone (cheap: no IK), then the full check between them; where
     // that finds an axis past a limit, a little lower.
-    let fits = |a: f64| fits_at_knots(joints, derivatives, &shaped(a), limits);
+    // (On an arc, the whole acceleration too: a lower acceleration never reaches a higher
+    // peak speed, so this too holds below where it holds.)
+    let fits = |a: f64| {
+        let p = shaped(a);
+        within_whole(&p, normal, whole) && fits_at_knots(joints, derivatives, &p, limits)
+    };
     let mut a = hi;
     if !fits(hi) {
         let mut lo = 0.0;
@@ -613,6 +616,18 @@ fn lower_profile(
         a *= LOWER_STEP;
     }
     Ok(None)
+}
+
+/// Whether a profile's peak acceleration along a path and the centripetal one at its peak
+/// speed (`normal`·v², `normal` an arc's swept angle, 0 on a line) stay together within
+/// the path's whole acceleration (per unit of its fraction; they peak at different times,
+/// so this is on the safe side).
+fn within_whole(p: &Profile, normal: f64, whole: f64) -> bool {
+    if normal == 0.0 {
+        return true;
+    }
+    let centripetal = normal * p.v * p.v;
+    p.a * p.a + centripetal * centripetal <= whole * whole
 }
 
 /// Every axis's (q′, q″) at every knot ([`JointPath::derivatives`]), computed once per

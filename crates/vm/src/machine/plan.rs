@@ -756,9 +756,11 @@ fn plan_cartesian(
     let tcp_accel = tcp.accel.unwrap_or(f64::INFINITY);
     // (Said once per statement: a `slowdown` warning.)
     let mut capped = None;
-    if duration_ns.is_none() && (v > tcp_speed || accel.is_some_and(|a| a > tcp_accel)) {
+    // (With a duration the speed is not asked.)
+    let speed_above = duration_ns.is_none() && v > tcp_speed;
+    if speed_above || accel.is_some_and(|a| a > tcp_accel) {
         capped = Some(Capped {
-            speed: (v > tcp_speed).then_some((v, tcp_speed)),
+            speed: speed_above.then_some((v, tcp_speed)),
             accel: accel.filter(|a| *a > tcp_accel).map(|a| (a, tcp_accel)),
         });
     }
@@ -831,6 +833,7 @@ fn plan_cartesian(
     // program repeating its moves samples each once (`memo`, exact: keyed by the bits).
     // (A motion with a duration is keyed by it, as minus its nanoseconds: never a speed.)
     let vs_key = duration_ns.map_or(vs, |t| -(t as f64));
+    let orient_key = orient.unwrap_or(f64::NAN);
     let mut key = [0u64; PATH_KEY];
     let via_or_none = via_t.unwrap_or([f64::NAN; 3]);
     for (k, x) in start_joints
@@ -840,7 +843,7 @@ fn plan_cartesian(
         .chain(goal.r.iter().flatten())
         .chain(&goal.t)
         .chain(&via_or_none)
-        .chain([&vs_key, &as_, &js, &whole])
+        .chain([&vs_key, &as_, &js, &whole, &orient_key])
         .chain(tool.r.iter().flatten())
         .chain(&tool.t)
         .enumerate()
@@ -889,7 +892,7 @@ fn plan_cartesian(
         longer = longer_than(
             lasts,
             want,
-            "at the fastest TCP speed (7 m/s, or the model's TCP speed) and orientation speed (500°/s)",
+            "at the fastest TCP speed (7 m/s, or the model's TCP speed) and orientation speed (500°/s, or its `orient`)",
         );
     }
     Ok(cartesian_plan(
@@ -971,16 +974,41 @@ fn duration_search(
     let goal = want as f64;
     let full = at(1.0)?;
     if full.2 > goal {
-        return Ok(full);
+        // (Not always fastest at full speed: an arc's centripetal acceleration, a jerk
+        // ramp. A few slower speeds, then the fastest found.)
+        let mut fastest = (1.0, full);
+        for k in [0.5, 0.25, 0.125] {
+            let found = at(k)?;
+            if found.2 < fastest.1.2 {
+                fastest = (k, found);
+            }
+        }
+        if fastest.1.2 > goal {
+            return Ok(fastest.1);
+        }
+        // Fast enough at k: the bracket below ends there.
+        return duration_between(want, cruise, fastest, at);
     }
-    let k0 = (cruise * NS / goal).min(1.0);
+    duration_between(want, cruise, (1.0, full), at)
+}
+
+/// [`duration_search`] in the bracket from the slowest fraction that can do (cruise at
+/// full speed all the way over `want`) to `fast`, a fraction fast enough.
+fn duration_between(
+    want: i64,
+    cruise: f64,
+    (k_fast, full): (f64, (PathSamples, Profile, f64)),
+    at: impl Fn(f64) -> Result<(PathSamples, Profile, f64), PlanError>,
+) -> Result<(PathSamples, Profile, f64), PlanError> {
+    let goal = want as f64;
+    let k0 = (cruise * NS / goal).min(k_fast);
     let low = at(k0)?;
     if low.2 <= goal {
         return Ok(stretch(low, want));
     }
     // A bracket [ka, kb]: too slow at ka, fast enough at kb.
     let (mut ka, mut fa) = (k0, low.2 - goal);
-    let (mut kb, mut fb, mut best) = (1.0, full.2 - goal, full);
+    let (mut kb, mut fb, mut best) = (k_fast, full.2 - goal, full);
     let mut kept = 0i8;
     for _ in 0..DURATION_ROUNDS {
         if fb > -1.0 || kb - ka <= 1e-14 * kb {
