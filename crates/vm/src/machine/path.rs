@@ -25,9 +25,10 @@ const TIMING_MARGIN: f64 = 5e-4;
 /// Sampled paths a VM remembers (the oldest goes first).
 pub(super) const PATH_MEMO: usize = 32;
 /// A sampled path's key: the bits of the start joints, the start and goal poses (rotation,
-/// translation), the via point (NaN for a line), the path's speed, acceleration, jerk
-/// and whole acceleration, the orientation speed asked (NaN: none), and the tool.
-pub(super) const PATH_KEY: usize = MAX_AXES + 12 + 12 + 3 + 5 + 12;
+/// translation), the via point (NaN for a line), the path's speed (minus the duration's
+/// nanoseconds, with one), acceleration and jerk, the orientation speed asked (NaN: none),
+/// and the tool.
+pub(super) const PATH_KEY: usize = MAX_AXES + 12 + 12 + 3 + 4 + 12;
 
 /// What sampling a Cartesian path found: its time-optimal timing where the planned profile
 /// would take an axis past its speed or acceleration limit (`None`: the profile keeps

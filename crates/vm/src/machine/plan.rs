@@ -795,14 +795,9 @@ fn plan_cartesian(
         (vs, as_, js)
     };
     let mut longer = None;
+    // (`as_` is also the TCP's whole acceleration: on an arc, along it and towards its
+    // centre together, within `accel` or the model's.)
     let (vs, as_, js) = limits(v, w);
-    // The TCP's whole acceleration (on an arc, along it and towards its centre) within
-    // the `accel` asked or the model's (per unit of the path's fraction).
-    let whole = if len > 1e-7 {
-        accel.unwrap_or(f64::INFINITY).min(tcp_accel) / len
-    } else {
-        f64::INFINITY
-    };
     if !vs.is_finite() {
         let traj = Trajectory::Cartesian {
             path,
@@ -843,7 +838,7 @@ fn plan_cartesian(
         .chain(goal.r.iter().flatten())
         .chain(&goal.t)
         .chain(&via_or_none)
-        .chain([&vs_key, &as_, &js, &whole, &orient_key])
+        .chain([&vs_key, &as_, &js, &orient_key])
         .chain(tool.r.iter().flatten())
         .chain(&tool.t)
         .enumerate()
@@ -857,12 +852,8 @@ fn plan_cartesian(
     let sample_at = |v: f64, w: f64| -> Result<(PathSamples, Profile, f64), PlanError> {
         let (vs, as_, js) = limits(v, w);
         let profile = Profile::with_jerk(1.0, vs, as_, js);
-        let s = sample_path(model, &tool, ends, branch, (&profile, vs, ramp, whole))?;
-        let lasts = match (&s.timing, &s.executed) {
-            (Some(t), _) => t.duration(),
-            (None, Some(p)) => p.t_total,
-            (None, None) => profile.t_total,
-        };
+        let s = sample_path(model, &tool, ends, branch, (&profile, vs, ramp, as_))?;
+        let lasts = sampled_seconds(&s.timing, &s.executed, &profile);
         Ok((s, profile, lasts * NS))
     };
     let profile = Profile::with_jerk(1.0, vs, as_, js);
@@ -881,16 +872,15 @@ fn plan_cartesian(
             }
             Ok(samples)
         }
-        None => sample_path(model, &tool, ends, branch, (&profile, vs, ramp, whole)),
+        None => sample_at(v, w).map(|(s, ..)| s),
     })?;
     if let Some(want) = duration_ns {
-        let lasts = match (&sampled.timing, &sampled.executed) {
-            (Some(t), _) => (t.duration() * NS).ceil() as i64,
-            (None, Some(p)) => p.duration_ns(),
-            (None, None) => profile.duration_ns(),
-        };
         longer = longer_than(
-            lasts,
+            to_ns(sampled_seconds(
+                &sampled.timing,
+                &sampled.executed,
+                &profile,
+            )),
             want,
             "at the fastest TCP speed (7 m/s, or the model's TCP speed) and orientation speed (500°/s, or its `orient`)",
         );
@@ -923,11 +913,8 @@ fn cartesian_plan(
         cruise_rates,
         end: prev,
     } = sampled;
+    let duration_ns = to_ns(sampled_seconds(&timing, &executed, &profile));
     let profile = executed.unwrap_or(profile);
-    let duration_ns = match &timing {
-        None => profile.duration_ns(),
-        Some(t) => (t.duration() * NS).ceil() as i64,
-    };
     let slowed = unslowed.filter(|_| !timed).map(|would| Slowed {
         axis: worst_axis,
         lasts: duration_ns,
@@ -954,6 +941,25 @@ fn cartesian_plan(
         slowed,
         capped,
     }
+}
+
+/// How long a sampled path lasts (s): its timing's, else the profile it executes, else
+/// the programmed one.
+fn sampled_seconds(
+    timing: &Option<Timing>,
+    executed: &Option<Profile>,
+    programmed: &Profile,
+) -> f64 {
+    match (timing, executed) {
+        (Some(t), _) => t.duration(),
+        (None, Some(p)) => p.t_total,
+        (None, None) => programmed.t_total,
+    }
+}
+
+/// Seconds rounded up to whole nanoseconds (as [`Profile::duration_ns`]).
+fn to_ns(seconds: f64) -> i64 {
+    (seconds * NS).ceil() as i64
 }
 
 /// Rounds of the search for a `duration` motion's speed (regula falsi, Illinois): it
@@ -1054,11 +1060,7 @@ fn stretch(
             (None, Some(p)) => (None, Some(p.stretched(f))),
             (None, None) => (None, Some(profile.stretched(f))),
         };
-        let ns = match &stretched {
-            (Some(t), _) => (t.duration() * NS).ceil() as i64,
-            (None, Some(p)) => p.duration_ns(),
-            (None, None) => 0,
-        };
+        let ns = to_ns(sampled_seconds(&stretched.0, &stretched.1, &profile));
         if ns <= want {
             (samples.timing, samples.executed) = stretched;
             return (samples, profile, ns as f64);
