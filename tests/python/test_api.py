@@ -168,7 +168,7 @@ def test_compile_files_makes_one_program_of_a_tasks_modules():
 def test_a_rapid_cell_runs_from_python():
     r = vworks.load_cell(str(ROOT / "workcells/rapid_handoff/cell.toml")).run()
     assert r.outcome == "completed"
-    assert r.end_time == pytest.approx(45.461, abs=5e-4)
+    assert r.end_time == pytest.approx(45.384, abs=5e-4)
 
 
 # --- load_cell and run --------------------------------------------------------------------

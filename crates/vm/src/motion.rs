@@ -419,6 +419,29 @@ impl Path {
         }
     }
 
+    /// The first and second derivatives of the position by the fraction `s` of the path.
+    pub fn derivatives(&self, s: f64) -> (V3, V3) {
+        match self {
+            Path::Line { from, to } => (sub(*to, *from), [0.0; 3]),
+            Path::Arc { u, v, sweep, .. } => {
+                let (sn, c) = (sweep * s).sin_cos();
+                let w = *sweep;
+                (
+                    [
+                        w * (v[0] * c - u[0] * sn),
+                        w * (v[1] * c - u[1] * sn),
+                        w * (v[2] * c - u[2] * sn),
+                    ],
+                    [
+                        -w * w * (u[0] * c + v[0] * sn),
+                        -w * w * (u[1] * c + v[1] * sn),
+                        -w * w * (u[2] * c + v[2] * sn),
+                    ],
+                )
+            }
+        }
+    }
+
     /// The circle through three points, or `None` if they are (nearly) collinear.
     pub fn arc(p0: V3, via: V3, p1: V3) -> Option<Path> {
         use vworks_model::math::cross;

@@ -47,6 +47,9 @@ pub struct JointPath {
     /// Where each knot is (`s`, 0 to 1): `k / SEGMENTS` unless graded.
     knots: [f64; KNOTS],
     graded: bool,
+    /// Knots where the path's second derivative may jump (where two pieces of it meet):
+    /// there each step takes the derivatives of its own side. 0: none.
+    breaks: [usize; 2],
 }
 
 impl JointPath {
@@ -59,7 +62,38 @@ impl JointPath {
             end_slopes: [[0.0; MAX_AXES]; 2],
             knots: std::array::from_fn(|k| k as f64 / SEGMENTS as f64),
             graded: false,
+            breaks: [0; 2],
         }
+    }
+
+    /// Marks knots (up to two; 0 for none) where the path's second derivative may jump, as
+    /// where a curve meets a straight piece: the steps on either side take their
+    /// derivatives there from their own side (one-sided differences), so neither sees the
+    /// other's curvature.
+    pub fn set_breaks(&mut self, breaks: [usize; 2]) {
+        self.breaks = breaks.map(|k| if k < SEGMENTS { k } else { 0 });
+    }
+
+    /// Axis `i`'s derivatives `(q', q'')` at knot `k` as the step on `side` of it sees them
+    /// (`Side::Before`: the step ending there): [`JointPath::derivatives`], except at a
+    /// break ([`JointPath::set_breaks`]), where they come from the three knots on that side.
+    pub fn derivatives_on(&self, k: usize, i: usize, side: Side) -> (f64, f64) {
+        let k = k.min(SEGMENTS);
+        if k == 0 || k == SEGMENTS || !self.breaks.contains(&k) {
+            return self.derivatives(k, i);
+        }
+        let (a, b, c) = match side {
+            Side::Before if k >= 2 => (k - 2, k - 1, k),
+            Side::After if k + 2 <= SEGMENTS => (k, k + 1, k + 2),
+            _ => return self.derivatives(k, i),
+        };
+        let q = |j: usize| self.q[j][i];
+        let (s0, s1, s2) = (self.knots[a], self.knots[b], self.knots[c]);
+        let (h1, h2) = (s1 - s0, s2 - s1);
+        let (d01, d12) = ((q(b) - q(a)) / h1, (q(c) - q(b)) / h2);
+        let d2 = 2.0 * (d12 - d01) / (h1 + h2);
+        let d1 = d01 + d2 * (self.knots[k] - 0.5 * (s0 + s1));
+        (d1, d2)
     }
 
     /// Where knot `k` is on the path (`s`, 0 to 1).
@@ -208,6 +242,15 @@ impl JointPath {
     }
 }
 
+/// Which step of a knot: the one that ends there or the one that begins there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Side {
+    /// The step ending at the knot.
+    Before,
+    /// The step beginning at the knot.
+    After,
+}
+
 /// How much of itself an axis's slope may change across one step before the path is
 /// graded ([`JointPath::grade`]): 1 %.
 pub const GRADE_CHANGE: f64 = 0.01;
@@ -246,6 +289,39 @@ pub struct Limits<'a> {
     /// [`NORMAL_FACES`] sides inscribed in that half disk (at most 0.5 % inside it, never
     /// outside).
     pub path_whole: f64,
+    /// Limits that change along the path, knot by knot (a path of pieces, as a corner's:
+    /// [`KnotLimits`]); with them the scalar `path_normal` polygon is not used.
+    pub along: Option<&'a KnotLimits>,
+}
+
+/// A path's own limits knot by knot, in its fraction `s` (for a TCP path of pieces whose
+/// length per unit of `s` and curvature change: a corner between two motions). At each
+/// knot the path speed `ṡ² ≤ x_max`, and the TCP's acceleration — along the path
+/// `u + tangent·ṡ²` and across it `normal·ṡ²` (`normal ≥ 0`), both per unit of the TCP's
+/// length per `s` there — stays inside the polygon of [`NORMAL_FACES`] sides inscribed in
+/// the half disk of radius `whole` (as [`Limits::path_whole`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct KnotLimits {
+    /// The largest `ṡ²` (1/s²).
+    pub x_max: [f64; KNOTS],
+    /// The tangential acceleration per `ṡ²` the path's own curvature in `s` adds (1).
+    pub tangent: [f64; KNOTS],
+    /// The normal acceleration per `ṡ²` (1).
+    pub normal: [f64; KNOTS],
+    /// The largest whole acceleration (1/s²; `f64::INFINITY`: none).
+    pub whole: [f64; KNOTS],
+}
+
+impl KnotLimits {
+    /// No limit anywhere.
+    pub fn none() -> KnotLimits {
+        KnotLimits {
+            x_max: [f64::INFINITY; KNOTS],
+            tangent: [0.0; KNOTS],
+            normal: [0.0; KNOTS],
+            whole: [f64::INFINITY; KNOTS],
+        }
+    }
 }
 
 /// Sides of the polygon that bounds a curved path's whole acceleration
@@ -272,6 +348,12 @@ pub enum TimingError {
         knot: usize,
         /// The axis whose limit leaves no speed.
         axis: usize,
+    },
+    /// No timing within the limits starts as fast as asked ([`Timing::from_speed`]): the
+    /// fastest start, `ṡ²`.
+    TooFast {
+        /// The largest `ṡ²` the path can start with.
+        largest: f64,
     },
 }
 
@@ -303,6 +385,15 @@ struct Line {
     c: f64,
 }
 
+impl Line {
+    /// `0 ≤ 0`: room in a buffer of lines.
+    const NONE: Line = Line {
+        a: 0.0,
+        b: 0.0,
+        c: 0.0,
+    };
+}
+
 /// The constraints of step `k` (from knot `k` to `k + 1`) on `(u, x_k)`: every limit at
 /// both knots and halfway, `x = x_k + 2Δ·u·(s − s_k)/Δ` along the step. Halfway the
 /// speed `q'` is the exact central difference of the two knots. `out` holds at most
@@ -332,11 +423,11 @@ fn step_lines(
         #[allow(clippy::needless_range_loop)] // (axis i of the knots, the joints and the limits)
         for i in 0..path.axes {
             let (d1, d2) = match point {
-                0 => slopes[k][i],
-                2 => slopes[k + 1][i],
+                0 => slopes.after[k][i],
+                2 => slopes.before[k + 1][i],
                 _ => (
                     (path.q[k + 1][i] - path.q[k][i]) / delta,
-                    0.5 * (slopes[k][i].1 + slopes[k + 1][i].1),
+                    0.5 * (slopes.after[k][i].1 + slopes.before[k + 1][i].1),
                 ),
             };
             let amax = lim.axis_accel[i] * path.room[k];
@@ -349,6 +440,21 @@ fn step_lines(
                 x_max = x_max.min(v * v);
             }
         }
+        // The limits along the path there (halfway: the tighter speed and whole
+        // acceleration, the mean curvature).
+        let along = lim.along.map(|al| {
+            let (i, j) = match point {
+                0 => (k, k),
+                2 => (k + 1, k + 1),
+                _ => (k, k + 1),
+            };
+            x_max = x_max.min(al.x_max[i]).min(al.x_max[j]);
+            (
+                0.5 * (al.tangent[i] + al.tangent[j]),
+                0.5 * (al.normal[i] + al.normal[j]),
+                al.whole[i].min(al.whole[j]),
+            )
+        });
         // x + shift·u ≤ x_max.
         if x_max.is_finite() {
             push(shift, 1.0, x_max);
@@ -356,7 +462,17 @@ fn step_lines(
         // A curved path: (u, w = path_normal·x) within the polygon inscribed in the half
         // disk of radius path_whole (w ≥ 0), vertices at angles jπ/M, each side's
         // normal halfway: cos α·u + sin α·w ≤ path_whole·cos(π/2M).
-        if curved {
+        // Along a path of pieces: (u + tangent·x', normal·x') with x' = x + shift·u.
+        if let Some((tg, nm, whole)) = along.filter(|a| a.2.is_finite()) {
+            let m = NORMAL_FACES as f64;
+            let c = whole * (std::f64::consts::PI / (2.0 * m)).cos();
+            for j in 0..NORMAL_FACES {
+                let alpha = (j as f64 + 0.5) * std::f64::consts::PI / m;
+                let (sin, cos) = alpha.sin_cos();
+                let b = cos * tg + sin * nm;
+                push(cos + b * shift, b, c);
+            }
+        } else if curved {
             let m = NORMAL_FACES as f64;
             let c = lim.path_whole * (std::f64::consts::PI / (2.0 * m)).cos();
             for j in 0..NORMAL_FACES {
@@ -370,8 +486,12 @@ fn step_lines(
     m
 }
 
-/// Every axis's `(q', q'')` at every knot ([`JointPath::derivatives`]).
-type KnotSlopes = [[(f64, f64); MAX_AXES]; KNOTS];
+/// Every axis's `(q', q'')` at every knot as the step before it and the step after it see
+/// them ([`JointPath::derivatives_on`]: the same but at a break).
+struct KnotSlopes {
+    before: [[(f64, f64); MAX_AXES]; KNOTS],
+    after: [[(f64, f64); MAX_AXES]; KNOTS],
+}
 
 /// The largest `x ≥ 0` for which some `u` satisfies every line. Rest (`u = 0, x = 0`)
 /// satisfies them all, so the feasible `x` are an interval from 0: below the lines that
@@ -469,86 +589,138 @@ fn largest_u(lines: &[Line], x: f64) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// Room for the lines of one step and the two of its next knot.
+const LINES: usize = 6 * MAX_AXES + 8 + 3 * NORMAL_FACES;
+
+/// Checks `limits` and `path` and gives every knot's slopes, or the error.
+fn checked_slopes(path: &JointPath, limits: &Limits<'_>) -> Result<KnotSlopes, TimingError> {
+    let all = limits
+        .axis_speed
+        .iter()
+        .chain(limits.axis_accel)
+        .take(2 * path.axes)
+        .chain([&limits.path_speed, &limits.path_accel]);
+    for v in all {
+        if v.is_nan() || *v <= 0.0 {
+            return Err(TimingError::BadLimit(*v));
+        }
+    }
+    if limits.axis_speed.len() < path.axes || limits.axis_accel.len() < path.axes {
+        return Err(TimingError::BadLimit(f64::NAN));
+    }
+    // A curved path's bounds; knots that increase (a step of no length has no slope).
+    if limits.path_normal.is_nan() || limits.path_normal < 0.0 || limits.path_normal.is_infinite() {
+        return Err(TimingError::BadLimit(limits.path_normal));
+    }
+    if limits.path_whole.is_nan() || limits.path_whole <= 0.0 {
+        return Err(TimingError::BadLimit(limits.path_whole));
+    }
+    if let Some(al) = limits.along {
+        let bad = al
+            .x_max
+            .iter()
+            .chain(&al.whole)
+            .find(|v| v.is_nan() || **v <= 0.0)
+            .or_else(|| al.tangent.iter().chain(&al.normal).find(|v| !v.is_finite()))
+            .or_else(|| al.normal.iter().find(|v| **v < 0.0));
+        if let Some(v) = bad {
+            return Err(TimingError::BadLimit(*v));
+        }
+    }
+    if let Some(k) = (0..SEGMENTS).find(|&k| path.step(k).is_nan() || path.step(k) <= 0.0) {
+        return Err(TimingError::Stuck { knot: k, axis: 0 });
+    }
+    for (knot, q) in path.q.iter().enumerate() {
+        if let Some(axis) = q[..path.axes].iter().position(|v| !v.is_finite()) {
+            return Err(TimingError::NotFinite { knot, axis });
+        }
+    }
+    let mut slopes = KnotSlopes {
+        before: [[(0.0, 0.0); MAX_AXES]; KNOTS],
+        after: [[(0.0, 0.0); MAX_AXES]; KNOTS],
+    };
+    for k in 0..KNOTS {
+        for i in 0..path.axes {
+            slopes.before[k][i] = path.derivatives_on(k, i, Side::Before);
+            slopes.after[k][i] = path.derivatives_on(k, i, Side::After);
+        }
+    }
+    Ok(slopes)
+}
+
+/// The backward pass: the controllable sets `[0, reach[k]]` for coming to rest at knot
+/// `until` (`reach` is 0 from there on).
+fn backward(
+    path: &JointPath,
+    slopes: &KnotSlopes,
+    limits: &Limits<'_>,
+    until: usize,
+    reach: &mut [f64; KNOTS],
+    lines: &mut [Line; LINES],
+) -> Result<(), TimingError> {
+    for r in reach[until..].iter_mut() {
+        *r = 0.0;
+    }
+    for k in (0..until).rev() {
+        let two_delta = 2.0 * path.step(k);
+        let mut m = step_lines(path, slopes, limits, k, lines);
+        // x_{k+1} = x + 2Δu within [0, K_{k+1}].
+        lines[m] = Line {
+            a: two_delta,
+            b: 1.0,
+            c: reach[k + 1],
+        };
+        lines[m + 1] = Line {
+            a: -two_delta,
+            b: -1.0,
+            c: 0.0,
+        };
+        m += 2;
+        reach[k] = largest_x(&lines[..m]);
+        if k > 0 && reach[k] <= 0.0 {
+            // No speed at all inside the path: the axis whose speed bound is zero.
+            let axis = (0..path.axes)
+                .max_by(|&a, &b| {
+                    let da = slopes.after[k][a].0.abs() / limits.axis_speed[a];
+                    let db = slopes.after[k][b].0.abs() / limits.axis_speed[b];
+                    da.total_cmp(&db)
+                })
+                .unwrap_or(0);
+            return Err(TimingError::Stuck { knot: k, axis });
+        }
+    }
+    Ok(())
+}
+
 impl Timing {
     /// The time-optimal timing of `path` within `limits`, from rest to rest.
     pub fn optimal(path: &JointPath, limits: &Limits<'_>) -> Result<Timing, TimingError> {
-        let all = limits
-            .axis_speed
-            .iter()
-            .chain(limits.axis_accel)
-            .take(2 * path.axes)
-            .chain([&limits.path_speed, &limits.path_accel]);
-        for v in all {
-            if v.is_nan() || *v <= 0.0 {
-                return Err(TimingError::BadLimit(*v));
-            }
+        Timing::from_speed(path, limits, 0.0)
+    }
+
+    /// The time-optimal timing of `path` within `limits` from the path speed `ṡ² = x0`
+    /// at its start (a robot already moving: a corner taking over from the motion before)
+    /// to rest at its end; [`TimingError::TooFast`] where no timing within the limits can
+    /// start that fast.
+    pub fn from_speed(
+        path: &JointPath,
+        limits: &Limits<'_>,
+        x0: f64,
+    ) -> Result<Timing, TimingError> {
+        if x0.is_nan() || x0 < 0.0 || x0.is_infinite() {
+            return Err(TimingError::BadLimit(x0));
         }
-        if limits.axis_speed.len() < path.axes || limits.axis_accel.len() < path.axes {
-            return Err(TimingError::BadLimit(f64::NAN));
-        }
-        // A curved path's bounds; knots that increase (a step of no length has no slope).
-        if limits.path_normal.is_nan()
-            || limits.path_normal < 0.0
-            || limits.path_normal.is_infinite()
-        {
-            return Err(TimingError::BadLimit(limits.path_normal));
-        }
-        if limits.path_whole.is_nan() || limits.path_whole <= 0.0 {
-            return Err(TimingError::BadLimit(limits.path_whole));
-        }
-        if let Some(k) = (0..SEGMENTS).find(|&k| path.step(k).is_nan() || path.step(k) <= 0.0) {
-            return Err(TimingError::Stuck { knot: k, axis: 0 });
-        }
-        for (knot, q) in path.q.iter().enumerate() {
-            if let Some(axis) = q[..path.axes].iter().position(|v| !v.is_finite()) {
-                return Err(TimingError::NotFinite { knot, axis });
-            }
-        }
-        let mut slopes = [[(0.0, 0.0); MAX_AXES]; KNOTS];
-        for (k, row) in slopes.iter_mut().enumerate() {
-            for (i, d) in row.iter_mut().enumerate().take(path.axes) {
-                *d = path.derivatives(k, i);
-            }
-        }
-        let mut lines = [Line {
-            a: 0.0,
-            b: 0.0,
-            c: 0.0,
-        }; 6 * MAX_AXES + 8 + 3 * NORMAL_FACES];
-        // Backward: the controllable sets [0, K_k].
+        let slopes = checked_slopes(path, limits)?;
+        let mut lines = [Line::NONE; LINES];
         let mut reach = [0.0f64; KNOTS];
-        reach[SEGMENTS] = 0.0;
-        for k in (0..SEGMENTS).rev() {
-            let two_delta = 2.0 * path.step(k);
-            let mut m = step_lines(path, &slopes, limits, k, &mut lines);
-            // x_{k+1} = x + 2Δu within [0, K_{k+1}].
-            lines[m] = Line {
-                a: two_delta,
-                b: 1.0,
-                c: reach[k + 1],
-            };
-            lines[m + 1] = Line {
-                a: -two_delta,
-                b: -1.0,
-                c: 0.0,
-            };
-            m += 2;
-            reach[k] = largest_x(&lines[..m]);
-            if k > 0 && reach[k] <= 0.0 {
-                // No speed at all inside the path: the axis whose speed bound is zero.
-                let axis = (0..path.axes)
-                    .max_by(|&a, &b| {
-                        let da = path.derivatives(k, a).0.abs() / limits.axis_speed[a];
-                        let db = path.derivatives(k, b).0.abs() / limits.axis_speed[b];
-                        da.total_cmp(&db)
-                    })
-                    .unwrap_or(0);
-                return Err(TimingError::Stuck { knot: k, axis });
-            }
+        backward(path, &slopes, limits, SEGMENTS, &mut reach, &mut lines)?;
+        if x0 > reach[0] {
+            return Err(TimingError::TooFast { largest: reach[0] });
         }
-        // Forward: from rest, the largest u that keeps x_{k+1} controllable.
+        // Forward: from x0, the largest u that keeps x_{k+1} controllable.
         let mut x = [0.0f64; KNOTS];
         let mut t = [0.0f64; KNOTS];
+        x[0] = x0;
         for k in 0..SEGMENTS {
             let two_delta = 2.0 * path.step(k);
             let m = step_lines(path, &slopes, limits, k, &mut lines);
@@ -575,6 +747,39 @@ impl Timing {
             t,
             s: path.knots,
         })
+    }
+
+    /// The controllable sets of `path` within `limits` for stopping at knot `until`: at
+    /// each knot up to it, the largest `ṡ²` from which the path can still come to rest at
+    /// `until` (TOPP-RA's backward pass; 0 from `until` on). Where the path cannot move at
+    /// all before `until`, the error says where.
+    pub fn stopping_at(
+        path: &JointPath,
+        limits: &Limits<'_>,
+        until: usize,
+    ) -> Result<[f64; KNOTS], TimingError> {
+        let slopes = checked_slopes(path, limits)?;
+        let mut lines = [Line::NONE; LINES];
+        let mut reach = [0.0f64; KNOTS];
+        backward(
+            path,
+            &slopes,
+            limits,
+            until.min(SEGMENTS),
+            &mut reach,
+            &mut lines,
+        )?;
+        Ok(reach)
+    }
+
+    /// `ṡ²` at knot `k` (1/s²).
+    pub fn state_at_knot(&self, k: usize) -> f64 {
+        self.x[k.min(SEGMENTS)]
+    }
+
+    /// The time (s) the path reaches knot `k`.
+    pub fn time_at_knot(&self, k: usize) -> f64 {
+        self.t[k.min(SEGMENTS)]
     }
 
     /// The same timing `factor` (≥ 1) times slower: every speed divided by it, every
@@ -628,7 +833,7 @@ impl Timing {
         if time.is_nan() || time <= 0.0 {
             return PathState {
                 s: 0.0,
-                speed: 0.0,
+                speed: self.x[0].sqrt(),
                 accel: 0.0,
             };
         }

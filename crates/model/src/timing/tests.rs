@@ -37,6 +37,7 @@ fn limits<'a>(speed: &'a [f64], accel: &'a [f64], ps: f64, pa: f64) -> Limits<'a
         path_accel: pa,
         path_normal: 0.0,
         path_whole: f64::INFINITY,
+        along: None,
     }
 }
 
@@ -465,4 +466,91 @@ fn an_arc_keeps_its_whole_acceleration_within_the_path_acceleration() {
         "{} against {exact}",
         t.duration()
     );
+}
+
+/// The same arc with its limits given knot by knot ([`KnotLimits`]) times the same, to
+/// the bit: a corner's path of pieces uses the same constraints as one arc.
+#[test]
+fn limits_along_the_path_are_the_scalar_ones_knot_by_knot() {
+    let (a, kappa) = (2.0f64, 1.2f64);
+    let p = path(1, |s, _| s);
+    let scalar = Limits {
+        path_normal: kappa,
+        path_whole: a,
+        ..limits(&[BIG], &[BIG], BIG, a)
+    };
+    let along = KnotLimits {
+        normal: [kappa; KNOTS],
+        whole: [a; KNOTS],
+        ..KnotLimits::none()
+    };
+    let knotwise = Limits {
+        along: Some(&along),
+        ..limits(&[BIG], &[BIG], BIG, a)
+    };
+    let (t1, t2) = (
+        Timing::optimal(&p, &scalar).unwrap(),
+        Timing::optimal(&p, &knotwise).unwrap(),
+    );
+    assert_eq!(t1, t2);
+    // A speed limit on the second half only: the path brakes to it before the middle.
+    let mut half = KnotLimits::none();
+    for k in SEGMENTS / 2..KNOTS {
+        half.x_max[k] = 0.25;
+    }
+    let lim = Limits {
+        along: Some(&half),
+        ..limits(&[BIG], &[10.0], BIG, BIG)
+    };
+    let t = Timing::optimal(&p, &lim).unwrap();
+    for k in SEGMENTS / 2..KNOTS {
+        assert!(t.state_at_knot(k) <= 0.25 * (1.0 + 1e-12));
+    }
+    // By hand (no speed limit on the first half): up at 10/s² from rest, braking at
+    // 10/s² to ṡ = 0.5 at s = 0.5 (ṡ² = 20·s up, 0.25 + 20·(0.5 − s) down: they meet
+    // at s = 0.25625, ṡ = √5.125), cruising at 0.5 until 0.0125 is left, stopping.
+    let peak = 5.125f64.sqrt();
+    let up = peak / 10.0;
+    let down = (peak - 0.5) / 10.0;
+    let cruise2 = (1.0 - 0.0125 - 0.5) / 0.5;
+    let stop = 0.05;
+    let exact = up + down + cruise2 + stop;
+    assert!(
+        t.duration() >= exact * (1.0 - 1e-12) && t.duration() <= exact * 1.004,
+        "{} against {exact}",
+        t.duration()
+    );
+}
+
+/// A path started at speed: one axis q = 1.2·s at 2 rad/s and 5 rad/s², entered at full
+/// speed, cruises (1.2 − 0.4) / 2 = 0.4 s and brakes 0.4 s: 0.8 s. Faster than the path
+/// can stop is an error naming the fastest start: v² = 2·5·1.2 = 12 (rad/s)², so
+/// ṡ² = 12 / 1.44.
+#[test]
+fn a_path_started_at_speed_cruises_and_brakes() {
+    let p = path(1, |s, _| 1.2 * s);
+    let lim = limits(&[2.0], &[5.0], BIG, BIG);
+    let x0 = (2.0f64 / 1.2).powi(2);
+    let t = Timing::from_speed(&p, &lim, x0).unwrap();
+    assert!(
+        t.duration() >= 0.8 * (1.0 - 1e-12) && t.duration() <= 0.8 * 1.002,
+        "{}",
+        t.duration()
+    );
+    assert_eq!(t.at(0.0).speed, x0.sqrt());
+    assert_eq!(Timing::from_speed(&p, &lim, 0.0), Timing::optimal(&p, &lim));
+    let fast = limits(&[BIG], &[5.0], BIG, BIG);
+    match Timing::from_speed(&p, &fast, 10.0) {
+        Err(TimingError::TooFast { largest }) => {
+            assert!((largest - 12.0 / 1.44).abs() < 1e-9, "{largest}")
+        }
+        other => panic!("{other:?}"),
+    }
+    // Stopping at the middle instead: ṡ² = 2·5·1.2·(0.5 − s)/1.44 before it.
+    let reach = Timing::stopping_at(&p, &fast, SEGMENTS / 2).unwrap();
+    for (k, r) in reach.iter().enumerate() {
+        let s = k as f64 / SEGMENTS as f64;
+        let exact = (2.0 * 5.0 * 1.2 * (0.5 - s) / 1.44).max(0.0);
+        assert!((r - exact).abs() < 1e-9, "knot {k}: {r} against {exact}");
+    }
 }

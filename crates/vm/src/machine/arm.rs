@@ -10,6 +10,7 @@ use vworks_model::RobotModel;
 use vworks_model::math::Iso;
 
 use super::blend::{self, Fading, Planned};
+use super::corner;
 use super::path::PathMemo;
 use super::plan::{self, Capped, Longer, MotionOperands, PlanError, PlanFrom, Slowed, Trajectory};
 use crate::MAX_AXES;
@@ -203,6 +204,7 @@ impl Arm {
             tool: self.tool,
             time,
             default_speed,
+            zone: programmed,
         };
         let plan::Plan {
             mut traj,
@@ -210,6 +212,7 @@ impl Arm {
             longer,
             slowed,
             capped,
+            mut look_ahead,
         } = plan::plan(&self.model, &from, ops, &mut self.memo)?;
         let mut notes = PlanNotes {
             longer,
@@ -224,35 +227,43 @@ impl Arm {
         let tool = self.tool;
         let fading = self.fading.as_mut().filter(|f| time < f.end());
         let tool_changed = fading.as_ref().is_some_and(|f| f.motion.tool != tool);
+        // (when it starts, the radius, when the first motion is over, its statement, and
+        // whether it stops at its point: a corner failure)
         let corner = fading.map(|f| {
             if tool_changed {
-                return (f.end(), 0.0, f.end(), f.pos);
+                return (f.end(), 0.0, f.end(), f.pos, false);
             }
             // Two lines fly by with ramps and look-ahead where they can (or stop, where
             // that cannot beat stopping and superposing them would break their TCP
-            // acceleration); else the next is superposed on the first as it was planned.
+            // acceleration).
             match blend::corner_ramps(model, time, f, &traj) {
                 Some(blend::RampCorner::Flies(c)) => {
                     let (first, next) = blend::with_corner(f, &traj, &c);
                     *f = first;
                     traj = next;
                     point_ns = (traj.path_duration() * NS).ceil() as i64;
-                    return (c.start, c.radius, f.end(), f.pos);
+                    return (c.start, c.radius, f.end(), f.pos, false);
                 }
-                Some(blend::RampCorner::Stops) => return (f.end(), 0.0, f.end(), f.pos),
+                Some(blend::RampCorner::Stops) => return (f.end(), 0.0, f.end(), f.pos, true),
                 None => {}
             }
+            // Else the next takes the robot over now, through a corner timed with the rest of
+            // the first as one path, where it can.
+            if let Some(taken) = corner::take_over(model, &tool, time, f, &traj, programmed) {
+                traj = taken.traj;
+                point_ns = taken.point_ns;
+                look_ahead = taken.look_ahead;
+                return (time, taken.radius, time, f.pos, false);
+            }
+            // Else it is superposed on the first as it was planned.
             let (ts, radius) = blend::blend_start(model, &tool, time, f, &traj, point_ns);
-            (ts, radius, f.end(), f.pos)
+            (ts, radius, f.end(), f.pos, ts >= f.end())
         });
-        if let Some((ts, _, point, at)) = corner
-            && ts >= point
-            && !tool_changed
-        {
+        if let Some((_, _, point, at, true)) = corner {
             notes.corner_failure = Some((point, at));
         }
         let (start, blend) = match corner {
-            Some((ts, _, _, _)) if tool_changed => (ts, None),
+            Some((ts, ..)) if tool_changed => (ts, None),
             Some((ts, r, ..)) => (ts, Some(r)),
             None => (time, None),
         };
@@ -264,8 +275,15 @@ impl Arm {
             },
             None => (point_ns, 0.0, point_ns),
         };
+        // A path timed within its axes' limits looks ahead from where it can still stop
+        // before its zone.
+        if let Some(t) = look_ahead
+            && zone > 0.0
+        {
+            end_ns = end_ns.min(((t * NS).floor() as i64).clamp(0, point_ns));
+        }
         // The next corner begins after this one has ended.
-        if let Some((_, _, point, _)) = corner {
+        if let Some((_, _, point, ..)) = corner {
             end_ns = end_ns.max((point - start).min(point_ns));
         }
         let planned = self.pending.insert(Planned {
@@ -285,6 +303,20 @@ impl Arm {
     /// The pending motion starts: it becomes the current one.
     pub(super) fn start_pending(&mut self) {
         self.current = self.pending.take();
+        // A motion that takes the robot over through a timed corner: the rest of the
+        // zoned motion is now its own.
+        if let (Some(m), Some(f)) = (&self.current, &mut self.fading)
+            && matches!(
+                m.traj,
+                Trajectory::Cartesian {
+                    corner: Some(_),
+                    ..
+                }
+            )
+            && m.start < f.end()
+        {
+            f.motion.point_ns = m.start - f.motion.start;
+        }
     }
 
     /// The current motion's `motion_end` (of the statement at `pos`): the robot rests at

@@ -15,6 +15,7 @@ use crate::types::{Dim, Type, fmt_quantity};
 
 mod arm;
 mod blend;
+mod corner;
 mod describe;
 mod handlers;
 mod interp;
@@ -24,6 +25,7 @@ mod plan;
 mod pulses;
 mod remote;
 mod state;
+mod trajectory;
 mod view;
 mod vm;
 mod waits;

@@ -7,7 +7,7 @@
 
 use vworks_model::RobotModel;
 use vworks_model::math::Iso;
-use vworks_model::timing::{JointPath, KNOTS, Limits, SEGMENTS, Timing, TimingError};
+use vworks_model::timing::{JointPath, KNOTS, KnotLimits, Limits, SEGMENTS, Timing, TimingError};
 
 use super::plan::{JOINT_SPEED_TOLERANCE, PlanError, ik_tcp};
 use crate::MAX_AXES;
@@ -27,8 +27,8 @@ pub(super) const PATH_MEMO: usize = 32;
 /// A sampled path's key: the bits of the start joints, the start and goal poses (rotation,
 /// translation), the via point (NaN for a line), the path's speed (minus the duration's
 /// nanoseconds, with one), acceleration and jerk, the orientation speed asked (NaN: none),
-/// and the tool.
-pub(super) const PATH_KEY: usize = MAX_AXES + 12 + 12 + 3 + 4 + 12;
+/// the zone's share of the path (NaN: none), and the tool.
+pub(super) const PATH_KEY: usize = MAX_AXES + 12 + 12 + 3 + 5 + 12;
 
 /// What sampling a Cartesian path found: its time-optimal timing where the planned profile
 /// would take an axis past its speed or acceleration limit (`None`: the profile keeps
@@ -51,6 +51,9 @@ pub(super) struct PathSamples {
     /// one's top speed anywhere (what a corner's ramps may do).
     pub(super) cruise_rates: [f64; MAX_AXES],
     pub(super) end: [f64; MAX_AXES],
+    /// A timed path with a zone: when (s from its start) it can still stop where its zone
+    /// begins, the last knot that can with a margin: its `motion_end`.
+    pub(super) look_ahead: Option<f64>,
 }
 
 /// Cartesian paths sampled, by the bits of their joints, poses, speed and tool: a program
@@ -101,67 +104,13 @@ pub(super) fn sample_path(
     (path, start, goal, from): (&Path, &Iso, &Iso, &[f64; MAX_AXES]),
     branch: Option<u8>,
     (profile, vs, ramp, whole): (&Profile, f64, f64, f64),
+    zone: Option<f64>,
 ) -> Result<PathSamples, PlanError> {
     let n = model.dof();
-    let mut joints = JointPath::new(n);
-    joints.q[0] = *from;
-    let tool_inv = tool.inverse();
-    // The joints at path fraction `s`, seeded from `prev`: on the motion's own branch where
-    // it is within the joint limits (the executed path); else the nearest solution, which
-    // then shows as a jump.
-    let joints_at = |s: f64, prev: &[f64; MAX_AXES]| -> Result<[f64; MAX_AXES], PlanError> {
-        let pose = cartesian_at(path, start, goal, s);
-        let mut q = [0.0; MAX_AXES];
-        let on_branch = branch.is_some_and(|b| {
-            let flange = pose.mul(&tool_inv);
-            model
-                .ik_in_branch(&flange, &prev[..n], b, &mut q[..n])
-                .is_ok()
-                && model.within_limits(&q[..n])
-        });
-        if on_branch {
-            return Ok(q);
-        }
-        ik_tcp(model, tool, &pose, prev).map_err(|error| PlanError::Unreachable {
-            error,
-            at_percent: Some(s * 100.0),
-        })
-    };
-    for k in 1..KNOTS {
-        let prev = joints.q[k - 1];
-        joints.q[k] = joints_at(joints.knot(k), &prev)?;
-    }
-    check_turns(&joints)?;
-    // Close to each end, the steepest slope of points 1/4 to 1/4096 of a step in: a
-    // path that starts or ends near a singularity is steeper there than the knots show.
-    for (end, (s0, sign)) in [(0.0, 1.0), (1.0, -1.0)].into_iter().enumerate() {
-        let delta = joints.step(end * (SEGMENTS - 1));
-        let q0 = joints.q[end * SEGMENTS];
-        for frac in [
-            0.25,
-            0.0625,
-            0.015625,
-            0.00390625,
-            0.0009765625,
-            0.000244140625,
-        ] {
-            let ds = frac * delta;
-            let q = joints_at(s0 + sign * ds, &q0)?;
-            for i in 0..n {
-                let slope = sign * (q[i] - q0[i]) / ds;
-                if slope.abs() > joints.end_slopes[end][i].abs() {
-                    joints.end_slopes[end][i] = slope;
-                }
-            }
-        }
-    }
-    let mut speed = [0.0f64; MAX_AXES];
-    let mut accel = [0.0f64; MAX_AXES];
-    for i in 0..n {
-        let j = model.axis(i);
-        speed[i] = j.max_velocity;
-        accel[i] = j.max_accel;
-    }
+    let pose = |s: f64| cartesian_at(path, start, goal, s);
+    let joints_at = knot_joints(model, tool, branch, &pose);
+    let mut joints = sample_knots(n, from, None, &joints_at)?;
+    let (speed, accel) = axis_limits(model);
     let end = joints.q[SEGMENTS];
     let mut derivatives = knot_derivatives(&joints);
     let mut inner = Inner::new();
@@ -266,85 +215,30 @@ pub(super) fn sample_path(
             return Ok(profile_samples(&joints, lower, check, Some(*lower), end));
         }
     }
-    // Where the axes' slopes change fast (near a singularity), the timing takes finer
-    // steps there: the path is sampled again at graded knots (only paths that are timed:
-    // a profile that fits needs no steps).
-    if let Some(knots) = joints.grade() {
-        joints.set_knots(&knots);
-        for (k, s) in knots.iter().enumerate().skip(1) {
-            let prev = joints.q[k - 1];
-            joints.q[k] = joints_at(*s, &prev)?;
-        }
-        check_turns(&joints)?;
-        derivatives = knot_derivatives(&joints);
-        inner = Inner::new();
-    }
-    // The timing keeps a margin below the limits the checks measure against.
-    let speed_timed = speed.map(|v| v * (1.0 - TIMING_MARGIN));
-    let accel_timed = accel.map(|a| a * (1.0 - TIMING_MARGIN));
-    let limits = Limits {
-        axis_speed: &speed_timed[..n],
-        axis_accel: &accel_timed[..n],
-        path_speed: vs,
-        path_accel: profile.a,
-        path_normal: normal,
-        path_whole: whole,
+    let path_limits = PathLimits {
+        speed: vs,
+        accel: profile.a,
+        normal,
+        whole,
+        along: None,
     };
-    let optimal = |joints: &JointPath| {
-        Timing::optimal(joints, &limits).map_err(|e| match e {
-            TimingError::Stuck { knot, axis } | TimingError::NotFinite { knot, axis } => {
-                PlanError::Singular {
-                    axis,
-                    at_percent: joints.knot(knot) * 100.0,
-                }
-            }
-            // (The limits come from a checked model and a checked profile.)
-            _ => PlanError::Singular {
-                axis: 0,
-                at_percent: 0.0,
-            },
-        })
-    };
-    // The timing keeps the limits at the knots and halfway; between them, where the
-    // quarter points find an axis past a limit, that step gets less room and the timing
-    // is made again (a few rounds; then, if still needed, the whole timing slower).
-    let mut timing = optimal(&joints)?;
-    let mut ratios = [0.0f64; SEGMENTS];
-    for round in 0..=ROOM_ROUNDS {
-        // The steps where an axis comes near a limit at a knot under the timing.
-        let mut near = [false; SEGMENTS];
-        for (k, flag) in near.iter_mut().enumerate() {
-            let (x, u) = timing.step_state(k);
-            let x1 = x + 2.0 * u * joints.step(k);
-            *flag = [(k, x), (k + 1, x1)].iter().any(|&(knot, x)| {
-                (0..n).any(|i| {
-                    let (d1, d2) = derivatives[knot][i];
-                    let v = (d1 * x.max(0.0).sqrt()).abs() / speed[i];
-                    let a = (d1 * u + d2 * x).abs() / accel[i];
-                    v.max(a) > NEAR_LIMIT
-                })
-            });
-        }
-        inner.fill(&joints, &near, joints_at)?;
-        let state = |k: usize, s: f64| {
-            let (x, u) = timing.step_state(k);
-            (x + 2.0 * u * (s - joints.knot(k)), u)
-        };
-        let (rv, ra) = inner.ratios(&joints, &speed[..n], &accel[..n], state, &mut ratios);
-        if rv.max(ra) <= 1.0 {
-            break;
-        }
-        if round == ROOM_ROUNDS {
-            timing = timing.slower(rv.max(ra.sqrt()).max(1.0));
-            break;
-        }
-        for (room, r) in joints.room.iter_mut().zip(&ratios) {
-            if *r > 1.0 - TIMING_MARGIN {
-                *room *= (1.0 - TIMING_MARGIN) / r;
-            }
-        }
-        timing = optimal(&joints)?;
-    }
+    let (timing, look_ahead) = time_path(
+        &mut joints,
+        &mut derivatives,
+        &mut inner,
+        (&speed, &accel),
+        &path_limits,
+        (0.0, zone.map(|z| 1.0 - z)),
+        &joints_at,
+    )
+    .map_err(|e| match e {
+        Untimed::Plan(e) => e,
+        // (From rest, a path that can move at all can start.)
+        Untimed::TooFast { .. } => PlanError::Singular {
+            axis: 0,
+            at_percent: 0.0,
+        },
+    })?;
     if let Some((lower, mut check)) = lower
         && lower.t_total <= timing.duration()
     {
@@ -367,9 +261,15 @@ pub(super) fn sample_path(
         None
     } else {
         let no_speed = [f64::INFINITY; MAX_AXES];
+        let accel_timed = accel.map(|a| a * (1.0 - TIMING_MARGIN));
         let unbound = Limits {
             axis_speed: &no_speed[..n],
-            ..limits
+            axis_accel: &accel_timed[..n],
+            path_speed: vs,
+            path_accel: profile.a,
+            path_normal: normal,
+            path_whole: whole,
+            along: None,
         };
         // (Without a timing to compare with, no warning.)
         Timing::optimal(&joints, &unbound)
@@ -388,8 +288,266 @@ pub(super) fn sample_path(
         unslowed,
         worst_axis,
         end,
+        look_ahead,
     })
 }
+
+/// The joints at path fraction `s` of the TCP poses `pose`, seeded from `prev`: on the
+/// motion's own analytic `branch` where it is within the joint limits (the executed
+/// path); else the nearest solution, which then shows as a jump.
+pub(super) fn knot_joints<'a>(
+    model: &'a RobotModel,
+    tool: &'a Iso,
+    branch: Option<u8>,
+    pose: &'a dyn Fn(f64) -> Iso,
+) -> impl Fn(f64, &[f64; MAX_AXES]) -> Result<[f64; MAX_AXES], PlanError> + 'a {
+    let n = model.dof();
+    let tool_inv = tool.inverse();
+    move |s: f64, prev: &[f64; MAX_AXES]| {
+        let pose = pose(s);
+        let mut q = [0.0; MAX_AXES];
+        let on_branch = branch.is_some_and(|b| {
+            let flange = pose.mul(&tool_inv);
+            model
+                .ik_in_branch(&flange, &prev[..n], b, &mut q[..n])
+                .is_ok()
+                && model.within_limits(&q[..n])
+        });
+        if on_branch {
+            return Ok(q);
+        }
+        ik_tcp(model, tool, &pose, prev).map_err(|error| PlanError::Unreachable {
+            error,
+            at_percent: Some(s * 100.0),
+        })
+    }
+}
+
+/// The joints of a path at the timing's [`KNOTS`] (equal steps, or `knots`) from joints
+/// `from` (each knot's IK seeded from the one before): every point reachable, no axis jumping to another
+/// configuration between two knots, and the steepest slopes close to each end.
+pub(super) fn sample_knots(
+    n: usize,
+    from: &[f64; MAX_AXES],
+    knots: Option<&[f64; KNOTS]>,
+    joints_at: &impl Fn(f64, &[f64; MAX_AXES]) -> Result<[f64; MAX_AXES], PlanError>,
+) -> Result<JointPath, PlanError> {
+    let mut joints = JointPath::new(n);
+    if let Some(knots) = knots {
+        joints.set_knots(knots);
+    }
+    joints.q[0] = *from;
+    for k in 1..KNOTS {
+        let prev = joints.q[k - 1];
+        joints.q[k] = joints_at(joints.knot(k), &prev)?;
+    }
+    check_turns(&joints)?;
+    // Close to each end, the steepest slope of points 1/4 to 1/4096 of a step in: a
+    // path that starts or ends near a singularity is steeper there than the knots show.
+    for (end, (s0, sign)) in [(0.0, 1.0), (1.0, -1.0)].into_iter().enumerate() {
+        let delta = joints.step(end * (SEGMENTS - 1));
+        let q0 = joints.q[end * SEGMENTS];
+        for frac in [
+            0.25,
+            0.0625,
+            0.015625,
+            0.00390625,
+            0.0009765625,
+            0.000244140625,
+        ] {
+            let ds = frac * delta;
+            let q = joints_at(s0 + sign * ds, &q0)?;
+            for i in 0..n {
+                let slope = sign * (q[i] - q0[i]) / ds;
+                if slope.abs() > joints.end_slopes[end][i].abs() {
+                    joints.end_slopes[end][i] = slope;
+                }
+            }
+        }
+    }
+    Ok(joints)
+}
+
+/// Every axis's speed and acceleration limits in `model`.
+pub(super) fn axis_limits(model: &RobotModel) -> ([f64; MAX_AXES], [f64; MAX_AXES]) {
+    let mut speed = [0.0f64; MAX_AXES];
+    let mut accel = [0.0f64; MAX_AXES];
+    for i in 0..model.dof() {
+        let j = model.axis(i);
+        speed[i] = j.max_velocity;
+        accel[i] = j.max_accel;
+    }
+    (speed, accel)
+}
+
+/// The limits along a path made for its knots ([`KnotLimits`]).
+pub(super) type AlongKnots<'a> = dyn Fn(&[f64; KNOTS]) -> KnotLimits + 'a;
+
+/// The path's own limits for a timing: its speed and acceleration (fractions per second),
+/// an arc's normal acceleration per `ṡ²` and its whole acceleration, and those that
+/// change along it (a corner's, made for the knots given).
+pub(super) struct PathLimits<'a> {
+    pub(super) speed: f64,
+    pub(super) accel: f64,
+    pub(super) normal: f64,
+    pub(super) whole: f64,
+    pub(super) along: Option<&'a AlongKnots<'a>>,
+}
+
+/// Why [`time_path`] found no timing.
+#[derive(Debug)]
+pub(super) enum Untimed {
+    /// The path cannot be timed (a singularity, a point out of reach).
+    Plan(PlanError),
+    /// It cannot start as fast as asked: the fastest `ṡ²` it can start with.
+    TooFast { largest: f64 },
+}
+
+impl From<PlanError> for Untimed {
+    fn from(e: PlanError) -> Untimed {
+        Untimed::Plan(e)
+    }
+}
+
+/// The time-optimal timing of a sampled path from `ṡ² = x0` to rest within every axis's
+/// `speed` and `accel` and the path's limits: sampled again at graded knots where the
+/// axes' slopes change fast (near a singularity), a margin below the limits, and where
+/// the quarter points between knots find an axis past a limit, less room for that step
+/// (a few rounds; then the whole timing slower).
+pub(super) fn time_path(
+    joints: &mut JointPath,
+    derivatives: &mut KnotDerivatives,
+    inner: &mut Inner,
+    (speed, accel): (&[f64; MAX_AXES], &[f64; MAX_AXES]),
+    path: &PathLimits<'_>,
+    (x0, stop_at): (f64, Option<f64>),
+    joints_at: &impl Fn(f64, &[f64; MAX_AXES]) -> Result<[f64; MAX_AXES], PlanError>,
+) -> Result<(Timing, Option<f64>), Untimed> {
+    let n = joints.axes;
+    // Where the axes' slopes change fast (near a singularity), the timing takes finer
+    // steps there: the path is sampled again at graded knots (only paths that are timed:
+    // a profile that fits needs no steps).
+    if let Some(knots) = joints.grade() {
+        joints.set_knots(&knots);
+        for (k, s) in knots.iter().enumerate().skip(1) {
+            let prev = joints.q[k - 1];
+            joints.q[k] = joints_at(*s, &prev)?;
+        }
+        check_turns(joints)?;
+        *derivatives = knot_derivatives(joints);
+        *inner = Inner::new();
+    }
+    let along = path.along.map(|f| f(joints.knots()));
+    // The timing keeps a margin below the limits the checks measure against.
+    let speed_timed = speed.map(|v| v * (1.0 - TIMING_MARGIN));
+    let accel_timed = accel.map(|a| a * (1.0 - TIMING_MARGIN));
+    let limits = Limits {
+        axis_speed: &speed_timed[..n],
+        axis_accel: &accel_timed[..n],
+        path_speed: path.speed,
+        path_accel: path.accel,
+        path_normal: path.normal,
+        path_whole: path.whole,
+        along: along.as_ref(),
+    };
+    let optimal = |joints: &JointPath| {
+        Timing::from_speed(joints, &limits, x0).map_err(|e| match e {
+            TimingError::Stuck { knot, axis } | TimingError::NotFinite { knot, axis } => {
+                Untimed::Plan(PlanError::Singular {
+                    axis,
+                    at_percent: joints.knot(knot) * 100.0,
+                })
+            }
+            TimingError::TooFast { largest } => Untimed::TooFast { largest },
+            // (The limits come from a checked model and a checked profile.)
+            _ => Untimed::Plan(PlanError::Singular {
+                axis: 0,
+                at_percent: 0.0,
+            }),
+        })
+    };
+    // The timing keeps the limits at the knots and halfway; between them, where the
+    // quarter points find an axis past a limit, that step gets less room and the timing
+    // is made again (a few rounds; then, if still needed, the whole timing slower).
+    let mut timing = optimal(joints)?;
+    let mut ratios = [0.0f64; SEGMENTS];
+    for round in 0..=ROOM_ROUNDS_AT_SPEED {
+        // The steps where an axis comes near a limit at a knot under the timing.
+        let mut near = [false; SEGMENTS];
+        for (k, flag) in near.iter_mut().enumerate() {
+            let (x, u) = timing.step_state(k);
+            let x1 = x + 2.0 * u * joints.step(k);
+            *flag = [(k, x), (k + 1, x1)].iter().any(|&(knot, x)| {
+                (0..n).any(|i| {
+                    let (d1, d2) = derivatives[knot][i];
+                    let v = (d1 * x.max(0.0).sqrt()).abs() / speed[i];
+                    let a = (d1 * u + d2 * x).abs() / accel[i];
+                    v.max(a) > NEAR_LIMIT
+                })
+            });
+        }
+        inner
+            .fill(joints, &near, joints_at)
+            .map_err(Untimed::Plan)?;
+        let state = |k: usize, s: f64| {
+            let (x, u) = timing.step_state(k);
+            (x + 2.0 * u * (s - joints.knot(k)), u)
+        };
+        let (rv, ra) = inner.ratios(joints, &speed[..n], &accel[..n], state, &mut ratios);
+        if rv.max(ra) <= 1.0 {
+            break;
+        }
+        // A timing that starts at speed cannot be made slower as a whole: it gets more
+        // rounds, else there is none.
+        if x0 > 0.0 {
+            if round + 1 < ROOM_ROUNDS_AT_SPEED && ratios[0] <= 1.0 {
+                // (Twice the step: the rounds converge from above.)
+                for (room, r) in joints.room.iter_mut().zip(&ratios) {
+                    if *r > 1.0 - TIMING_MARGIN {
+                        *room *= ((1.0 - TIMING_MARGIN) / r).powi(2);
+                    }
+                }
+                timing = optimal(joints)?;
+                continue;
+            }
+            return Err(Untimed::TooFast { largest: 0.0 });
+        }
+        if round == ROOM_ROUNDS {
+            timing = timing.slower(rv.max(ra.sqrt()).max(1.0));
+            break;
+        }
+        for (room, r) in joints.room.iter_mut().zip(&ratios) {
+            if *r > 1.0 - TIMING_MARGIN {
+                *room *= (1.0 - TIMING_MARGIN) / r;
+            }
+        }
+        timing = optimal(joints)?;
+    }
+    // The look-ahead point for a zone beginning at `stop_at`: the last knot before the
+    // first where stopping there binds (the path could go faster if it did not have to)
+    // and the timing is above a share of what it allows.
+    let look_ahead = stop_at.and_then(|s_in| {
+        let k_in = joints
+            .knots()
+            .partition_point(|s| *s <= s_in)
+            .saturating_sub(1);
+        if k_in == 0 {
+            return None;
+        }
+        let stop = Timing::stopping_at(joints, &limits, k_in).ok()?;
+        let full = Timing::stopping_at(joints, &limits, SEGMENTS).ok()?;
+        let over = (1..=k_in).find(|&k| {
+            stop[k] < full[k] * (1.0 - 1e-9) && timing.state_at_knot(k) > LOOK_AHEAD_SHARE * stop[k]
+        })?;
+        Some(timing.time_at_knot(over - 1))
+    });
+    Ok((timing, look_ahead))
+}
+
+/// The share of the speed squared from which a path could still stop where its zone
+/// begins that its look-ahead point may have: a corner planned there is timed again on
+/// other knots, and must find its start within its own limits.
+const LOOK_AHEAD_SHARE: f64 = 0.95;
 
 /// No axis turns more than [`MAX_KNOT_TURN`] between two knots (else the arm changes
 /// configuration there).
@@ -472,8 +630,24 @@ fn check_profile(
             }
         }
     }
+    // Where the profile's acceleration peaks (its phases' ends) the steps are checked
+    // between the knots too: an S-curve's braking peaks within the last step or two,
+    // between two knots.
+    let mut peaks = false;
+    if profile.t_jerk > 0.0 && profile.dist > 0.0 {
+        for t in profile.breakpoints() {
+            let s = (profile.at(t) / profile.dist).clamp(0.0, 1.0);
+            let k = joints.knots()[..SEGMENTS]
+                .partition_point(|v| *v <= s)
+                .saturating_sub(1);
+            for step in [k.saturating_sub(1), k, (k + 1).min(SEGMENTS - 1)] {
+                near[step] = true;
+            }
+            peaks = true;
+        }
+    }
     let mut fits = worst >= 1.0 - JOINT_SPEED_TOLERANCE;
-    if fits && worst < 1.0 / NEAR_LIMIT {
+    if fits && (worst < 1.0 / NEAR_LIMIT || peaks) {
         inner.fill(joints, &near, joints_at)?;
         let state = |_: usize, s: f64| {
             let (v, a) = state_at_distance(profile, s * profile.dist);
@@ -523,6 +697,7 @@ fn profile_samples(
         rates: rate_bounds(joints, &step_speed),
         cruise_rates: rate_bounds(joints, &[peak; SEGMENTS]),
         end,
+        look_ahead: None,
     }
 }
 
@@ -633,9 +808,9 @@ fn within_whole(p: &Profile, normal: f64, whole: f64) -> bool {
 
 /// Every axis's (q′, q″) at every knot ([`JointPath::derivatives`]), computed once per
 /// sampled path.
-type KnotDerivatives = [[(f64, f64); MAX_AXES]; KNOTS];
+pub(super) type KnotDerivatives = [[(f64, f64); MAX_AXES]; KNOTS];
 
-fn knot_derivatives(joints: &JointPath) -> KnotDerivatives {
+pub(super) fn knot_derivatives(joints: &JointPath) -> KnotDerivatives {
     let mut out = [[(0.0, 0.0); MAX_AXES]; KNOTS];
     for (k, row) in out.iter_mut().enumerate() {
         for (i, d) in row.iter_mut().enumerate().take(joints.axes) {
@@ -688,7 +863,7 @@ pub(super) const SEEDS: usize = SEGMENTS / 16 + 1;
 
 /// The seeds of a sampled path: its joints at every 16th knot (at the knots nearest
 /// every 16th of the path where they are graded).
-fn seeds_of(joints: &JointPath) -> [[f64; MAX_AXES]; SEEDS] {
+pub(super) fn seeds_of(joints: &JointPath) -> [[f64; MAX_AXES]; SEEDS] {
     let mut out = [[0.0; MAX_AXES]; SEEDS];
     for (j, seed) in out.iter_mut().enumerate() {
         let k = if joints.graded() {
@@ -715,15 +890,18 @@ const NEAR_LIMIT: f64 = 0.95;
 /// Rounds of giving steps less room before the timing is slowed as a whole.
 const ROOM_ROUNDS: usize = 4;
 
+/// Rounds of giving steps less room to a timing that starts at speed (a corner's).
+const ROOM_ROUNDS_AT_SPEED: usize = 10;
+
 /// The joints at each step's quarter points (`s_k + j·Δ/4`, j = 1, 2, 3), solved only when
 /// needed; on the stack (planning allocates nothing).
-struct Inner {
+pub(super) struct Inner {
     filled: [bool; SEGMENTS],
     q: [[[f64; MAX_AXES]; 3]; SEGMENTS],
 }
 
 impl Inner {
-    fn new() -> Inner {
+    pub(super) fn new() -> Inner {
         Inner {
             filled: [false; SEGMENTS],
             q: [[[0.0; MAX_AXES]; 3]; SEGMENTS],
@@ -819,7 +997,7 @@ fn state_at_distance(p: &Profile, d: f64) -> (f64, f64) {
 /// `step_speed[k]` through step `k`: the largest of the axis's rate of change over the
 /// step (the chord) and at its two knots, times that speed, with 1 % for the path's
 /// curvature within a step (the collider's horizon relies on it as a bound).
-fn rate_bounds(joints: &JointPath, step_speed: &[f64; SEGMENTS]) -> [f64; MAX_AXES] {
+pub(super) fn rate_bounds(joints: &JointPath, step_speed: &[f64; SEGMENTS]) -> [f64; MAX_AXES] {
     let mut rates = [0.0f64; MAX_AXES];
     for (k, v) in step_speed.iter().enumerate() {
         for (i, r) in rates.iter_mut().enumerate().take(joints.axes) {

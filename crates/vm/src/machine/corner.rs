@@ -1,0 +1,396 @@
+//! Corners timed as one path (docs/engine.md, "Zones", "Timed corners"): a Cartesian
+//! motion that flies out of the zone of a Cartesian motion timed within its axes' limits
+//! takes the robot over where it is, and moves along the rest of the first path to the
+//! zone, a curve inside it, and the rest of its own path, timed as one path from the
+//! robot's speed to rest (`vworks_model::timing::Timing::from_speed`).
+//!
+//! The curve is the two paths *superposed* with fixed progressions: with `u` from 0 to 1
+//! through the curve, the first path runs from where its zone begins to its point as
+//! `1 − (1 − u)²` of that stretch and the second from its point to where its zone ends
+//! as `u²`, and the pose is `p₁ + p₂ − P`, orientation `R₂·R_Pᵀ·R₁`. For two lines this is
+//! the parabola from `P − r·u₁` to `P + r·u₂` (the quadratic Bézier curve with its control
+//! point at the corner), within `r·((1 − u)² + u²) ≤ r` of the point: inside the zone; for
+//! arcs, the same sum. The shares of the path's fraction `s` given to the three pieces
+//! make the pose's derivative by `s` continuous at both joins (the joints' speeds are
+//! continuous); its second derivative is not (the curve's curvature begins there), so the
+//! joins are knots of the timing, with each side's derivatives on its side. Every limit holds through the corner: the axes'
+//! speeds and accelerations, the TCP's speed (from the first motion's to the second's
+//! across the curve), its whole acceleration (along and across the path, knot by knot)
+//! and each motion's orientation speed.
+
+use vworks_model::RobotModel;
+use vworks_model::math::{Iso, V3, add, axpy, dot, mat_mul, norm, sub, transpose};
+use vworks_model::timing::{KNOTS, KnotLimits, SEGMENTS};
+
+use super::blend::Fading;
+use super::path::{
+    Inner, PathLimits, Untimed, axis_limits, knot_derivatives, knot_joints, rate_bounds,
+    sample_knots, seeds_of,
+};
+use super::plan::Trajectory;
+use crate::motion::{NS, Path, cartesian_at};
+
+/// How a trajectory that flies out of a zone follows the previous motion's path and its
+/// own (module docs): the fractions of both at its own fraction `s`.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct TimedCorner {
+    /// The previous motion's path, its start pose and its point.
+    pub(super) first: Path,
+    pub(super) first_from: Iso,
+    pub(super) first_to: Iso,
+    /// The first path's fraction where the robot was when this motion took over, and
+    /// where its zone begins.
+    pub(super) f_now: f64,
+    pub(super) f_in: f64,
+    /// The fraction of this motion's own path where the zone ends.
+    pub(super) f_out: f64,
+    /// Where the curve begins and ends in `s`.
+    pub(super) s_in: f64,
+    pub(super) s_out: f64,
+}
+
+/// The fractions of both paths at `s` and their first and second derivatives by `s`.
+#[derive(Clone, Copy, Debug)]
+struct Progress {
+    f1: f64,
+    d1: f64,
+    dd1: f64,
+    f2: f64,
+    d2: f64,
+    dd2: f64,
+}
+
+impl TimedCorner {
+    fn progress(&self, s: f64) -> Progress {
+        if s <= self.s_in && self.s_in > 0.0 {
+            let d1 = (self.f_in - self.f_now) / self.s_in;
+            return Progress {
+                f1: self.f_now + d1 * s,
+                d1,
+                dd1: 0.0,
+                f2: 0.0,
+                d2: 0.0,
+                dd2: 0.0,
+            };
+        }
+        if s >= self.s_out {
+            let d2 = (1.0 - self.f_out) / (1.0 - self.s_out);
+            return Progress {
+                f1: 1.0,
+                d1: 0.0,
+                dd1: 0.0,
+                f2: (self.f_out + d2 * (s - self.s_out)).min(1.0),
+                d2,
+                dd2: 0.0,
+            };
+        }
+        let sigma = self.s_out - self.s_in;
+        let u = ((s - self.s_in) / sigma).clamp(0.0, 1.0);
+        let (r1, r2) = (1.0 - self.f_in, self.f_out);
+        let (g1, g1d, g1dd) = run_out(u);
+        let (g2, g2d, g2dd) = run_out(1.0 - u);
+        Progress {
+            f1: self.f_in + r1 * g1,
+            d1: r1 * g1d / sigma,
+            dd1: r1 * g1dd / (sigma * sigma),
+            f2: r2 * (1.0 - g2),
+            d2: r2 * g2d / sigma,
+            dd2: -r2 * g2dd / (sigma * sigma),
+        }
+    }
+
+    /// The TCP pose at `s` of the motion whose own path is `path` from `from` to `to`.
+    pub(super) fn pose(&self, path: &Path, from: &Iso, to: &Iso, s: f64) -> Iso {
+        let p = self.progress(s);
+        if p.f2 <= 0.0 {
+            return cartesian_at(&self.first, &self.first_from, &self.first_to, p.f1);
+        }
+        if p.f1 >= 1.0 {
+            return cartesian_at(path, from, to, p.f2);
+        }
+        let one = cartesian_at(&self.first, &self.first_from, &self.first_to, p.f1);
+        let two = cartesian_at(path, from, to, p.f2);
+        Iso {
+            r: mat_mul(&two.r, &mat_mul(&transpose(&self.first_to.r), &one.r)),
+            t: sub(add(one.t, two.t), self.first_to.t),
+        }
+    }
+
+    /// The fraction of the motion's own path done at `s`.
+    pub(super) fn own_fraction(&self, s: f64) -> f64 {
+        self.progress(s).f2
+    }
+
+    /// The rate of the motion's own fraction per unit of `s` at `s`.
+    pub(super) fn own_rate(&self, s: f64) -> f64 {
+        self.progress(s).d2
+    }
+
+    /// The `s` at which the motion's own fraction is `f2` (the curve's start for 0).
+    pub(super) fn s_of_own(&self, f2: f64) -> f64 {
+        if f2 >= self.f_out {
+            let share = (1.0 - self.s_out) / (1.0 - self.f_out);
+            return (self.s_out + (f2 - self.f_out) * share).min(1.0);
+        }
+        if f2 <= 0.0 {
+            return self.s_in;
+        }
+        // f2 = r₂·u².
+        self.s_in + (self.s_out - self.s_in) * (f2 / self.f_out).sqrt()
+    }
+}
+
+/// Knots for a path of three pieces meeting at `joins` (fractions, increasing; a piece of
+/// no length gets no steps): each piece in equal steps, as many as its share (at least
+/// two; the curve, the middle one, at least [`CURVE_STEPS`]), and the knots where they
+/// meet.
+fn piece_knots(joins: [f64; 2]) -> ([f64; KNOTS], [usize; 2]) {
+    let ends = [0.0, joins[0], joins[1], 1.0];
+    let mut steps = [0usize; 3];
+    for (j, st) in steps.iter_mut().enumerate() {
+        let share = ends[j + 1] - ends[j];
+        if share > 0.0 {
+            let least = if j == 1 { CURVE_STEPS } else { 2 };
+            *st = ((share * SEGMENTS as f64).round() as usize).max(least);
+        }
+    }
+    // The largest piece takes what the rounding leaves over or short.
+    let total: usize = steps.iter().sum();
+    let big = (0..3).max_by_key(|&j| steps[j]).unwrap_or(2);
+    steps[big] = (steps[big] + SEGMENTS).saturating_sub(total);
+    let mut knots = [0.0f64; KNOTS];
+    let mut k = 0;
+    for (j, st) in steps.iter().enumerate() {
+        for m in 0..*st {
+            knots[k] = ends[j] + (ends[j + 1] - ends[j]) * m as f64 / *st as f64;
+            k += 1;
+        }
+    }
+    knots[SEGMENTS] = 1.0;
+    (knots, [steps[0], steps[0] + steps[1]])
+}
+
+/// The first path's progression through the curve, `g(u) = 2u − u² = 1 − (1 − u)²`, and
+/// its first and second derivatives: from 0 at slope 2 to 1 at slope 0 (the second runs
+/// in as `1 − g(1 − u) = u²`).
+fn run_out(u: f64) -> (f64, f64, f64) {
+    (2.0 * u - u * u, 2.0 - 2.0 * u, -2.0)
+}
+
+/// The fewest steps of a corner's curve: it turns the TCP within the zone, often a small
+/// share of the path, and its axes' accelerations change along it.
+const CURVE_STEPS: usize = 64;
+
+/// How much faster (in `ṡ²`) the robot may be than the fastest start a corner's timing
+/// finds, for that start to be taken: half the timing's margin below the limits.
+const START_TOLERANCE: f64 = 4e-4;
+
+/// A corner timed as one path: the next motion's trajectory from now, how long it takes
+/// (ns), its own look-ahead point (s from its start) and the radius of the corner.
+pub(super) struct Taken {
+    pub(super) traj: Trajectory,
+    pub(super) point_ns: i64,
+    pub(super) look_ahead: Option<f64>,
+    pub(super) radius: f64,
+}
+
+/// The next Cartesian motion `next` (planned from the point as if from rest) taking the
+/// robot over at `time` from the rest of `f`, a Cartesian motion timed within its axes'
+/// limits (module docs); `next_zone` its own zone. `None` where this corner does not
+/// apply (a motion with a `duration`, jerk limits, corner ramps, a path of no length, the
+/// robot already inside the zone or still in a corner of its own) or has no timing that
+/// starts at the robot's speed: the caller superposes them instead.
+pub(super) fn take_over(
+    model: &RobotModel,
+    tool: &Iso,
+    time: i64,
+    f: &Fading,
+    next: &Trajectory,
+    next_zone: Option<f64>,
+) -> Option<Taken> {
+    let first = &f.motion.traj;
+    let Trajectory::Cartesian {
+        path: p1,
+        from: from1,
+        to: to1,
+        profile: prof1,
+        ramps: None,
+        timed: false,
+        corner: corner1,
+        path_limits: [vs1, as1],
+        ..
+    } = first
+    else {
+        return None;
+    };
+    let Trajectory::Cartesian {
+        path: p2,
+        from: from2,
+        to: to2,
+        profile: prof2,
+        ramps: None,
+        timed: false,
+        corner: None,
+        end_joints,
+        branch,
+        path_limits: [vs2, as2],
+        ..
+    } = next
+    else {
+        return None;
+    };
+    let (l1, l2) = (p1.length(), p2.length());
+    if l1 <= 1e-7 || l2 <= 1e-7 || prof1.t_jerk > 0.0 || prof2.t_jerk > 0.0 {
+        return None;
+    }
+    let dt = (time - f.motion.start) as f64 / NS;
+    let s_now = first.fraction_at(dt);
+    if corner1.as_ref().is_some_and(|c| s_now < c.s_out) {
+        return None;
+    }
+    let r = f.motion.zone.min(0.5 * l2);
+    if r <= 1e-9 {
+        return None;
+    }
+    let (f_in, f_out) = (1.0 - r / l1, r / l2);
+    let f_now = first.own_fraction_at(dt);
+    if f_now > f_in + 1e-12 {
+        return None;
+    }
+    // (Within a billionth of the zone: there.)
+    let f_now = if f_in - f_now < 1e-9 { f_in } else { f_now };
+    // Shares of s: the derivative by s continuous at both joins.
+    let (rho1, c1, c2, rho2) = (f_in - f_now, 2.0 * (1.0 - f_in), 2.0 * f_out, 1.0 - f_out);
+    let sigma = 1.0 / (1.0 + rho1 / c1 + rho2 / c2);
+    let s_in = sigma * rho1 / c1;
+    let corner = TimedCorner {
+        first: p1.clone(),
+        first_from: *from1,
+        first_to: *to1,
+        f_now,
+        f_in,
+        f_out,
+        s_in,
+        s_out: s_in + sigma,
+    };
+    let n = model.dof();
+    let q_now = first.joints_at(model, dt)?;
+    let pose = |s: f64| corner.pose(p2, from2, to2, s);
+    let joints_at = knot_joints(model, tool, *branch, &pose);
+    // Knots on both joins, each piece in equal steps by its share of s (at least two).
+    let (knots, breaks) = piece_knots([corner.s_in, corner.s_out]);
+    let mut joints = sample_knots(n, &q_now, Some(&knots), &joints_at).ok()?;
+    joints.set_breaks(breaks);
+    let mut derivatives = knot_derivatives(&joints);
+    let mut inner = Inner::new();
+    let limits = axis_limits(model);
+    // The TCP's speed and acceleration along each motion (m/s, m/s²) and each motion's
+    // own fraction speed (which holds its orientation speed too).
+    let (v1, v2) = (vs1 * l1, vs2 * l2);
+    let (a1, a2) = (as1 * l1, as2 * l2);
+    let along = |knots: &[f64; KNOTS]| {
+        let mut out = KnotLimits::none();
+        for (k, s) in knots.iter().enumerate() {
+            let p = corner.progress(*s);
+            let (t1, c1) = p1.derivatives(p.f1);
+            let (t2, c2) = p2.derivatives(p.f2);
+            let d = add(t1.map(|x| x * p.d1), t2.map(|x| x * p.d2));
+            let dd = add(
+                axpy(p.dd1, t1, c1.map(|x| x * p.d1 * p.d1)),
+                axpy(p.dd2, t2, c2.map(|x| x * p.d2 * p.d2)),
+            );
+            let (v, a) = if p.f2 <= 0.0 {
+                (v1, a1)
+            } else if p.f1 >= 1.0 {
+                (v2, a2)
+            } else {
+                let u = ((*s - corner.s_in) / (corner.s_out - corner.s_in)).clamp(0.0, 1.0);
+                ((1.0 - u) * v1 + u * v2, a1.min(a2))
+            };
+            let mut x_max = f64::INFINITY;
+            for (rate, vs) in [(p.d1, *vs1), (p.d2, *vs2)] {
+                if rate > 0.0 {
+                    x_max = x_max.min((vs / rate).powi(2));
+                }
+            }
+            let len = norm(d);
+            if len > 1e-12 {
+                x_max = x_max.min((v / len).powi(2));
+                let along_t = dot(dd, d) / (len * len);
+                let across: V3 = axpy(-along_t, d, dd);
+                out.tangent[k] = along_t;
+                out.normal[k] = norm(across) / len;
+                out.whole[k] = a / len;
+            }
+            out.x_max[k] = x_max;
+        }
+        out
+    };
+    let path_limits = PathLimits {
+        speed: f64::INFINITY,
+        accel: f64::INFINITY,
+        normal: 0.0,
+        whole: f64::INFINITY,
+        along: Some(&along),
+    };
+    // The robot's speed now, in this path's fraction.
+    let rate_now = corner.progress(0.0).d1;
+    let x0 = if rate_now > 0.0 {
+        (first.own_speed_at(dt) / rate_now).powi(2)
+    } else {
+        0.0
+    };
+    let stop_at = next_zone
+        .filter(|z| *z > 0.0)
+        .map(|z| corner.s_of_own(1.0 - z.min(0.5 * l2) / l2));
+    let mut time = |x0: f64| {
+        super::path::time_path(
+            &mut joints,
+            &mut derivatives,
+            &mut inner,
+            (&limits.0, &limits.1),
+            &path_limits,
+            (x0, stop_at),
+            &joints_at,
+        )
+    };
+    let (timing, look_ahead) = match time(x0) {
+        Ok(found) => found,
+        // The same state on other knots: its finite differences may put the fastest start
+        // a little below the robot's speed. Within the timing's margin below the limits,
+        // the corner starts at that speed (a jump of at most 2e-4 of it); else it is not
+        // taken.
+        Err(Untimed::TooFast { largest }) if x0 <= largest * (1.0 + START_TOLERANCE) => {
+            time(largest).ok()?
+        }
+        Err(_) => return None,
+    };
+    let mut step_speed = [0.0f64; SEGMENTS];
+    for (k, v) in step_speed.iter_mut().enumerate() {
+        *v = timing.speed_at_knot(k).max(timing.speed_at_knot(k + 1));
+    }
+    let rates = rate_bounds(&joints, &step_speed);
+    let point_ns = (timing.duration() * NS).ceil() as i64;
+    Some(Taken {
+        traj: Trajectory::Cartesian {
+            path: p2.clone(),
+            from: *from2,
+            to: *to2,
+            profile: *prof2,
+            timing: Some(timing),
+            ramps: None,
+            timed: false,
+            end_joints: *end_joints,
+            branch: *branch,
+            rates,
+            cruise_rates: rates,
+            seeds: seeds_of(&joints),
+            tool: *tool,
+            corner: Some(corner.clone()),
+            path_limits: [*vs2, *as2],
+        },
+        point_ns,
+        look_ahead,
+        radius: r,
+    })
+}
