@@ -347,10 +347,10 @@ proptest! {
     #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
 
     /// Lines at a low `accel` (trapezoids where the axes allow them, so corners fly with
-    /// ramps and look-ahead): every corner in its zone, the TCP never faster than the
-    /// fastest programmed speed nor — outside corners superposed as planned — accelerating
-    /// harder than `accel` (second differences at 1 kHz, a mean of the acceleration),
-    /// never slower than stopping.
+    /// ramps and look-ahead, else timed as one path): every corner in its zone, the TCP
+    /// never faster than the fastest programmed speed nor — outside corners superposed as
+    /// planned — accelerating harder than `accel` (second differences at 1 kHz, a mean of
+    /// the acceleration), never slower than stopping.
     #[test]
     fn cartesian_corners_with_look_ahead_keep_the_tcp_acceleration(
         pts in points(),
@@ -367,20 +367,25 @@ proptest! {
         let dt = 1e-3;
         // (After the first move_j, which the samples' TCP follows at its own limits.)
         let first_move = r.events.iter().find(|e| matches!(e.kind, EventKind::MotionEnd { .. })).unwrap().time;
-        // A corner the VM could not fly with ramps (a path timed within its axes' limits
-        // is superposed as planned: the TCP's acceleration adds up there) is left out: one
-        // with ramps blends within min(zone, L₂/2) or a power-of-two fraction of it.
+        // A corner superposed as planned (the TCP's acceleration adds up there) is left
+        // out: one with ramps blends within min(zone, L₂/2) or a power-of-two fraction of
+        // it; one timed as one path starts as the motion before ends (its motion_end).
         let ends = fine_points(&src, None);
         let mut superposed = Vec::new();
-        let (mut zone, mut k) = (0.0, 0usize);
+        let (mut zone, mut k, mut ended) = (0.0, 0usize, 0i64);
         for (i, e) in r.events.iter().enumerate() {
             match e.kind {
-                EventKind::MotionEnd { zone_m, .. } => { zone = zone_m.unwrap_or(0.0); k += 1; }
+                EventKind::MotionEnd { zone_m, .. } => {
+                    zone = zone_m.unwrap_or(0.0);
+                    k += 1;
+                    ended = e.time;
+                }
                 EventKind::MotionStart { blend_m: Some(b), .. } if b > 0.0 => {
                     let l2 = norm(sub(ends[k], ends[k - 1]));
                     let r0 = zone.min(0.5 * l2);
                     let ramps = (0..4).any(|j| (b - r0 / f64::from(1u32 << j)).abs() <= 1e-12 * r0);
-                    if !ramps {
+                    let timed = e.time == ended;
+                    if !ramps && !timed {
                         let to = r.events[i..].iter().find(|e| matches!(e.kind, EventKind::MotionEnd { .. })).unwrap().time;
                         superposed.push((e.time - MS, to + MS));
                     }
@@ -513,4 +518,102 @@ fn a_jerk_limited_line_that_binds_an_axis_speed_keeps_its_s_curve() {
             .any(|w| w.kind == WarningKind::Slowdown && w.pos.line == 3),
         "{w:?}"
     );
+}
+
+/// The program of the IRB 120's picking cycle corner at its own limits (docs/models.md):
+/// 25 mm up from `a`, then `dy` mm across at the model's TCP speed, with `zone`.
+fn pick_corner(dy: i32, zone: &str) -> String {
+    format!(
+        "const a = pose(400mm, -150mm, 200mm, 180deg, 0deg, 0deg);\nproc main() {{\n    move_j a;\n    move_l offset(a, 0mm, 0mm, 25mm) speed 6200mm/s {zone};\n    move_l offset(a, 0mm, {dy}mm, 25mm) speed 6200mm/s zone fine;\n}}\n"
+    )
+}
+
+/// Corners timed as one path (docs/engine.md, "Zones"): the up move of the IRB 120's
+/// picking cycle is timed within its axes' limits, so the move across takes the robot over
+/// at its motion_end — the same instant — and runs through a parabola inside the zone
+/// (12.5 mm: half the up move). Sampled every 0.5 ms: the TCP within the zone around the
+/// point until it is on the second line, its acceleration within the model's 28 m/s², the
+/// axes within their limits (1e-6, the samples' rounding); faster than stopping. Flying
+/// straight on (a point halfway along one line) costs what the one line does, to the
+/// timing's steps (0.5 %).
+#[test]
+fn a_corner_timed_as_one_path_takes_over_and_keeps_every_limit() {
+    let model = builtin::load("irb120").unwrap();
+    let src = pick_corner(300, "zone 25mm");
+    let mut v = vm(&src, None);
+    let r = run(&mut v, 50.0);
+    let ends: Vec<i64> = r
+        .events
+        .iter()
+        .filter(|e| matches!(e.kind, EventKind::MotionEnd { .. }))
+        .map(|e| e.time)
+        .collect();
+    let starts: Vec<(i64, Option<f64>)> = r
+        .events
+        .iter()
+        .filter_map(|e| match e.kind {
+            EventKind::MotionStart { blend_m, .. } => Some((e.time, blend_m)),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(starts[2].0, ends[1], "{:?}", r.events);
+    assert!(
+        starts[2].1.is_some_and(|b| (b - 0.0125).abs() < 1e-12),
+        "{:?}",
+        starts[2]
+    );
+    // Finer samples through the corner: every 0.5 ms from the take-over to the end.
+    let (from, to) = (ends[1], ends[2]);
+    let h = 500_000;
+    let samples: Vec<_> = (0..=(to - from) / h)
+        .map(|k| {
+            let t = from + k * h;
+            (t, v.joints_at(t), v.tcp_at(t).t)
+        })
+        .collect();
+    let corner = [400e-3, -150e-3, 225e-3];
+    for (t, _, p) in &samples {
+        let d = norm(sub(*p, corner));
+        let on_second = (p[0] - 0.4).abs() < 1e-7 && (p[2] - 0.225).abs() < 1e-7;
+        let on_first = (p[0] - 0.4).abs() < 1e-7 && (p[1] + 0.15).abs() < 1e-7;
+        assert!(
+            d <= 0.0125 + 1e-9 || on_first || on_second,
+            "at {t}: {d} m from the point"
+        );
+    }
+    let dt = h as f64 / 1e9;
+    for w in samples.windows(3) {
+        let (t, p0, p1, p2) = (w[1].0, w[0].2, w[1].2, w[2].2);
+        let acc = norm([
+            p2[0] - 2.0 * p1[0] + p0[0],
+            p2[1] - 2.0 * p1[1] + p0[1],
+            p2[2] - 2.0 * p1[2] + p0[2],
+        ]) / (dt * dt);
+        assert!(acc <= 28.0 * (1.0 + 1e-6), "TCP at {t}: {acc} m/s²");
+        for i in 0..6 {
+            let j = model.axis(i);
+            let speed = (w[2].1[i] - w[1].1[i]).abs() / dt;
+            let a = (w[2].1[i] - 2.0 * w[1].1[i] + w[0].1[i]).abs() / (dt * dt);
+            assert!(
+                speed <= j.max_velocity * (1.0 + 1e-6),
+                "axis {i} at {t}: {speed}"
+            );
+            assert!(a <= j.max_accel * (1.0 + 1e-6), "axis {i} at {t}: {a}");
+        }
+    }
+    let stop = run(&mut vm(&pick_corner(300, "zone fine"), None), 50.0);
+    assert!(r.end < stop.end, "{} against stopping {}", r.end, stop.end);
+    // Straight on: up 25 mm and on up 25 mm, against one 50 mm line.
+    let straight = |zone: &str| {
+        format!(
+            "const a = pose(400mm, -150mm, 200mm, 180deg, 0deg, 0deg);\nproc main() {{\n    move_j a;\n    move_l offset(a, 0mm, 0mm, 25mm) speed 6200mm/s {zone};\n    move_l offset(a, 0mm, 0mm, 50mm) speed 6200mm/s zone fine;\n}}\n"
+        )
+    };
+    let one = "const a = pose(400mm, -150mm, 200mm, 180deg, 0deg, 0deg);\nproc main() {\n    move_j a;\n    move_l offset(a, 0mm, 0mm, 50mm) speed 6200mm/s zone fine;\n}\n";
+    let (flown, line) = (
+        run(&mut vm(&straight("zone 25mm"), None), 50.0).end,
+        run(&mut vm(one, None), 50.0).end,
+    );
+    let ratio = flown as f64 / line as f64;
+    assert!((0.995..1.005).contains(&ratio), "{flown} against {line}");
 }

@@ -493,6 +493,15 @@ struct KnotSlopes {
     after: [[(f64, f64); MAX_AXES]; KNOTS],
 }
 
+impl KnotSlopes {
+    fn new() -> KnotSlopes {
+        KnotSlopes {
+            before: [[(0.0, 0.0); MAX_AXES]; KNOTS],
+            after: [[(0.0, 0.0); MAX_AXES]; KNOTS],
+        }
+    }
+}
+
 /// The largest `x ≥ 0` for which some `u` satisfies every line. Rest (`u = 0, x = 0`)
 /// satisfies them all, so the feasible `x` are an interval from 0: below the lines that
 /// bound `x` alone, and where the room for `u`, h(x) = min of the upper bounds − max of
@@ -592,8 +601,13 @@ fn largest_u(lines: &[Line], x: f64) -> f64 {
 /// Room for the lines of one step and the two of its next knot.
 const LINES: usize = 6 * MAX_AXES + 8 + 3 * NORMAL_FACES;
 
-/// Checks `limits` and `path` and gives every knot's slopes, or the error.
-fn checked_slopes(path: &JointPath, limits: &Limits<'_>) -> Result<KnotSlopes, TimingError> {
+/// Checks `limits` and `path` and puts every knot's slopes in `slopes`, or gives the
+/// error.
+fn checked_slopes(
+    path: &JointPath,
+    limits: &Limits<'_>,
+    slopes: &mut KnotSlopes,
+) -> Result<(), TimingError> {
     let all = limits
         .axis_speed
         .iter()
@@ -635,17 +649,21 @@ fn checked_slopes(path: &JointPath, limits: &Limits<'_>) -> Result<KnotSlopes, T
             return Err(TimingError::NotFinite { knot, axis });
         }
     }
-    let mut slopes = KnotSlopes {
-        before: [[(0.0, 0.0); MAX_AXES]; KNOTS],
-        after: [[(0.0, 0.0); MAX_AXES]; KNOTS],
-    };
     for k in 0..KNOTS {
+        for i in 0..path.axes {
+            let d = path.derivatives(k, i);
+            slopes.before[k][i] = d;
+            slopes.after[k][i] = d;
+        }
+    }
+    // (At a break each side has its own.)
+    for k in path.breaks.into_iter().filter(|k| *k > 0) {
         for i in 0..path.axes {
             slopes.before[k][i] = path.derivatives_on(k, i, Side::Before);
             slopes.after[k][i] = path.derivatives_on(k, i, Side::After);
         }
     }
-    Ok(slopes)
+    Ok(())
 }
 
 /// The backward pass: the controllable sets `[0, reach[k]]` for coming to rest at knot
@@ -710,7 +728,8 @@ impl Timing {
         if x0.is_nan() || x0 < 0.0 || x0.is_infinite() {
             return Err(TimingError::BadLimit(x0));
         }
-        let slopes = checked_slopes(path, limits)?;
+        let mut slopes = KnotSlopes::new();
+        checked_slopes(path, limits, &mut slopes)?;
         let mut lines = [Line::NONE; LINES];
         let mut reach = [0.0f64; KNOTS];
         backward(path, &slopes, limits, SEGMENTS, &mut reach, &mut lines)?;
@@ -758,7 +777,8 @@ impl Timing {
         limits: &Limits<'_>,
         until: usize,
     ) -> Result<[f64; KNOTS], TimingError> {
-        let slopes = checked_slopes(path, limits)?;
+        let mut slopes = KnotSlopes::new();
+        checked_slopes(path, limits, &mut slopes)?;
         let mut lines = [Line::NONE; LINES];
         let mut reach = [0.0f64; KNOTS];
         backward(

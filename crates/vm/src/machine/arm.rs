@@ -10,7 +10,7 @@ use vworks_model::RobotModel;
 use vworks_model::math::Iso;
 
 use super::blend::{self, Fading, Planned};
-use super::corner;
+use super::corner::{self, CornerMemo};
 use super::path::PathMemo;
 use super::plan::{self, Capped, Longer, MotionOperands, PlanError, PlanFrom, Slowed, Trajectory};
 use crate::MAX_AXES;
@@ -34,6 +34,8 @@ pub(super) struct Arm {
     tool: Iso,
     /// Cartesian paths already sampled.
     memo: PathMemo,
+    /// Corners already timed as one path.
+    corners: CornerMemo,
 }
 
 /// What planning a motion found that the program should be told.
@@ -65,6 +67,7 @@ impl Arm {
             fading: None,
             tool,
             memo: PathMemo::new(),
+            corners: CornerMemo::new(),
         }
     }
 
@@ -249,7 +252,10 @@ impl Arm {
             }
             // Else the next takes the robot over now, through a corner timed with the rest of
             // the first as one path, where it can.
-            if let Some(taken) = corner::take_over(model, &tool, time, f, &traj, programmed) {
+            let corners = &mut self.corners;
+            if let Some(taken) =
+                corner::take_over(model, &tool, time, (f, &traj, programmed), corners)
+            {
                 traj = taken.traj;
                 point_ns = taken.point_ns;
                 look_ahead = taken.look_ahead;

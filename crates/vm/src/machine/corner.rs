@@ -20,7 +20,7 @@
 
 use vworks_model::RobotModel;
 use vworks_model::math::{Iso, V3, add, axpy, dot, mat_mul, norm, sub, transpose};
-use vworks_model::timing::{KNOTS, KnotLimits, SEGMENTS};
+use vworks_model::timing::{JointPath, KNOTS, KnotLimits, SEGMENTS};
 
 use super::blend::Fading;
 use super::path::{
@@ -28,6 +28,7 @@ use super::path::{
     sample_knots, seeds_of,
 };
 use super::plan::Trajectory;
+use crate::MAX_AXES;
 use crate::motion::{NS, Path, cartesian_at};
 
 /// How a trajectory that flies out of a zone follows the previous motion's path and its
@@ -187,6 +188,7 @@ const START_TOLERANCE: f64 = 4e-4;
 
 /// A corner timed as one path: the next motion's trajectory from now, how long it takes
 /// (ns), its own look-ahead point (s from its start) and the radius of the corner.
+#[derive(Clone, Debug)]
 pub(super) struct Taken {
     pub(super) traj: Trajectory,
     pub(super) point_ns: i64,
@@ -204,9 +206,8 @@ pub(super) fn take_over(
     model: &RobotModel,
     tool: &Iso,
     time: i64,
-    f: &Fading,
-    next: &Trajectory,
-    next_zone: Option<f64>,
+    (f, next, next_zone): (&Fading, &Trajectory, Option<f64>),
+    memo: &mut CornerMemo,
 ) -> Option<Taken> {
     let first = &f.motion.traj;
     let Trajectory::Cartesian {
@@ -273,13 +274,99 @@ pub(super) fn take_over(
         s_in,
         s_out: s_in + sigma,
     };
-    let n = model.dof();
     let q_now = first.joints_at(model, dt)?;
+    let own_speed = first.own_speed_at(dt);
+    // The same corner from the same state (a program repeating its moves) is timed once.
+    let mut key = [0u64; CORNER_KEY];
+    let mid1 = p1.at(0.5);
+    let mid2 = p2.at(0.5);
+    let zone_key = next_zone.unwrap_or(f64::NAN);
+    for (k, x) in q_now
+        .iter()
+        .chain(end_joints)
+        .chain([&f_now, &own_speed, &r, &zone_key, vs1, as1, vs2, as2])
+        .chain(from1.r.iter().flatten().chain(&from1.t))
+        .chain(to1.r.iter().flatten().chain(&to1.t))
+        .chain(from2.r.iter().flatten().chain(&from2.t))
+        .chain(to2.r.iter().flatten().chain(&to2.t))
+        .chain(tool.r.iter().flatten().chain(&tool.t))
+        .chain(mid1.iter().chain(&mid2))
+        .enumerate()
+    {
+        key[k] = x.to_bits();
+    }
+    key[CORNER_KEY - 1] = branch.map_or(u64::MAX, u64::from);
+    if let Some((_, found)) = memo.entries.iter().find(|(k, _)| *k == key) {
+        return found.clone();
+    }
+    let taken = time_corner(
+        model,
+        tool,
+        (corner, r, [*vs1, *as1]),
+        (q_now, own_speed),
+        (next, next_zone),
+    );
+    if memo.entries.len() >= CORNER_MEMO {
+        memo.entries.remove(0);
+    }
+    memo.entries.push((key, taken.clone()));
+    taken
+}
+
+/// Corners timed already, by the bits of what they depend on: the robot's joints and
+/// place and speed on the first path, both paths (ends, midpoints), their limits, the
+/// zones, the tool and the IK branch. A cache of a pure function (exact keys), at most
+/// [`CORNER_MEMO`] of them (the oldest goes first).
+#[derive(Debug)]
+pub(super) struct CornerMemo {
+    entries: Vec<([u64; CORNER_KEY], Option<Taken>)>,
+}
+
+impl CornerMemo {
+    /// An empty memo, its room reserved once.
+    pub(super) fn new() -> CornerMemo {
+        CornerMemo {
+            entries: Vec::with_capacity(CORNER_MEMO),
+        }
+    }
+}
+
+/// Corners a VM remembers.
+const CORNER_MEMO: usize = 16;
+/// A corner's key: joints now and at the end, 8 numbers, 5 poses, 2 midpoints, the branch.
+const CORNER_KEY: usize = 2 * MAX_AXES + 8 + 5 * 12 + 6 + 1;
+
+/// The corner `corner` from the robot's joints and own-path speed `now` on the first
+/// path into `next`, timed (`take_over`'s work once the corner is known).
+fn time_corner(
+    model: &RobotModel,
+    tool: &Iso,
+    (corner, r, [vs1, as1]): (TimedCorner, f64, [f64; 2]),
+    (q_now, own_speed): ([f64; MAX_AXES], f64),
+    (next, next_zone): (&Trajectory, Option<f64>),
+) -> Option<Taken> {
+    let Trajectory::Cartesian {
+        path: p2,
+        from: from2,
+        to: to2,
+        profile: prof2,
+        end_joints,
+        branch,
+        path_limits: [vs2, as2],
+        ..
+    } = next
+    else {
+        return None;
+    };
+    let p1 = &corner.first;
+    let (l1, l2) = (p1.length(), p2.length());
+    let n = model.dof();
     let pose = |s: f64| corner.pose(p2, from2, to2, s);
     let joints_at = knot_joints(model, tool, *branch, &pose);
     // Knots on both joins, each piece in equal steps by its share of s (at least two).
     let (knots, breaks) = piece_knots([corner.s_in, corner.s_out]);
-    let mut joints = sample_knots(n, &q_now, Some(&knots), &joints_at).ok()?;
+    let mut joints = JointPath::new(n);
+    sample_knots(&mut joints, &q_now, Some(&knots), &joints_at).ok()?;
     joints.set_breaks(breaks);
     let mut derivatives = knot_derivatives(&joints);
     let mut inner = Inner::new();
@@ -308,7 +395,7 @@ pub(super) fn take_over(
                 ((1.0 - u) * v1 + u * v2, a1.min(a2))
             };
             let mut x_max = f64::INFINITY;
-            for (rate, vs) in [(p.d1, *vs1), (p.d2, *vs2)] {
+            for (rate, vs) in [(p.d1, vs1), (p.d2, *vs2)] {
                 if rate > 0.0 {
                     x_max = x_max.min((vs / rate).powi(2));
                 }
@@ -336,7 +423,7 @@ pub(super) fn take_over(
     // The robot's speed now, in this path's fraction.
     let rate_now = corner.progress(0.0).d1;
     let x0 = if rate_now > 0.0 {
-        (first.own_speed_at(dt) / rate_now).powi(2)
+        (own_speed / rate_now).powi(2)
     } else {
         0.0
     };

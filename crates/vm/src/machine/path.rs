@@ -109,7 +109,8 @@ pub(super) fn sample_path(
     let n = model.dof();
     let pose = |s: f64| cartesian_at(path, start, goal, s);
     let joints_at = knot_joints(model, tool, branch, &pose);
-    let mut joints = sample_knots(n, from, None, &joints_at)?;
+    let mut joints = JointPath::new(n);
+    sample_knots(&mut joints, from, None, &joints_at)?;
     let (speed, accel) = axis_limits(model);
     let end = joints.q[SEGMENTS];
     let mut derivatives = knot_derivatives(&joints);
@@ -324,15 +325,15 @@ pub(super) fn knot_joints<'a>(
 }
 
 /// The joints of a path at the timing's [`KNOTS`] (equal steps, or `knots`) from joints
-/// `from` (each knot's IK seeded from the one before): every point reachable, no axis jumping to another
+/// `from` (each knot's IK seeded from the one before), into `joints`: every point reachable, no axis jumping to another
 /// configuration between two knots, and the steepest slopes close to each end.
 pub(super) fn sample_knots(
-    n: usize,
+    joints: &mut JointPath,
     from: &[f64; MAX_AXES],
     knots: Option<&[f64; KNOTS]>,
     joints_at: &impl Fn(f64, &[f64; MAX_AXES]) -> Result<[f64; MAX_AXES], PlanError>,
-) -> Result<JointPath, PlanError> {
-    let mut joints = JointPath::new(n);
+) -> Result<(), PlanError> {
+    let n = joints.axes;
     if let Some(knots) = knots {
         joints.set_knots(knots);
     }
@@ -341,7 +342,7 @@ pub(super) fn sample_knots(
         let prev = joints.q[k - 1];
         joints.q[k] = joints_at(joints.knot(k), &prev)?;
     }
-    check_turns(&joints)?;
+    check_turns(joints)?;
     // Close to each end, the steepest slope of points 1/4 to 1/4096 of a step in: a
     // path that starts or ends near a singularity is steeper there than the knots show.
     for (end, (s0, sign)) in [(0.0, 1.0), (1.0, -1.0)].into_iter().enumerate() {
@@ -365,7 +366,7 @@ pub(super) fn sample_knots(
             }
         }
     }
-    Ok(joints)
+    Ok(())
 }
 
 /// Every axis's speed and acceleration limits in `model`.
