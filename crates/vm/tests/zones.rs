@@ -10,7 +10,7 @@
 //! - Joint-space programs never exceed an axis's speed or acceleration (first and second
 //!   differences at 1 kHz; a second difference is a weighted mean of the acceleration);
 //!   Cartesian ones, whose paths and superposed corners are checked at samples, stay
-//!   within 0.1 % of the speeds and 0.5 % of the accelerations (corners timed as one
+//!   within 0.01 % of the speeds and 0.2 % of the accelerations (corners timed as one
 //!   path keep them at their knots and between; a corner that cannot keep them stops).
 //! - Position and velocity are continuous at every event: the joints and their one-sided
 //!   finite-difference velocities agree before and after the event is performed.
@@ -249,21 +249,21 @@ proptest! {
         for w in r.samples.windows(2) {
             for i in 0..6 {
                 let ratio = (w[1].1[i] - w[0].1[i]).abs() / 1e-3 / model.axis(i).max_velocity;
-                prop_assert!(ratio <= 1.001, "axis {i} at {}: {ratio} × its speed limit\n{src}", w[1].0);
+                prop_assert!(ratio <= 1.0001, "axis {i} at {}: {ratio} × its speed limit\n{src}", w[1].0);
             }
         }
         // Axis accelerations: a corner timed as one path keeps them at its knots and, near
         // a limit, at quarter steps; a superposed corner's are checked at 64 even steps
         // (second differences, 1 % below the limit); where none keeps them the robot stops
-        // at the point. Between the samples a profile is checked at (an S-curve's first
-        // jerk phase lies within a quarter step) an axis may still go a little over: on
-        // 600 random programs the worst at 1 kHz was 0.25 % (it was 2.2× while corners
-        // that could not keep the accelerations superposed them anyway).
+        // at the point; an S-curve is checked at its phases' ends too. Between the samples
+        // a path is checked at an axis may still go a little over: in three runs of 600 to
+        // 1,000 random programs the worst at 1 kHz was 1.00013× a limit (it was 2.2× while
+        // corners that could not keep the accelerations superposed them anyway).
         for w in r.samples.windows(3) {
             for i in 0..6 {
                 let acc = (w[2].1[i] - 2.0 * w[1].1[i] + w[0].1[i]).abs() / 1e-6;
                 let ratio = acc / model.axis(i).max_accel;
-                prop_assert!(ratio <= 1.005, "axis {i} at {}: {ratio} × its acceleration limit\n{src}", w[1].0);
+                prop_assert!(ratio <= 1.002, "axis {i} at {}: {ratio} × its acceleration limit\n{src}", w[1].0);
             }
         }
 

@@ -802,6 +802,11 @@ impl Timing {
         self.t[k.min(SEGMENTS)]
     }
 
+    /// Where knot `k` is on the path (`s`, 0 to 1).
+    pub fn knot(&self, k: usize) -> f64 {
+        self.s[k.min(SEGMENTS)]
+    }
+
     /// The same timing `factor` (≥ 1) times slower: every speed divided by it, every
     /// acceleration by its square.
     pub fn slower(&self, factor: f64) -> Timing {

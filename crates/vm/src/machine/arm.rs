@@ -236,10 +236,10 @@ impl Arm {
             if tool_changed {
                 return (f.end(), 0.0, f.end(), f.pos, false);
             }
-            // Two lines fly by with ramps and look-ahead where they can (or stop, where
-            // that cannot beat stopping and superposing them would break their TCP
-            // acceleration).
-            match blend::corner_ramps(model, time, f, &traj) {
+            // Two lines fly by with ramps and look-ahead where they can (where that cannot
+            // beat stopping and superposing them would break their TCP acceleration, they
+            // are timed as one path, or stop).
+            let stops = match blend::corner_ramps(model, time, f, &traj) {
                 Some(blend::RampCorner::Flies(c)) => {
                     let (first, next) = blend::with_corner(f, &traj, &c);
                     *f = first;
@@ -247,9 +247,9 @@ impl Arm {
                     point_ns = (traj.path_duration() * NS).ceil() as i64;
                     return (c.start, c.radius, f.end(), f.pos, false);
                 }
-                Some(blend::RampCorner::Stops) => return (f.end(), 0.0, f.end(), f.pos, true),
-                None => {}
-            }
+                Some(blend::RampCorner::Stops) => true,
+                None => false,
+            };
             // Else the next takes the robot over now, through a corner timed with the rest of
             // the first as one path, where it can.
             let corners = &mut self.corners;
@@ -260,6 +260,9 @@ impl Arm {
                 point_ns = taken.point_ns;
                 look_ahead = taken.look_ahead;
                 return (time, taken.radius, time, f.pos, false);
+            }
+            if stops {
+                return (f.end(), 0.0, f.end(), f.pos, true);
             }
             // Else it is superposed on the first as it was planned.
             let (ts, radius) = blend::blend_start(model, &tool, time, f, &traj, point_ns);

@@ -494,7 +494,7 @@ fn ramps_fit(model: &RobotModel, time: i64, f: &Fading, next: &Trajectory, c: &C
                 return false;
             };
             q = [q[1], q[2], qk];
-            if !axes_within(model, &q, k, dt, true) {
+            if !axes_within(model, &q, k, dt, Some(1.0 + JOINT_SPEED_TOLERANCE)) {
                 return false;
             }
         }
@@ -636,7 +636,7 @@ fn corner_bounds(
             // A path timed within its axes' limits: the summed path speed at 65 points of
             // the window within the faster motion's top speed (the sampled checks of the
             // axes follow).
-            let vmax = (l1 * first.top_path_speed()).max(l2 * next.top_path_speed());
+            let vmax = (l1 * first.top_own_speed()).max(l2 * next.top_path_speed());
             let within = (0..=64).all(|j| {
                 let tau = window * f64::from(j) / 64.0;
                 let v = l1 * first.own_speed_at(off1 + tau) + l2 * next.path_speed_at(tau);
@@ -700,7 +700,8 @@ fn corner_samples(
         if inside && joint_space && !model.within_limits(&q[2][..n]) {
             return None;
         }
-        if !axes_within(model, &q, k as usize, dt, !both_joint) {
+        let accel = (!both_joint).then_some(1.0 - SAMPLED_ACCEL_MARGIN);
+        if !axes_within(model, &q, k as usize, dt, accel) {
             return None;
         }
         if inside && joint_space {
@@ -716,26 +717,26 @@ fn corner_samples(
 }
 
 /// Every axis within its speed between the last two of three samples `dt` apart (when
-/// there are two: sample `k` ≥ 1) and, with `accelerations`, within its acceleration by their
-/// second difference (`k` ≥ 2): the speed within [`JOINT_SPEED_TOLERANCE`], the acceleration
-/// [`SAMPLED_ACCEL_MARGIN`] below its limit.
+/// there are two: sample `k` ≥ 1, within [`JOINT_SPEED_TOLERANCE`]) and, with a share
+/// `accel` of its acceleration, within that by their second difference (`k` ≥ 2): corner
+/// ramps `1 + JOINT_SPEED_TOLERANCE`, superposed corners [`SAMPLED_ACCEL_MARGIN`] below.
 fn axes_within(
     model: &RobotModel,
     q: &[[f64; MAX_AXES]; 3],
     k: usize,
     dt: f64,
-    accelerations: bool,
+    accel: Option<f64>,
 ) -> bool {
     let axes = q[0].iter().zip(&q[1]).zip(&q[2]).take(model.dof());
     axes.enumerate().all(|(i, ((q0, q1), q2))| {
         let axis = model.axis(i);
         let speed =
             k < 1 || (q2 - q1).abs() / dt <= axis.max_velocity * (1.0 + JOINT_SPEED_TOLERANCE);
-        let accel = k < 2
-            || !accelerations
-            || (q2 - 2.0 * q1 + q0).abs() / (dt * dt)
-                <= axis.max_accel * (1.0 - SAMPLED_ACCEL_MARGIN);
-        speed && accel
+        let within = k < 2
+            || accel.is_none_or(|share| {
+                (q2 - 2.0 * q1 + q0).abs() / (dt * dt) <= axis.max_accel * share
+            });
+        speed && within
     })
 }
 

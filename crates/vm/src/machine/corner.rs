@@ -13,10 +13,11 @@
 //! arcs, the same sum. The shares of the path's fraction `s` given to the three pieces
 //! make the pose's derivative by `s` continuous at both joins (the joints' speeds are
 //! continuous); its second derivative is not (the curve's curvature begins there), so the
-//! joins are knots of the timing, with each side's derivatives on its side. Every limit holds through the corner: the axes'
-//! speeds and accelerations, the TCP's speed (from the first motion's to the second's
-//! across the curve), its whole acceleration (along and across the path, knot by knot)
-//! and each motion's orientation speed.
+//! joins are knots of the timing, with each side's derivatives on its side. These limits
+//! hold through the corner: the axes' speeds and accelerations, the TCP's speed (from the
+//! first motion's to the second's across the curve), its whole acceleration (along and
+//! across the path, knot by knot) and each motion's own path speed (its orientation speed
+//! on its own pieces; in the curve the two rotations compose).
 
 use vworks_model::RobotModel;
 use vworks_model::math::{Iso, V3, add, axpy, dot, mat_mul, norm, sub, transpose};
@@ -63,6 +64,16 @@ struct Progress {
 
 impl TimedCorner {
     fn progress(&self, s: f64) -> Progress {
+        self.progress_on(s, false)
+    }
+
+    /// [`TimedCorner::progress`], or at a join, with `curve`, the curve's side of it (its
+    /// curvature begins there).
+    fn progress_on(&self, s: f64, curve: bool) -> Progress {
+        let join = s == self.s_in || s == self.s_out;
+        if curve && join && self.s_out > self.s_in {
+            return self.in_curve(s);
+        }
         if s <= self.s_in && self.s_in > 0.0 {
             let d1 = (self.f_in - self.f_now) / self.s_in;
             return Progress {
@@ -85,6 +96,11 @@ impl TimedCorner {
                 dd2: 0.0,
             };
         }
+        self.in_curve(s)
+    }
+
+    /// The progressions inside the curve at `s` (clamped to it).
+    fn in_curve(&self, s: f64) -> Progress {
         let sigma = self.s_out - self.s_in;
         let u = ((s - self.s_in) / sigma).clamp(0.0, 1.0);
         let (r1, r2) = (1.0 - self.f_in, self.f_out);
@@ -163,7 +179,10 @@ fn piece_knots(joins: [f64; 2]) -> ([f64; KNOTS], [usize; 2]) {
     let mut k = 0;
     for (j, st) in steps.iter().enumerate() {
         for m in 0..*st {
-            knots[k] = ends[j] + (ends[j + 1] - ends[j]) * m as f64 / *st as f64;
+            // (The steps sum to SEGMENTS: CURVE_STEPS + 4 ≤ SEGMENTS.)
+            if let Some(knot) = knots.get_mut(k) {
+                *knot = ends[j] + (ends[j + 1] - ends[j]) * m as f64 / *st as f64;
+            }
             k += 1;
         }
     }
@@ -181,6 +200,7 @@ fn run_out(u: f64) -> (f64, f64, f64) {
 /// The fewest steps of a corner's curve: it turns the TCP within the zone, often a small
 /// share of the path, and its axes' accelerations change along it.
 const CURVE_STEPS: usize = 64;
+const _: () = assert!(CURVE_STEPS + 4 <= SEGMENTS);
 
 /// How much faster (in `ṡ²`) the robot may be than the fastest start a corner's timing
 /// finds, for that start to be taken: half the timing's margin below the limits.
@@ -246,20 +266,27 @@ pub(super) fn take_over(
     }
     let dt = (time - f.motion.start) as f64 / NS;
     let s_now = first.fraction_at(dt);
-    if corner1.as_ref().is_some_and(|c| s_now < c.s_out) {
+    // (Its motion_end is where its curve ends, or later: the same knot within rounding.)
+    if corner1.as_ref().is_some_and(|c| s_now < c.s_out - 1e-9) {
         return None;
     }
-    let r = f.motion.zone.min(0.5 * l2);
-    if r <= 1e-9 {
+    let mut r = f.motion.zone.min(0.5 * l2);
+    let f_now = first.own_fraction_at(dt);
+    // Already past where the zone begins (short moves whose corners meet: the last one
+    // ended there): the corner from where the robot is, as far on.
+    if f_now > 1.0 - r / l1 {
+        r = (1.0 - f_now) * l1;
+    }
+    if r <= 1e-6 {
         return None;
     }
     let (f_in, f_out) = (1.0 - r / l1, r / l2);
-    let f_now = first.own_fraction_at(dt);
-    if f_now > f_in + 1e-12 {
-        return None;
-    }
-    // (Within a billionth of the zone: there.)
-    let f_now = if f_in - f_now < 1e-9 { f_in } else { f_now };
+    // (Within a micrometre of the zone: there; a shorter piece would be all rounding.)
+    let f_now = if (f_in - f_now) * l1 < 1e-6 {
+        f_in
+    } else {
+        f_now
+    };
     // Shares of s: the derivative by s continuous at both joins.
     let (rho1, c1, c2, rho2) = (f_in - f_now, 2.0 * (1.0 - f_in), 2.0 * f_out, 1.0 - f_out);
     let sigma = 1.0 / (1.0 + rho1 / c1 + rho2 / c2);
@@ -291,6 +318,15 @@ pub(super) fn take_over(
         .chain(to2.r.iter().flatten().chain(&to2.t))
         .chain(tool.r.iter().flatten().chain(&tool.t))
         .chain(mid1.iter().chain(&mid2))
+        .chain([
+            &prof2.dist,
+            &prof2.v,
+            &prof2.a,
+            &prof2.j,
+            &prof2.t_jerk,
+            &prof2.t_acc,
+            &prof2.t_total,
+        ])
         .enumerate()
     {
         key[k] = x.to_bits();
@@ -315,7 +351,7 @@ pub(super) fn take_over(
 
 /// Corners timed already, by the bits of what they depend on: the robot's joints and
 /// place and speed on the first path, both paths (ends, midpoints), their limits, the
-/// zones, the tool and the IK branch. A cache of a pure function (exact keys), at most
+/// zones, the next motion's profile, the tool and the IK branch. A cache of a pure function (exact keys), at most
 /// [`CORNER_MEMO`] of them (the oldest goes first).
 #[derive(Debug)]
 pub(super) struct CornerMemo {
@@ -333,8 +369,9 @@ impl CornerMemo {
 
 /// Corners a VM remembers.
 const CORNER_MEMO: usize = 16;
-/// A corner's key: joints now and at the end, 8 numbers, 5 poses, 2 midpoints, the branch.
-const CORNER_KEY: usize = 2 * MAX_AXES + 8 + 5 * 12 + 6 + 1;
+/// A corner's key: joints now and at the end, 8 numbers, 5 poses, 2 midpoints, the next
+/// motion's profile, the branch.
+const CORNER_KEY: usize = 2 * MAX_AXES + 8 + 5 * 12 + 6 + 7 + 1;
 
 /// The corner `corner` from the robot's joints and own-path speed `now` on the first
 /// path into `next`, timed (`take_over`'s work once the corner is known).
@@ -378,7 +415,8 @@ fn time_corner(
     let along = |knots: &[f64; KNOTS]| {
         let mut out = KnotLimits::none();
         for (k, s) in knots.iter().enumerate() {
-            let p = corner.progress(*s);
+            // (At a join, the curve's side: the stricter, its curvature begins there.)
+            let p = corner.progress_on(*s, true);
             let (t1, c1) = p1.derivatives(p.f1);
             let (t2, c2) = p2.derivatives(p.f2);
             let d = add(t1.map(|x| x * p.d1), t2.map(|x| x * p.d2));
@@ -386,9 +424,9 @@ fn time_corner(
                 axpy(p.dd1, t1, c1.map(|x| x * p.d1 * p.d1)),
                 axpy(p.dd2, t2, c2.map(|x| x * p.d2 * p.d2)),
             );
-            let (v, a) = if p.f2 <= 0.0 {
+            let (v, a) = if *s < corner.s_in {
                 (v1, a1)
-            } else if p.f1 >= 1.0 {
+            } else if *s > corner.s_out {
                 (v2, a2)
             } else {
                 let u = ((*s - corner.s_in) / (corner.s_out - corner.s_in)).clamp(0.0, 1.0);
@@ -452,6 +490,9 @@ fn time_corner(
         }
         Err(_) => return None,
     };
+    // (Its own motion_end, and so the next corner, never before its curve has ended.)
+    let curve_end = timing.time_at(corner.s_out);
+    let look_ahead = look_ahead.map(|t| t.max(curve_end));
     let mut step_speed = [0.0f64; SEGMENTS];
     for (k, v) in step_speed.iter_mut().enumerate() {
         *v = timing.speed_at_knot(k).max(timing.speed_at_knot(k + 1));

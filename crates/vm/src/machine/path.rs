@@ -502,8 +502,9 @@ pub(super) fn time_path(
         // rounds, else there is none.
         if x0 > 0.0 {
             if round + 1 < ROOM_ROUNDS_AT_SPEED && ratios[0] <= 1.0 {
-                // (Twice the step: the rounds converge from above.)
-                for (room, r) in joints.room.iter_mut().zip(&ratios) {
+                // (Twice the step: the rounds converge from above. The first step keeps
+                // its room: less would leave no start at the robot's speed.)
+                for (room, r) in joints.room.iter_mut().zip(&ratios).skip(1) {
                     if *r > 1.0 - TIMING_MARGIN {
                         *room *= ((1.0 - TIMING_MARGIN) / r).powi(2);
                     }
@@ -632,8 +633,9 @@ fn check_profile(
         }
     }
     // Where the profile's acceleration peaks (its phases' ends) the steps are checked
-    // between the knots too: an S-curve's braking peaks within the last step or two,
-    // between two knots.
+    // between the knots too, and every axis at the peak itself (its slopes interpolated
+    // between the two knots around): an S-curve's braking peaks within the last step or
+    // two, and between its quarter points the acceleration's triangle can rise by 2 %.
     let mut peaks = false;
     if profile.t_jerk > 0.0 && profile.dist > 0.0 {
         for t in profile.breakpoints() {
@@ -645,6 +647,21 @@ fn check_profile(
                 near[step] = true;
             }
             peaks = true;
+            let w = ((s - joints.knot(k)) / joints.step(k)).clamp(0.0, 1.0);
+            let (v_path, a_path) = (
+                profile.speed_at(t) / profile.dist,
+                profile.accel_at(t) / profile.dist,
+            );
+            for i in 0..joints.axes {
+                let (a0, a1) = (derivatives[k][i], derivatives[k + 1][i]);
+                let d = (a0.0 + w * (a1.0 - a0.0), a0.1 + w * (a1.1 - a0.1));
+                let (v, a) = axis_load(d, v_path, a_path);
+                let ratio = (speed[i] / v).min(accel[i] / a);
+                if ratio < worst {
+                    worst = ratio;
+                    worst_axis = i;
+                }
+            }
         }
     }
     let mut fits = worst >= 1.0 - JOINT_SPEED_TOLERANCE;

@@ -4,7 +4,7 @@
 
 use vworks_model::RobotModel;
 use vworks_model::math::Iso;
-use vworks_model::timing::Timing;
+use vworks_model::timing::{SEGMENTS, Timing};
 
 use super::corner::TimedCorner;
 use super::path::SEEDS;
@@ -247,6 +247,22 @@ impl Trajectory {
                 corner: Some(c), ..
             } => c.own_rate(self.fraction_at(dt)) * self.path_speed_at(dt),
             _ => self.path_speed_at(dt),
+        }
+    }
+
+    /// The largest speed of a Cartesian motion's own path fraction (1/s): through a corner
+    /// it took over, the largest at the timing's knots (its own fraction's rate is linear
+    /// or constant between them).
+    pub(super) fn top_own_speed(&self) -> f64 {
+        match self {
+            Trajectory::Cartesian {
+                corner: Some(c),
+                timing: Some(t),
+                ..
+            } => (0..=SEGMENTS)
+                .map(|k| c.own_rate(t.knot(k)) * t.speed_at_knot(k))
+                .fold(0.0, f64::max),
+            _ => self.top_path_speed(),
         }
     }
 
