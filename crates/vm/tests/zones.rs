@@ -257,7 +257,7 @@ proptest! {
         // (second differences, 1 % below the limit); where none keeps them the robot stops
         // at the point; an S-curve is checked at its phases' ends too. Between the samples
         // a path is checked at an axis may still go a little over: in three runs of 600 to
-        // 1,000 random programs the worst at 1 kHz was 1.00013× a limit (it was 2.2× while
+        // 1,000 random programs the worst at 1 kHz was 1.00013× a limit (it was up to 2.21× while
         // corners that could not keep the accelerations superposed them anyway).
         for w in r.samples.windows(3) {
             for i in 0..6 {
