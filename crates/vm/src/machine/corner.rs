@@ -359,10 +359,11 @@ pub(super) struct CornerMemo {
 }
 
 impl CornerMemo {
-    /// An empty memo, its room reserved once.
+    /// An empty memo. It grows to [`CORNER_MEMO`] entries as corners are timed (10 KB
+    /// each: a robot without corners keeps none), then allocates no more.
     pub(super) fn new() -> CornerMemo {
         CornerMemo {
-            entries: Vec::with_capacity(CORNER_MEMO),
+            entries: Vec::new(),
         }
     }
 }
