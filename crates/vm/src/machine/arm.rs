@@ -11,7 +11,7 @@ use vworks_model::math::Iso;
 
 use super::blend::{self, Fading, Planned};
 use super::corner::{self, CornerMemo};
-use super::path::PathMemo;
+use super::path::{PATH_MEMO, PathMemo};
 use super::plan::{self, Capped, Longer, MotionOperands, PlanError, PlanFrom, Slowed, Trajectory};
 use crate::MAX_AXES;
 use crate::bytecode::SrcPos;
@@ -66,8 +66,8 @@ impl Arm {
             pending: None,
             fading: None,
             tool,
-            memo: PathMemo::new(),
-            corners: CornerMemo::new(),
+            memo: PathMemo::reserved(PATH_MEMO),
+            corners: CornerMemo::growing(corner::CORNER_MEMO),
         }
     }
 

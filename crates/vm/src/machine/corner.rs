@@ -25,12 +25,13 @@ use vworks_model::timing::{JointPath, KNOTS, KnotLimits, SEGMENTS};
 
 use super::blend::Fading;
 use super::path::{
-    Inner, PathLimits, Untimed, axis_limits, knot_derivatives, knot_joints, rate_bounds,
-    sample_knots, seeds_of,
+    Inner, Memo, PathLimits, Untimed, axis_limits, knot_derivatives, knot_joints, sample_knots,
+    seeds_of, timed_rates,
 };
-use super::plan::Trajectory;
+use super::plan::{Trajectory, to_ns};
 use crate::MAX_AXES;
 use crate::motion::{NS, Path, cartesian_at};
+use std::convert::Infallible;
 
 /// How a trajectory that flies out of a zone follows the previous motion's path and its
 /// own (module docs): the fractions of both at its own fraction `s`.
@@ -332,47 +333,30 @@ pub(super) fn take_over(
         key[k] = x.to_bits();
     }
     key[CORNER_KEY - 1] = branch.map_or(u64::MAX, u64::from);
-    if let Some((_, found)) = memo.entries.iter().find(|(k, _)| *k == key) {
-        return found.clone();
-    }
-    let taken = time_corner(
-        model,
-        tool,
-        (corner, r, [*vs1, *as1]),
-        (q_now, own_speed),
-        (next, next_zone),
-    );
-    if memo.entries.len() >= CORNER_MEMO {
-        memo.entries.remove(0);
-    }
-    memo.entries.push((key, taken.clone()));
+    let Ok(taken) = memo.get_or_try(key, || {
+        Ok::<_, Infallible>(time_corner(
+            model,
+            tool,
+            (corner, r, [*vs1, *as1]),
+            (q_now, own_speed),
+            (next, next_zone),
+        ))
+    });
     taken
 }
 
-/// Corners timed already, by the bits of what they depend on: the robot's joints and
-/// place and speed on the first path, both paths (ends, midpoints), their limits, the
-/// zones, the next motion's profile, the tool and the IK branch. A cache of a pure function (exact keys), at most
-/// [`CORNER_MEMO`] of them (the oldest goes first).
-#[derive(Debug)]
-pub(super) struct CornerMemo {
-    entries: Vec<([u64; CORNER_KEY], Option<Taken>)>,
-}
-
-impl CornerMemo {
-    /// An empty memo. It grows to [`CORNER_MEMO`] entries as corners are timed (10 KB
-    /// each: a robot without corners keeps none), then allocates no more.
-    pub(super) fn new() -> CornerMemo {
-        CornerMemo {
-            entries: Vec::new(),
-        }
-    }
-}
+/// Corners timed already ([`Memo`]), by the bits of what they depend on: the robot's
+/// joints and place and speed on the first path, both paths (ends, midpoints), their
+/// limits, the zones, the next motion's profile, the tool and the IK branch ([`CORNER_KEY`];
+/// `None`: no timed corner there). It grows as corners are timed (10 KB each: a robot
+/// without corners keeps none).
+pub(super) type CornerMemo = Memo<CORNER_KEY, Option<Taken>>;
 
 /// Corners a VM remembers.
-const CORNER_MEMO: usize = 16;
+pub(super) const CORNER_MEMO: usize = 16;
 /// A corner's key: joints now and at the end, 8 numbers, 5 poses, 2 midpoints, the next
 /// motion's profile, the branch.
-const CORNER_KEY: usize = 2 * MAX_AXES + 8 + 5 * 12 + 6 + 7 + 1;
+pub(super) const CORNER_KEY: usize = 2 * MAX_AXES + 8 + 5 * 12 + 6 + 7 + 1;
 
 /// The corner `corner` from the robot's joints and own-path speed `now` on the first
 /// path into `next`, timed (`take_over`'s work once the corner is known).
@@ -494,12 +478,8 @@ fn time_corner(
     // (Its own motion_end, and so the next corner, never before its curve has ended.)
     let curve_end = timing.time_at(corner.s_out);
     let look_ahead = look_ahead.map(|t| t.max(curve_end));
-    let mut step_speed = [0.0f64; SEGMENTS];
-    for (k, v) in step_speed.iter_mut().enumerate() {
-        *v = timing.speed_at_knot(k).max(timing.speed_at_knot(k + 1));
-    }
-    let rates = rate_bounds(&joints, &step_speed);
-    let point_ns = (timing.duration() * NS).ceil() as i64;
+    let rates = timed_rates(&joints, &timing);
+    let point_ns = to_ns(timing.duration());
     Some(Taken {
         traj: Trajectory::Cartesian {
             path: p2.clone(),

@@ -56,40 +56,56 @@ pub(super) struct PathSamples {
     pub(super) look_ahead: Option<f64>,
 }
 
-/// Cartesian paths sampled, by the bits of their joints, poses, speed and tool: a program
-/// repeating its moves samples each once. A cache of a pure function (exact keys): [`plan`]
-/// gives the same with an empty memo as with a full one.
+/// A cache of a pure function by exact keys (the bits of everything it depends on): at
+/// most `capacity` results, the oldest going first, so a caller gives the same with an
+/// empty memo as with a full one. Cartesian paths sampled ([`PathMemo`]) and corners timed
+/// (`corner::CornerMemo`) are kept in one: a program repeating its moves plans each once.
 #[derive(Debug)]
-pub(super) struct PathMemo {
-    entries: Vec<([u64; PATH_KEY], PathSamples)>,
+pub(super) struct Memo<const KEY: usize, V> {
+    entries: Vec<([u64; KEY], V)>,
+    capacity: usize,
 }
 
-impl PathMemo {
-    /// An empty memo, its room reserved once.
-    pub(super) fn new() -> PathMemo {
-        PathMemo {
-            entries: Vec::with_capacity(PATH_MEMO),
+impl<const KEY: usize, V: Clone> Memo<KEY, V> {
+    /// An empty memo with its room reserved once (it never allocates after).
+    pub(super) fn reserved(capacity: usize) -> Self {
+        Memo {
+            entries: Vec::with_capacity(capacity),
+            capacity,
         }
     }
 
-    /// The samples under `key`, or those `sample` makes (then remembered; the oldest goes
-    /// when the memo is full, so it never grows past its capacity).
-    pub(super) fn get_or_sample(
-        &mut self,
-        key: [u64; PATH_KEY],
-        sample: impl FnOnce() -> Result<PathSamples, PlanError>,
-    ) -> Result<PathSamples, PlanError> {
-        if let Some((_, s)) = self.entries.iter().find(|(k, _)| *k == key) {
-            return Ok(s.clone());
+    /// An empty memo that grows as it is used, to `capacity` entries.
+    pub(super) fn growing(capacity: usize) -> Self {
+        Memo {
+            entries: Vec::new(),
+            capacity,
         }
-        let s = sample()?;
-        if self.entries.len() >= PATH_MEMO {
+    }
+
+    /// The result under `key`, or the one `make` gives (then remembered; an error is
+    /// not).
+    pub(super) fn get_or_try<E>(
+        &mut self,
+        key: [u64; KEY],
+        make: impl FnOnce() -> Result<V, E>,
+    ) -> Result<V, E> {
+        if let Some((_, v)) = self.entries.iter().find(|(k, _)| *k == key) {
+            return Ok(v.clone());
+        }
+        let v = make()?;
+        if self.entries.len() >= self.capacity {
             self.entries.remove(0);
         }
-        self.entries.push((key, s.clone()));
-        Ok(s)
+        self.entries.push((key, v.clone()));
+        Ok(v)
     }
 }
+
+/// Cartesian paths sampled, by the bits of their joints, poses, speed and tool
+/// ([`PATH_KEY`]).
+pub(super) type PathMemo = Memo<PATH_KEY, PathSamples>;
+
 /// Samples a Cartesian path at the timing's [`KNOTS`] from joints `from` (each knot's IK
 /// seeded from the one before, on the analytic `branch` the motion executes on, if the arm
 /// has one): every point reachable (or the error, naming where), no axis jumping to
@@ -249,11 +265,6 @@ pub(super) fn sample_path(
         }
         return Ok(profile_samples(&joints, &lower, &check, Some(lower), end));
     }
-    // ṡ² is linear in s within a step: ṡ is largest at one of its ends.
-    let mut step_speed = [0.0f64; SEGMENTS];
-    for (k, v) in step_speed.iter_mut().enumerate() {
-        *v = timing.speed_at_knot(k).max(timing.speed_at_knot(k + 1));
-    }
     // Slowed: where an axis's speed keeps the TCP below its programmed speed (the axes'
     // accelerations are the path's own dynamics, as on a controller), against the same
     // timing without the axis speeds.
@@ -279,7 +290,7 @@ pub(super) fn sample_path(
             .filter(|would| timing.duration() > would * (1.0 + 1e-9))
     };
     // (A timed path never flies with corner ramps: its cruise bound is its bound.)
-    let rates = rate_bounds(&joints, &step_speed);
+    let rates = timed_rates(&joints, &timing);
     Ok(PathSamples {
         seeds: seeds_of(&joints),
         rates,
@@ -1011,11 +1022,21 @@ fn state_at_distance(p: &Profile, d: f64) -> (f64, f64) {
     (p.speed_at(t), p.accel_at(t))
 }
 
+/// Per axis, a bound on its speed along a sampled path under `timing` (ṡ² is linear in s
+/// within a step: ṡ is largest at one of its ends).
+pub(super) fn timed_rates(joints: &JointPath, timing: &Timing) -> [f64; MAX_AXES] {
+    let mut step_speed = [0.0f64; SEGMENTS];
+    for (k, v) in step_speed.iter_mut().enumerate() {
+        *v = timing.speed_at_knot(k).max(timing.speed_at_knot(k + 1));
+    }
+    rate_bounds(joints, &step_speed)
+}
+
 /// Per axis, a bound on its speed along a sampled path whose fraction moves at most
 /// `step_speed[k]` through step `k`: the largest of the axis's rate of change over the
 /// step (the chord) and at its two knots, times that speed, with 1 % for the path's
 /// curvature within a step (the collider's horizon relies on it as a bound).
-pub(super) fn rate_bounds(joints: &JointPath, step_speed: &[f64; SEGMENTS]) -> [f64; MAX_AXES] {
+fn rate_bounds(joints: &JointPath, step_speed: &[f64; SEGMENTS]) -> [f64; MAX_AXES] {
     let mut rates = [0.0f64; MAX_AXES];
     for (k, v) in step_speed.iter().enumerate() {
         for (i, r) in rates.iter_mut().enumerate().take(joints.axes) {

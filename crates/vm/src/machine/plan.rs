@@ -614,7 +614,7 @@ fn plan_cartesian(
     };
     let profile = Profile::with_jerk(1.0, vs, as_, js);
     // (A path that goes nowhere has returned above: a duration's path moves.)
-    let sampled = memo.get_or_sample(key, || match duration_ns {
+    let sampled = memo.get_or_try(key, || match duration_ns {
         Some(want) => {
             // The fastest TCP and orientation speeds (`orient`, if given, stays the
             // orientation's bound), scaled together by k.
@@ -720,7 +720,7 @@ fn sampled_seconds(
 }
 
 /// Seconds rounded up to whole nanoseconds (as [`Profile::duration_ns`]).
-fn to_ns(seconds: f64) -> i64 {
+pub(super) fn to_ns(seconds: f64) -> i64 {
     (seconds * NS).ceil() as i64
 }
 
