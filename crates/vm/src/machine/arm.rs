@@ -253,13 +253,13 @@ impl Arm {
             // Else the next takes the robot over now, through a corner timed with the rest of
             // the first as one path, where it can.
             let corners = &mut self.corners;
-            if let Some(taken) =
+            if let Some((start, taken)) =
                 corner::take_over(model, &tool, time, (f, &traj, programmed), corners)
             {
                 traj = taken.traj;
                 point_ns = taken.point_ns;
                 look_ahead = taken.look_ahead;
-                return (time, taken.radius, time, f.pos, false);
+                return (start, taken.radius, start, f.pos, false);
             }
             if stops {
                 return (f.end(), 0.0, f.end(), f.pos, true);

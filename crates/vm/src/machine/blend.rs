@@ -487,14 +487,14 @@ fn ramps_fit(model: &RobotModel, time: i64, f: &Fading, next: &Trajectory, c: &C
             continue;
         }
         let dt = (to - from) as f64 / NS / RAMP_SAMPLES as f64;
-        let mut q = [[0.0; MAX_AXES]; 3];
+        let mut q = [[0.0; MAX_AXES]; 4];
         for k in 0..=RAMP_SAMPLES {
             let t = from + ((to - from) as f64 * k as f64 / RAMP_SAMPLES as f64) as i64;
             let Some(qk) = blend_joints(model, &f, &next, ts, t) else {
                 return false;
             };
-            q = [q[1], q[2], qk];
-            if !axes_within(model, &q, k, dt, Some(1.0 + JOINT_SPEED_TOLERANCE)) {
+            q = [q[1], q[2], q[3], qk];
+            if !axes_within(model, &q, k, dt, Some(1.0 + JOINT_SPEED_TOLERANCE), true) {
                 return false;
             }
         }
@@ -691,21 +691,21 @@ fn corner_samples(
     // of its start and end are where the two motions' add up or stop adding up.
     let step = (span / CORNER_SAMPLES as i64).max(1);
     let dt = step as f64 / NS;
-    let mut q = [[0.0; MAX_AXES]; 3];
+    let mut q = [[0.0; MAX_AXES]; 4];
     let mut farthest = 0.0f64;
     for k in 0..=CORNER_SAMPLES as i64 + 2 {
         let t = ts + (k - 1) * step;
-        q = [q[1], q[2], blend_joints(model, f, next, ts, t)?];
+        q = [q[1], q[2], q[3], blend_joints(model, f, next, ts, t)?];
         let inside = t > ts && t <= f.end();
-        if inside && joint_space && !model.within_limits(&q[2][..n]) {
+        if inside && joint_space && !model.within_limits(&q[3][..n]) {
             return None;
         }
         let accel = (!both_joint).then_some(1.0 - SAMPLED_ACCEL_MARGIN);
-        if !axes_within(model, &q, k as usize, dt, accel) {
+        if !axes_within(model, &q, k as usize, dt, accel, !both_joint) {
             return None;
         }
         if inside && joint_space {
-            let p = model.tcp(&q[2][..n], tool).t;
+            let p = model.tcp(&q[3][..n], tool).t;
             let d = norm(sub(p, f.corner_pose.t));
             if d > f.motion.zone {
                 return None;
@@ -716,28 +716,56 @@ fn corner_samples(
     Some(farthest)
 }
 
-/// Every axis within its speed between the last two of three samples `dt` apart (when
-/// there are two: sample `k` ≥ 1, within [`JOINT_SPEED_TOLERANCE`]) and, with a share
-/// `accel` of its acceleration, within that by their second difference (`k` ≥ 2): corner
-/// ramps `1 + JOINT_SPEED_TOLERANCE`, superposed corners [`SAMPLED_ACCEL_MARGIN`] below.
+/// Every axis within its speed and acceleration at the last of four samples `dt` apart
+/// (`q[3]` is sample `k`):
+///
+/// - its speed between the last two (when there are two: `k` ≥ 1) within
+///   [`JOINT_SPEED_TOLERANCE`] of its limit, and, with `peaks` (`k` ≥ 3), its peak speed
+///   between the middle two: a chord averages the speed, and a smooth peak between two
+///   samples rises above it (at 1/64 of a corner, 1.8e-4 above a chord at the limit). The
+///   peak is that of the derivative of the cubic through the four samples, a quadratic
+///   whose means over the three intervals are their chords;
+/// - with a share `accel` of its acceleration, within that by the second difference of
+///   the last three (`k` ≥ 2): corner ramps `1 + JOINT_SPEED_TOLERANCE`, superposed
+///   corners [`SAMPLED_ACCEL_MARGIN`] below.
 fn axes_within(
     model: &RobotModel,
-    q: &[[f64; MAX_AXES]; 3],
+    q: &[[f64; MAX_AXES]; 4],
     k: usize,
     dt: f64,
     accel: Option<f64>,
+    peaks: bool,
 ) -> bool {
-    let axes = q[0].iter().zip(&q[1]).zip(&q[2]).take(model.dof());
-    axes.enumerate().all(|(i, ((q0, q1), q2))| {
+    (0..model.dof()).all(|i| {
         let axis = model.axis(i);
-        let speed =
-            k < 1 || (q2 - q1).abs() / dt <= axis.max_velocity * (1.0 + JOINT_SPEED_TOLERANCE);
+        let top = axis.max_velocity * (1.0 + JOINT_SPEED_TOLERANCE);
+        let [d1, d2, d3] = [1, 2, 3].map(|j| (q[j][i] - q[j - 1][i]) / dt);
+        let speed = k < 1 || d3.abs() <= top;
+        let peak = !peaks || k < 3 || chord_peak(d1, d2, d3) <= top;
         let within = k < 2
             || accel.is_none_or(|share| {
-                (q2 - 2.0 * q1 + q0).abs() / (dt * dt) <= axis.max_accel * share
+                (q[3][i] - 2.0 * q[2][i] + q[1][i]).abs() / (dt * dt) <= axis.max_accel * share
             });
-        speed && within
+        speed && peak && within
     })
+}
+
+/// The largest |v(s)| for s in [−½, ½] of the quadratic `v` whose means over the unit
+/// intervals centred on −1, 0 and 1 are `d1`, `d2` and `d3` (the mean of
+/// `A + B·s + C·s²` over the interval centred on `m` is `A + B·m + C·(m² + 1/12)`).
+fn chord_peak(d1: f64, d2: f64, d3: f64) -> f64 {
+    let c = 0.5 * (d1 + d3 - 2.0 * d2);
+    let b = 0.5 * (d3 - d1);
+    let a = d2 - c / 12.0;
+    let v = |s: f64| (a + s * (b + s * c)).abs();
+    let mut top = v(-0.5).max(v(0.5));
+    if c != 0.0 {
+        let s = -b / (2.0 * c);
+        if s.abs() < 0.5 {
+            top = top.max(v(s));
+        }
+    }
+    top
 }
 
 /// What makes a zoned point still ahead a stop point, named for the warning: the main
@@ -809,4 +837,22 @@ fn window_extremes(window: f64, parts: [(&Profile, f64, f64); 2]) -> (f64, f64) 
         }
     }
     (vmax, amax)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::chord_peak;
+
+    /// By hand: v(s) = 1 + 0.2·s − 3·s² has means A + B·m + C·(m² + 1/12) over the unit
+    /// intervals centred on m = −1, 0, 1: 1 − 0.2 − 3.25 = −2.45, 1 − 0.25 = 0.75 and
+    /// 1 + 0.2 − 3.25 = −2.05. Its peak is at s = 0.2/6, v = 1 + 0.01/3.
+    #[test]
+    fn a_chord_peak_is_the_peak_of_the_quadratic_with_those_means() {
+        let peak = chord_peak(-2.45, 0.75, -2.05);
+        assert!((peak - (1.0 + 0.01 / 3.0)).abs() < 1e-12, "{peak}");
+        // A straight speed peaks at an end: means 1, 2, 3 are v(s) = 2 + s.
+        assert!((chord_peak(1.0, 2.0, 3.0) - 2.5).abs() < 1e-12);
+        // Or at the other end, in magnitude.
+        assert!((chord_peak(-1.0, -2.0, -3.0) - 2.5).abs() < 1e-12);
+    }
 }

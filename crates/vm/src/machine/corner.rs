@@ -222,14 +222,16 @@ pub(super) struct Taken {
 /// limits (module docs); `next_zone` its own zone. `None` where this corner does not
 /// apply (a motion with a `duration`, jerk limits, corner ramps, a path of no length, the
 /// robot already inside the zone or still in a corner of its own) or has no timing that
-/// starts at the robot's speed: the caller superposes them instead.
+/// starts at the robot's speed: the caller superposes them instead. With the corner, the
+/// instant it takes over: `time`, or the few nanoseconds later at which the robot reaches
+/// its zone if it is within a micrometre of it.
 pub(super) fn take_over(
     model: &RobotModel,
     tool: &Iso,
     time: i64,
     (f, next, next_zone): (&Fading, &Trajectory, Option<f64>),
     memo: &mut CornerMemo,
-) -> Option<Taken> {
+) -> Option<(i64, Taken)> {
     let first = &f.motion.traj;
     let Trajectory::Cartesian {
         path: p1,
@@ -265,29 +267,40 @@ pub(super) fn take_over(
     if l1 <= 1e-7 || l2 <= 1e-7 || prof1.t_jerk > 0.0 || prof2.t_jerk > 0.0 {
         return None;
     }
-    let dt = (time - f.motion.start) as f64 / NS;
+    let zone = f.motion.zone.min(0.5 * l2);
+    // Within a micrometre before its zone (a look-ahead point is a knot, which may fall
+    // just before it): from where the robot has reached it, the nanoseconds later that
+    // takes. A shorter piece before the curve would be all rounding, and a robot moved on
+    // by a micrometre in no time would jump.
+    let before =
+        |at: i64| (1.0 - first.own_fraction_at((at - f.motion.start) as f64 / NS)) * l1 - zone;
+    let mut start = time;
+    let gap = before(start);
+    if gap > 0.0 && gap < 1e-6 {
+        let speed = l1 * first.own_speed_at((start - f.motion.start) as f64 / NS);
+        if speed <= 0.0 || gap / speed > 1e-3 {
+            return None;
+        }
+        start += to_ns(gap / speed);
+        // (The speed changes a little in those nanoseconds.)
+        while before(start) > 0.0 && start < f.end() {
+            start += 1;
+        }
+    }
+    let dt = (start - f.motion.start) as f64 / NS;
     let s_now = first.fraction_at(dt);
     // (Its motion_end is where its curve ends, or later: the same knot within rounding.)
     if corner1.as_ref().is_some_and(|c| s_now < c.s_out - 1e-9) {
         return None;
     }
-    let mut r = f.motion.zone.min(0.5 * l2);
     let f_now = first.own_fraction_at(dt);
     // Already past where the zone begins (short moves whose corners meet: the last one
     // ended there): the corner from where the robot is, as far on.
-    if f_now > 1.0 - r / l1 {
-        r = (1.0 - f_now) * l1;
-    }
+    let r = zone.min((1.0 - f_now) * l1);
     if r <= 1e-6 {
         return None;
     }
     let (f_in, f_out) = (1.0 - r / l1, r / l2);
-    // (Within a micrometre of the zone: there; a shorter piece would be all rounding.)
-    let f_now = if (f_in - f_now) * l1 < 1e-6 {
-        f_in
-    } else {
-        f_now
-    };
     // Shares of s: the derivative by s continuous at both joins.
     let (rho1, c1, c2, rho2) = (f_in - f_now, 2.0 * (1.0 - f_in), 2.0 * f_out, 1.0 - f_out);
     let sigma = 1.0 / (1.0 + rho1 / c1 + rho2 / c2);
@@ -342,7 +355,7 @@ pub(super) fn take_over(
             (next, next_zone),
         ))
     });
-    taken
+    Some((start, taken?))
 }
 
 /// Corners timed already ([`Memo`]), by the bits of what they depend on: the robot's
