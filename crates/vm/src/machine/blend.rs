@@ -24,6 +24,7 @@ use vworks_model::RobotModel;
 use vworks_model::math::{Iso, V3, axpy, norm, sub};
 
 use super::plan::{JOINT_SPEED_TOLERANCE, Trajectory};
+use super::quarters::chord_peak;
 use crate::MAX_AXES;
 use crate::bytecode::{Instr, SrcPos};
 use crate::motion::{NS, Path, Profile};
@@ -741,31 +742,13 @@ fn axes_within(
         let top = axis.max_velocity * (1.0 + JOINT_SPEED_TOLERANCE);
         let [d1, d2, d3] = [1, 2, 3].map(|j| (q[j][i] - q[j - 1][i]) / dt);
         let speed = k < 1 || d3.abs() <= top;
-        let peak = !peaks || k < 3 || chord_peak(d1, d2, d3) <= top;
+        let peak = !peaks || k < 3 || chord_peak([d1, d2, d3], 0.0) <= top;
         let within = k < 2
             || accel.is_none_or(|share| {
                 (q[3][i] - 2.0 * q[2][i] + q[1][i]).abs() / (dt * dt) <= axis.max_accel * share
             });
         speed && peak && within
     })
-}
-
-/// The largest |v(s)| for s in [−½, ½] of the quadratic `v` whose means over the unit
-/// intervals centred on −1, 0 and 1 are `d1`, `d2` and `d3` (the mean of
-/// `A + B·s + C·s²` over the interval centred on `m` is `A + B·m + C·(m² + 1/12)`).
-fn chord_peak(d1: f64, d2: f64, d3: f64) -> f64 {
-    let c = 0.5 * (d1 + d3 - 2.0 * d2);
-    let b = 0.5 * (d3 - d1);
-    let a = d2 - c / 12.0;
-    let v = |s: f64| (a + s * (b + s * c)).abs();
-    let mut top = v(-0.5).max(v(0.5));
-    if c != 0.0 {
-        let s = -b / (2.0 * c);
-        if s.abs() < 0.5 {
-            top = top.max(v(s));
-        }
-    }
-    top
 }
 
 /// What makes a zoned point still ahead a stop point, named for the warning: the main
@@ -837,22 +820,4 @@ fn window_extremes(window: f64, parts: [(&Profile, f64, f64); 2]) -> (f64, f64) 
         }
     }
     (vmax, amax)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::chord_peak;
-
-    /// By hand: v(s) = 1 + 0.2·s − 3·s² has means A + B·m + C·(m² + 1/12) over the unit
-    /// intervals centred on m = −1, 0, 1: 1 − 0.2 − 3.25 = −2.45, 1 − 0.25 = 0.75 and
-    /// 1 + 0.2 − 3.25 = −2.05. Its peak is at s = 0.2/6, v = 1 + 0.01/3.
-    #[test]
-    fn a_chord_peak_is_the_peak_of_the_quadratic_with_those_means() {
-        let peak = chord_peak(-2.45, 0.75, -2.05);
-        assert!((peak - (1.0 + 0.01 / 3.0)).abs() < 1e-12, "{peak}");
-        // A straight speed peaks at an end: means 1, 2, 3 are v(s) = 2 + s.
-        assert!((chord_peak(1.0, 2.0, 3.0) - 2.5).abs() < 1e-12);
-        // Or at the other end, in magnitude.
-        assert!((chord_peak(-1.0, -2.0, -3.0) - 2.5).abs() < 1e-12);
-    }
 }

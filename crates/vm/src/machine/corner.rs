@@ -25,10 +25,11 @@ use vworks_model::timing::{JointPath, KNOTS, KnotLimits, SEGMENTS};
 
 use super::blend::Fading;
 use super::path::{
-    Inner, Memo, PathLimits, Untimed, axis_limits, knot_derivatives, knot_joints, sample_knots,
-    seeds_of, timed_rates,
+    Memo, PathLimits, Untimed, axis_limits, knot_derivatives, knot_joints, sample_knots, seeds_of,
+    timed_rates,
 };
 use super::plan::{Trajectory, to_ns};
+use super::quarters::Inner;
 use crate::MAX_AXES;
 use crate::motion::{NS, Path, cartesian_at};
 use std::convert::Infallible;

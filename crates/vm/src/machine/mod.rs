@@ -23,6 +23,7 @@ mod names;
 mod path;
 mod plan;
 mod pulses;
+mod quarters;
 mod remote;
 mod state;
 mod trajectory;

@@ -10,6 +10,7 @@ use vworks_model::math::Iso;
 use vworks_model::timing::{JointPath, KNOTS, KnotLimits, Limits, SEGMENTS, Timing, TimingError};
 
 use super::plan::{JOINT_SPEED_TOLERANCE, PlanError, ik_tcp};
+use super::quarters::Inner;
 use crate::MAX_AXES;
 use crate::motion::{Path, Profile, cartesian_at};
 
@@ -505,7 +506,13 @@ pub(super) fn time_path(
             let (x, u) = timing.step_state(k);
             (x + 2.0 * u * (s - joints.knot(k)), u)
         };
-        let (rv, ra) = inner.ratios(joints, &speed[..n], &accel[..n], state, &mut ratios);
+        let (rv, ra) = inner.ratios(
+            joints,
+            (&speed[..n], &accel[..n]),
+            state,
+            &[false; SEGMENTS],
+            &mut ratios,
+        );
         if rv.max(ra) <= 1.0 {
             break;
         }
@@ -600,6 +607,10 @@ fn fastest_axis(derivatives: &KnotDerivatives, timing: &Timing, speed: &[f64]) -
     (axis, best)
 }
 
+/// How far to each side of a profile's breakpoint (a share of its time) its acceleration
+/// is taken on that side: a step of a trapezoid's acceleration is exactly at it.
+const PHASE_SIDE: f64 = 1e-12;
+
 /// How a profile keeps the axis limits along a sampled path.
 struct ProfileCheck {
     /// Every axis within its speed and acceleration at the knots, and between them where
@@ -645,10 +656,15 @@ fn check_profile(
     }
     // Where the profile's acceleration peaks (its phases' ends) the steps are checked
     // between the knots too, and every axis at the peak itself (its slopes interpolated
-    // between the two knots around): an S-curve's braking peaks within the last step or
-    // two, and between its quarter points the acceleration's triangle can rise by 2 %.
+    // between the two knots around), on both sides of it: an S-curve's braking peaks
+    // within the last step or two, and between its quarter points the acceleration's
+    // triangle can rise by 2 %; a trapezoid's braking begins at its top speed, where the
+    // term q″·ṡ² is largest, between two knots (0.07 % over on a line whose braking takes
+    // two steps).
     let mut peaks = false;
-    if profile.t_jerk > 0.0 && profile.dist > 0.0 {
+    // (The steps around a phase's end: the state's derivative steps there.)
+    let mut kinked = [false; SEGMENTS];
+    if profile.dist > 0.0 {
         for t in profile.breakpoints() {
             let s = (profile.at(t) / profile.dist).clamp(0.0, 1.0);
             let k = joints.knots()[..SEGMENTS]
@@ -656,21 +672,47 @@ fn check_profile(
                 .saturating_sub(1);
             for step in [k.saturating_sub(1), k, (k + 1).min(SEGMENTS - 1)] {
                 near[step] = true;
+                kinked[step] = true;
             }
             peaks = true;
             let w = ((s - joints.knot(k)) / joints.step(k)).clamp(0.0, 1.0);
-            let (v_path, a_path) = (
-                profile.speed_at(t) / profile.dist,
-                profile.accel_at(t) / profile.dist,
-            );
-            for i in 0..joints.axes {
-                let (a0, a1) = (derivatives[k][i], derivatives[k + 1][i]);
-                let d = (a0.0 + w * (a1.0 - a0.0), a0.1 + w * (a1.1 - a0.1));
-                let (v, a) = axis_load(d, v_path, a_path);
-                let ratio = (speed[i] / v).min(accel[i] / a);
-                if ratio < worst {
-                    worst = ratio;
-                    worst_axis = i;
+            let v_path = profile.speed_at(t) / profile.dist;
+            // The axes' slopes and curvatures at the breakpoint: inside the path, from the
+            // joints an eighth of a step to each side of it (the knots' own, interpolated,
+            // are a step's finite differences: 3e-5 of a limit off, where a braking phase
+            // ends at its peak); at its ends, the knots'.
+            let h = 0.125 * joints.step(k);
+            let at_point = if s - h > 0.0 && s + h < 1.0 {
+                let before = joints_at(s - h, &joints.q[k])?;
+                let here = joints_at(s, &before)?;
+                let after = joints_at(s + h, &here)?;
+                Some((before, here, after))
+            } else {
+                None
+            };
+            let slopes = |i: usize| match at_point {
+                Some((b, m, a)) => (
+                    (a[i] - b[i]) / (2.0 * h),
+                    (a[i] - 2.0 * m[i] + b[i]) / (h * h),
+                ),
+                None => {
+                    let (a0, a1) = (derivatives[k][i], derivatives[k + 1][i]);
+                    (a0.0 + w * (a1.0 - a0.0), a0.1 + w * (a1.1 - a0.1))
+                }
+            };
+            // (A trapezoid's acceleration steps at its breakpoints: both sides.)
+            let sides = [
+                t - PHASE_SIDE * profile.t_total,
+                t + PHASE_SIDE * profile.t_total,
+            ];
+            for a_path in sides.map(|t| profile.accel_at(t) / profile.dist) {
+                for i in 0..joints.axes {
+                    let (v, a) = axis_load(slopes(i), v_path, a_path);
+                    let ratio = (speed[i] / v).min(accel[i] / a);
+                    if ratio < worst {
+                        worst = ratio;
+                        worst_axis = i;
+                    }
                 }
             }
         }
@@ -683,7 +725,7 @@ fn check_profile(
             (v * v, a)
         };
         let mut ratios = [0.0f64; SEGMENTS];
-        let (rv, ra) = inner.ratios(joints, speed, accel, state, &mut ratios);
+        let (rv, ra) = inner.ratios(joints, (speed, accel), state, &kinked, &mut ratios);
         fits = rv.max(ra) <= 1.0 + JOINT_SPEED_TOLERANCE;
     }
     Ok(ProfileCheck {
@@ -921,88 +963,6 @@ const ROOM_ROUNDS: usize = 4;
 
 /// Rounds of giving steps less room to a timing that starts at speed (a corner's).
 const ROOM_ROUNDS_AT_SPEED: usize = 10;
-
-/// The joints at each step's quarter points (`s_k + j·Δ/4`, j = 1, 2, 3), solved only when
-/// needed; on the stack (planning allocates nothing).
-pub(super) struct Inner {
-    filled: [bool; SEGMENTS],
-    q: [[[f64; MAX_AXES]; 3]; SEGMENTS],
-}
-
-impl Inner {
-    pub(super) fn new() -> Inner {
-        Inner {
-            filled: [false; SEGMENTS],
-            q: [[[0.0; MAX_AXES]; 3]; SEGMENTS],
-        }
-    }
-
-    /// Solves the quarter points of the steps `wanted` that are not solved yet, each
-    /// seeded from the point before.
-    fn fill(
-        &mut self,
-        joints: &JointPath,
-        wanted: &[bool; SEGMENTS],
-        joints_at: impl Fn(f64, &[f64; MAX_AXES]) -> Result<[f64; MAX_AXES], PlanError>,
-    ) -> Result<(), PlanError> {
-        for (k, quarters) in self.q.iter_mut().enumerate() {
-            if !wanted[k] || self.filled[k] {
-                continue;
-            }
-            self.filled[k] = true;
-            let mut prev = joints.q[k];
-            for (j, q) in quarters.iter_mut().enumerate() {
-                let s = joints.knot(k) + (j + 1) as f64 / 4.0 * joints.step(k);
-                *q = joints_at(s, &prev)?;
-                prev = *q;
-            }
-        }
-        Ok(())
-    }
-
-    /// Per solved step, the largest ratio of an axis's speed or acceleration to its limit
-    /// at the quarter points (finite differences over the quarter grid), the path at
-    /// `state(k, s) = (ṡ², s̈)` (0 for the steps not solved: not near a limit at their
-    /// knots); and the largest speed and acceleration ratios overall.
-    fn ratios(
-        &self,
-        joints: &JointPath,
-        speed: &[f64],
-        accel: &[f64],
-        state: impl Fn(usize, f64) -> (f64, f64),
-        out: &mut [f64; SEGMENTS],
-    ) -> (f64, f64) {
-        let (mut rv, mut ra) = (0.0f64, 0.0f64);
-        for (k, r) in out.iter_mut().enumerate() {
-            let h = 0.25 * joints.step(k);
-            let p = |j: usize| match j {
-                0 => &joints.q[k],
-                4 => &joints.q[k + 1],
-                _ => &self.q[k][j - 1],
-            };
-            *r = 0.0;
-            if !self.filled[k] {
-                continue;
-            }
-            for j in 1..4 {
-                let s = joints.knot(k) + j as f64 * h;
-                let (x, u) = state(k, s);
-                let sd = x.max(0.0).sqrt();
-                for i in 0..joints.axes {
-                    let (a, b, c) = (p(j - 1)[i], p(j)[i], p(j + 1)[i]);
-                    let d1 = (c - a) / (2.0 * h);
-                    let d2 = (c - 2.0 * b + a) / (h * h);
-                    let v = (d1 * sd).abs() / speed[i];
-                    let acc = (d1 * u + d2 * x).abs() / accel[i];
-                    rv = rv.max(v);
-                    ra = ra.max(acc);
-                    *r = r.max(v).max(acc);
-                }
-            }
-        }
-        (rv, ra)
-    }
-}
 
 /// A profile's speed and acceleration where it has covered `d`: in closed form for a
 /// trapezoid (the speed squared is linear in the distance on each ramp; at a ramp's end
