@@ -714,7 +714,79 @@ fn corner_samples(
             farthest = farthest.max(d);
         }
     }
+    // (Where a profile changes phase the speed may turn at a kink, which the curves
+    // through the samples round off.)
+    if !both_joint && !phase_ends_within(model, f, next, ts) {
+        return None;
+    }
     Some(farthest)
+}
+
+/// How long the one-sided differences at a phase's end are (ns).
+const PHASE_END_STEP: i64 = 1_000;
+
+/// Every axis within its speed (to 1e-9 of it: rounding) on both sides of each instant
+/// inside the corner starting at `ts` where either motion's profile changes phase
+/// ([`Trajectory::phase_ends`]), and within its acceleration there as at the samples
+/// ([`SAMPLED_ACCEL_MARGIN`] below): a motion reaching its cruise at an axis's limit
+/// while the other still moves that axis the same way goes over at that kink, between
+/// two samples (2e-6 of a limit found), and two S-curves' accelerations add up to a
+/// triangle whose peak is there (0.8 % over the limit, 1.8 % over the samples around).
+/// By second-order differences [`PHASE_END_STEP`] long (one-sided for the speeds).
+fn phase_ends_within(model: &RobotModel, f: &Fading, next: &Trajectory, ts: i64) -> bool {
+    let end = f.end();
+    let h = PHASE_END_STEP as f64 / NS;
+    let mut ok = true;
+    let mut last = i64::MIN;
+    let mut check = |t: i64| {
+        if !ok || t <= ts || t > end || t == last {
+            return;
+        }
+        last = t;
+        // The joints 2, 1 and 0 steps before `t` and 1 and 2 after, where they lie within
+        // the corner (a phase may end next to its ends).
+        let mut q = [None; 5];
+        for (k, q) in q.iter_mut().enumerate() {
+            let at = t + (k as i64 - 2) * PHASE_END_STEP;
+            if at < ts || at > end {
+                continue;
+            }
+            match blend_joints(model, f, next, ts, at) {
+                Some(joints) => *q = Some(joints),
+                None => {
+                    ok = false;
+                    return;
+                }
+            }
+        }
+        for i in 0..model.dof() {
+            let at = |k: usize| q[k].map(|q| q[i]);
+            let (speed, accel) = (model.axis(i).max_velocity, model.axis(i).max_accel);
+            // Each side's speed, one-sided.
+            for (a, b, c) in [(at(2), at(1), at(0)), (at(2), at(3), at(4))] {
+                if let (Some(a), Some(b), Some(c)) = (a, b, c)
+                    && ((-3.0 * a + 4.0 * b - c) / (2.0 * h)).abs() > speed * (1.0 + 1e-9)
+                {
+                    ok = false;
+                }
+            }
+            // The acceleration there (its peak, where two S-curves' add up to a
+            // triangle), as at the samples.
+            if let (Some(a), Some(b), Some(c)) = (at(1), at(2), at(3))
+                && ((a - 2.0 * b + c) / (h * h)).abs() > accel * (1.0 - SAMPLED_ACCEL_MARGIN)
+            {
+                ok = false;
+            }
+        }
+    };
+    let to_ns = |origin: i64, b: f64| origin + (b * NS).round() as i64;
+    f.motion
+        .traj
+        .phase_ends(|b| check(to_ns(f.motion.start, b)));
+    next.phase_ends(|b| check(to_ns(ts, b)));
+    // (Where the first motion ends: where a corner's sum of speeds drops to the second's.)
+    check(end);
+    ok
 }
 
 /// Every axis within its speed and acceleration at the last of four samples `dt` apart

@@ -10,7 +10,7 @@ use vworks_model::math::Iso;
 use vworks_model::timing::{JointPath, KNOTS, KnotLimits, Limits, SEGMENTS, Timing, TimingError};
 
 use super::plan::{JOINT_SPEED_TOLERANCE, PlanError, ik_tcp};
-use super::quarters::Inner;
+use super::quarters::{Inner, Kink};
 use crate::MAX_AXES;
 use crate::motion::{Path, Profile, cartesian_at};
 
@@ -510,7 +510,7 @@ pub(super) fn time_path(
             joints,
             (&speed[..n], &accel[..n]),
             state,
-            &[false; SEGMENTS],
+            &[Kink::None; SEGMENTS],
             &mut ratios,
         );
         if rv.max(ra) <= 1.0 {
@@ -655,66 +655,82 @@ fn check_profile(
         }
     }
     // Where the profile's acceleration peaks (its phases' ends) the steps are checked
-    // between the knots too, and every axis at the peak itself (its slopes interpolated
-    // between the two knots around), on both sides of it: an S-curve's braking peaks
-    // within the last step or two, and between its quarter points the acceleration's
-    // triangle can rise by 2 %; a trapezoid's braking begins at its top speed, where the
-    // term q″·ṡ² is largest, between two knots (0.07 % over on a line whose braking takes
-    // two steps).
+    // between the knots too, and every axis at the peak itself, on both sides of it: an
+    // S-curve's braking peaks within the last step or two, and between its quarter points
+    // the acceleration's triangle can rise by 2 % (always checked); a trapezoid's braking
+    // begins at its top speed, where the term q″·ṡ² is largest, between two knots (0.07 %
+    // over on a line whose braking takes two steps: checked where an axis comes near a
+    // limit there).
     let mut peaks = false;
     // (The steps around a phase's end: the state's derivative steps there.)
-    let mut kinked = [false; SEGMENTS];
+    let mut kinks = [Kink::None; SEGMENTS];
     if profile.dist > 0.0 {
+        let s_curve = profile.t_jerk > 0.0;
+        let mut last = f64::NAN;
         for t in profile.breakpoints() {
+            // (A trapezoid's are pairs: no jerk phases.)
+            if t == last {
+                continue;
+            }
+            last = t;
             let s = (profile.at(t) / profile.dist).clamp(0.0, 1.0);
             let k = joints.knots()[..SEGMENTS]
                 .partition_point(|v| *v <= s)
                 .saturating_sub(1);
-            for step in [k.saturating_sub(1), k, (k + 1).min(SEGMENTS - 1)] {
-                near[step] = true;
-                kinked[step] = true;
+            let steps = [k.saturating_sub(1), k, (k + 1).min(SEGMENTS - 1)];
+            for step in steps {
+                kinks[step] = if s_curve { Kink::Accel } else { Kink::Speed };
             }
-            peaks = true;
             let w = ((s - joints.knot(k)) / joints.step(k)).clamp(0.0, 1.0);
             let v_path = profile.speed_at(t) / profile.dist;
-            // The axes' slopes and curvatures at the breakpoint: inside the path, from the
-            // joints an eighth of a step to each side of it (the knots' own, interpolated,
-            // are a step's finite differences: 3e-5 of a limit off, where a braking phase
-            // ends at its peak); at its ends, the knots'.
-            let h = 0.125 * joints.step(k);
-            let at_point = if s - h > 0.0 && s + h < 1.0 {
-                let before = joints_at(s - h, &joints.q[k])?;
-                let here = joints_at(s, &before)?;
-                let after = joints_at(s + h, &here)?;
-                Some((before, here, after))
-            } else {
-                None
-            };
-            let slopes = |i: usize| match at_point {
-                Some((b, m, a)) => (
-                    (a[i] - b[i]) / (2.0 * h),
-                    (a[i] - 2.0 * m[i] + b[i]) / (h * h),
-                ),
-                None => {
-                    let (a0, a1) = (derivatives[k][i], derivatives[k + 1][i]);
-                    (a0.0 + w * (a1.0 - a0.0), a0.1 + w * (a1.1 - a0.1))
-                }
-            };
             // (A trapezoid's acceleration steps at its breakpoints: both sides.)
             let sides = [
                 t - PHASE_SIDE * profile.t_total,
                 t + PHASE_SIDE * profile.t_total,
-            ];
-            for a_path in sides.map(|t| profile.accel_at(t) / profile.dist) {
-                for i in 0..joints.axes {
-                    let (v, a) = axis_load(slopes(i), v_path, a_path);
-                    let ratio = (speed[i] / v).min(accel[i] / a);
-                    if ratio < worst {
-                        worst = ratio;
-                        worst_axis = i;
+            ]
+            .map(|t| profile.accel_at(t) / profile.dist);
+            // The worst axis there, its slopes and curvatures given per axis.
+            let worst_at = |slopes: &dyn Fn(usize) -> (f64, f64)| {
+                let mut out = (f64::INFINITY, 0);
+                for a_path in sides {
+                    for i in 0..joints.axes {
+                        let (v, a) = axis_load(slopes(i), v_path, a_path);
+                        let ratio = (speed[i] / v).min(accel[i] / a);
+                        if ratio < out.0 {
+                            out = (ratio, i);
+                        }
                     }
                 }
+                out
+            };
+            // First the knots' slopes, interpolated.
+            let mut here = worst_at(&|i| {
+                let (a0, a1) = (derivatives[k][i], derivatives[k + 1][i]);
+                (a0.0 + w * (a1.0 - a0.0), a0.1 + w * (a1.1 - a0.1))
+            });
+            if !s_curve && here.0 >= 1.0 / NEAR_LIMIT {
+                continue;
             }
+            // Near a limit (or an S-curve's), the slopes and curvatures from the joints an
+            // eighth of a step to each side (the knots' are a step's finite differences:
+            // 3e-5 of a limit off, where a braking phase ends at its peak), inside the path.
+            let h = 0.125 * joints.step(k);
+            if here.0 < 1.0 / NEAR_LIMIT && s - h > 0.0 && s + h < 1.0 {
+                let before = joints_at(s - h, &joints.q[k])?;
+                let at = joints_at(s, &before)?;
+                let after = joints_at(s + h, &at)?;
+                here = worst_at(&|i| {
+                    let d1 = (after[i] - before[i]) / (2.0 * h);
+                    (d1, (after[i] - 2.0 * at[i] + before[i]) / (h * h))
+                });
+            }
+            if here.0 < worst {
+                (worst, worst_axis) = here;
+            }
+            for step in steps {
+                near[step] = true;
+            }
+            peaks = true;
         }
     }
     let mut fits = worst >= 1.0 - JOINT_SPEED_TOLERANCE;
@@ -725,7 +741,7 @@ fn check_profile(
             (v * v, a)
         };
         let mut ratios = [0.0f64; SEGMENTS];
-        let (rv, ra) = inner.ratios(joints, (speed, accel), state, &kinked, &mut ratios);
+        let (rv, ra) = inner.ratios(joints, (speed, accel), state, &kinks, &mut ratios);
         fits = rv.max(ra) <= 1.0 + JOINT_SPEED_TOLERANCE;
     }
     Ok(ProfileCheck {

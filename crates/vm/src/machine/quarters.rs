@@ -52,14 +52,14 @@ impl Inner {
     /// at the quarter points (finite differences over the quarter grid), the path at
     /// `state(k, s) = (ṡ², s̈)` (0 for the steps not solved: not near a limit at their
     /// knots); and the largest speed and acceleration ratios overall. Where the path's
-    /// state is smooth through a step (not `kinked`: a profile's phase ends there), also
+    /// state is smooth through a step (no [`Kink`] there: a profile's phase end), also
     /// between the points: speeds and accelerations peak between them where they turn.
     pub(super) fn ratios(
         &self,
         joints: &JointPath,
         (speed, accel): (&[f64], &[f64]),
         state: impl Fn(usize, f64) -> (f64, f64),
-        kinked: &[bool; SEGMENTS],
+        kinks: &[Kink; SEGMENTS],
         out: &mut [f64; SEGMENTS],
     ) -> (f64, f64) {
         let (mut rv, mut ra) = (0.0f64, 0.0f64);
@@ -76,36 +76,26 @@ impl Inner {
             }
             let xu = [0, 1, 2, 3, 4].map(|j| state(k, joints.knot(k) + j as f64 * h));
             let sd = xu.map(|(x, _)| x.max(0.0).sqrt());
-            let smooth = !kinked[k];
+            let kink = kinks[k];
             for i in 0..joints.axes {
                 let q = [0, 1, 2, 3, 4].map(|j| p(j)[i]);
-                // Slopes and curvatures: central at the quarter points; at the knots
-                // (only between points, where smooth), second-order one-sided.
+                // Slopes and curvatures: central at the quarter points.
                 let mut acc = [0.0f64; 5];
+                let mut here = 0.0f64;
                 for j in 1..4 {
                     let d1 = (q[j + 1] - q[j - 1]) / (2.0 * h);
                     let d2 = (q[j + 1] - 2.0 * q[j] + q[j - 1]) / (h * h);
                     let v = (d1 * sd[j]).abs() / speed[i];
                     acc[j] = d1 * xu[j].1 + d2 * xu[j].0;
+                    here = here.max(v).max(acc[j].abs() / accel[i]);
                     rv = rv.max(v);
                     ra = ra.max(acc[j].abs() / accel[i]);
-                    *r = r.max(v).max(acc[j].abs() / accel[i]);
                 }
-                if !smooth {
+                *r = r.max(here);
+                // (A smooth curve rises above its quarter points by far less than
+                // [`PEAKS_FROM`] leaves.)
+                if here < PEAKS_FROM || kink == Kink::Speed {
                     continue;
-                }
-                let ends = [
-                    (
-                        (-3.0 * q[0] + 4.0 * q[1] - q[2]) / (2.0 * h),
-                        (2.0 * q[0] - 5.0 * q[1] + 4.0 * q[2] - q[3]) / (h * h),
-                    ),
-                    (
-                        (3.0 * q[4] - 4.0 * q[3] + q[2]) / (2.0 * h),
-                        (2.0 * q[4] - 5.0 * q[3] + 4.0 * q[2] - q[1]) / (h * h),
-                    ),
-                ];
-                for (j, (d1, d2)) in [(0, ends[0]), (4, ends[1])] {
-                    acc[j] = d1 * xu[j].1 + d2 * xu[j].0;
                 }
                 // The speed's peak in each quarter: the slope's from the cubic through
                 // four points (its chords' quadratic), at the faster end's ṡ (ṡ² is
@@ -126,8 +116,25 @@ impl Inner {
                     rv = rv.max(v);
                     *r = r.max(v);
                 }
-                // The acceleration's peak: the parabola's through three points in a row,
-                // where it turns between them.
+                if kink == Kink::Accel {
+                    continue;
+                }
+                // The acceleration's peak: the parabola's through three points in a row
+                // (at the knots, slopes and curvatures second-order one-sided), where it
+                // turns between them.
+                let ends = [
+                    (
+                        (-3.0 * q[0] + 4.0 * q[1] - q[2]) / (2.0 * h),
+                        (2.0 * q[0] - 5.0 * q[1] + 4.0 * q[2] - q[3]) / (h * h),
+                    ),
+                    (
+                        (3.0 * q[4] - 4.0 * q[3] + q[2]) / (2.0 * h),
+                        (2.0 * q[4] - 5.0 * q[3] + 4.0 * q[2] - q[1]) / (h * h),
+                    ),
+                ];
+                for (j, (d1, d2)) in [(0, ends[0]), (4, ends[1])] {
+                    acc[j] = d1 * xu[j].1 + d2 * xu[j].0;
+                }
                 for j in 1..4 {
                     let a = parabola_peak([acc[j - 1], acc[j], acc[j + 1]]) / accel[i];
                     ra = ra.max(a);
@@ -138,6 +145,23 @@ impl Inner {
         (rv, ra)
     }
 }
+
+/// What the state of a path's timing does within a step where it is not smooth (a
+/// profile's phase ends there), which the curves through the quarter points cannot follow.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(super) enum Kink {
+    /// Smooth: the peaks between the points are sought.
+    #[default]
+    None,
+    /// The acceleration's slope steps (an S-curve's phase end): the speed stays smooth.
+    Accel,
+    /// The acceleration steps (a trapezoid's phase end): the speed's slope too.
+    Speed,
+}
+
+/// The share of a limit an axis must reach at a step's quarter points for the peaks
+/// between them to be sought: they rise above the points by a few 1e-5 of a limit.
+const PEAKS_FROM: f64 = 0.99;
 
 /// The largest |y| of the parabola through `(−1, y[0])`, `(0, y[1])`, `(1, y[2])` where
 /// it turns between −1 and 1 (else the largest |y| given: a parabola that turns outside

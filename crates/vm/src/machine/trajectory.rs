@@ -128,6 +128,25 @@ impl Trajectory {
             Trajectory::Cartesian { .. } => None,
         }
     }
+
+    /// The instants (s from its start) where its profile changes phase, where an axis's
+    /// speed may turn at a kink: every axis's profile's of a joint motion, the path's
+    /// profile's of a Cartesian one moved by it (none for a timed path or corner ramps:
+    /// they change only at their knots, which the samples around them check).
+    pub(super) fn phase_ends(&self, mut visit: impl FnMut(f64)) {
+        let mut each = |p: &Profile| p.breakpoints().into_iter().for_each(&mut visit);
+        match self {
+            Trajectory::Joint { profile, .. } => each(profile),
+            Trajectory::JointSynced { profiles, .. } => profiles.iter().for_each(each),
+            Trajectory::Cartesian {
+                profile,
+                timing: None,
+                ramps: None,
+                ..
+            } => each(profile),
+            Trajectory::Cartesian { .. } => {}
+        }
+    }
 }
 
 impl Trajectory {
