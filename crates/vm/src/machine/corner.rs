@@ -282,11 +282,21 @@ pub(super) fn take_over(
         if speed <= 0.0 || gap / speed > 1e-3 {
             return None;
         }
-        start += to_ns(gap / speed);
-        // (The speed changes a little in those nanoseconds.)
-        while before(start) > 0.0 && start < f.end() {
-            start += 1;
+        // The first nanosecond there (the robot only moves on along its path): from the
+        // estimate at its speed now, searched by bisection within its motion.
+        let (mut lo, mut hi) = (start, (start + 2 * to_ns(gap / speed)).min(f.end()));
+        if before(hi) > 0.0 {
+            hi = f.end();
         }
+        while hi - lo > 1 {
+            let mid = lo + (hi - lo) / 2;
+            if before(mid) > 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        start = hi;
     }
     let dt = (start - f.motion.start) as f64 / NS;
     let s_now = first.fraction_at(dt);
