@@ -722,17 +722,20 @@ fn corner_samples(
     Some(farthest)
 }
 
-/// How long the one-sided differences at a phase's end are (ns).
-const PHASE_END_STEP: i64 = 1_000;
+/// How long the differences at a phase's end are (ns): long enough that the joints'
+/// rounding (numeric IK converges to 1e-10 rad) stays below 1e-6 of a speed and 0.3 % of
+/// an acceleration, short enough to stay within one phase of each motion.
+const PHASE_END_STEP: i64 = 100_000;
 
-/// Every axis within its speed (to 1e-9 of it: rounding) on both sides of each instant
-/// inside the corner starting at `ts` where either motion's profile changes phase
-/// ([`Trajectory::phase_ends`]), and within its acceleration there as at the samples
-/// ([`SAMPLED_ACCEL_MARGIN`] below): a motion reaching its cruise at an axis's limit
-/// while the other still moves that axis the same way goes over at that kink, between
-/// two samples (2e-6 of a limit found), and two S-curves' accelerations add up to a
-/// triangle whose peak is there (0.8 % over the limit, 1.8 % over the samples around).
-/// By second-order differences [`PHASE_END_STEP`] long (one-sided for the speeds).
+/// Every axis within its speed (within [`JOINT_SPEED_TOLERANCE`], as at the samples) on
+/// both sides of each instant inside the corner starting at `ts` where either motion's
+/// profile changes phase ([`Trajectory::phase_ends`]), and within its acceleration there
+/// as at the samples ([`SAMPLED_ACCEL_MARGIN`] below): a motion reaching its cruise at an
+/// axis's limit while the other still moves that axis the same way goes over at that
+/// kink, between two samples (4.8e-6 of a limit found), and two S-curves' accelerations
+/// add up to a triangle whose peak is there (0.8 % over the limit, 1.8 % over the samples
+/// around). By second-order differences [`PHASE_END_STEP`] long (one-sided for the
+/// speeds).
 fn phase_ends_within(model: &RobotModel, f: &Fading, next: &Trajectory, ts: i64) -> bool {
     let end = f.end();
     let h = PHASE_END_STEP as f64 / NS;
@@ -765,7 +768,8 @@ fn phase_ends_within(model: &RobotModel, f: &Fading, next: &Trajectory, ts: i64)
             // Each side's speed, one-sided.
             for (a, b, c) in [(at(2), at(1), at(0)), (at(2), at(3), at(4))] {
                 if let (Some(a), Some(b), Some(c)) = (a, b, c)
-                    && ((-3.0 * a + 4.0 * b - c) / (2.0 * h)).abs() > speed * (1.0 + 1e-9)
+                    && ((-3.0 * a + 4.0 * b - c) / (2.0 * h)).abs()
+                        > speed * (1.0 + JOINT_SPEED_TOLERANCE)
                 {
                     ok = false;
                 }

@@ -312,6 +312,13 @@ pub(super) fn take_over(
         return None;
     }
     let (f_in, f_out) = (1.0 - r / l1, r / l2);
+    // (From where the robot is, `f_in` is `f_now` but for rounding: no piece before the
+    // curve, rather than one of 1e-16 with two steps of its own.)
+    let f_now = if (f_in - f_now).abs() * l1 < 1e-12 {
+        f_in
+    } else {
+        f_now
+    };
     // Shares of s: the derivative by s continuous at both joins.
     let (rho1, c1, c2, rho2) = (f_in - f_now, 2.0 * (1.0 - f_in), 2.0 * f_out, 1.0 - f_out);
     let sigma = 1.0 / (1.0 + rho1 / c1 + rho2 / c2);

@@ -616,15 +616,16 @@ struct ProfileCheck {
     /// Every axis within its speed and acceleration at the knots, and between them where
     /// one comes near a limit.
     fits: bool,
-    /// The axis nearest its limit (its largest fraction) at a knot.
+    /// The axis nearest its limit (its largest fraction) at a knot or a phase's end.
     worst_axis: usize,
     /// The path speed at each knot.
     sd: [f64; KNOTS],
 }
 
 /// Checks `profile` against every axis's speed and acceleration at the knots (axis speed
-/// q′(s)·ṡ, acceleration q′(s)·s̈ + q″(s)·ṡ²) and, where an axis comes within
-/// [`NEAR_LIMIT`] of a limit there, at the quarter points of the steps around.
+/// q′(s)·ṡ, acceleration q′(s)·s̈ + q″(s)·ṡ²), at its phases' ends (below) and, where an
+/// axis comes within [`NEAR_LIMIT`] of a limit there, at the quarter points of the steps
+/// around and between them ([`Inner::ratios`]).
 fn check_profile(
     joints: &JointPath,
     derivatives: &KnotDerivatives,

@@ -51,9 +51,10 @@ impl Inner {
     /// Per solved step, the largest ratio of an axis's speed or acceleration to its limit
     /// at the quarter points (finite differences over the quarter grid), the path at
     /// `state(k, s) = (ṡ², s̈)` (0 for the steps not solved: not near a limit at their
-    /// knots); and the largest speed and acceleration ratios overall. Where the path's
-    /// state is smooth through a step (no [`Kink`] there: a profile's phase end), also
-    /// between the points: speeds and accelerations peak between them where they turn.
+    /// knots); and the largest speed and acceleration ratios overall. For an axis at
+    /// [`PEAKS_FROM`] of a limit at the points, also between them, where speeds and
+    /// accelerations turn: a speed unless the step has a [`Kink::Speed`], an acceleration
+    /// unless it has any [`Kink`].
     pub(super) fn ratios(
         &self,
         joints: &JointPath,

@@ -131,8 +131,9 @@ impl Trajectory {
 
     /// The instants (s from its start) where its profile changes phase, where an axis's
     /// speed may turn at a kink: every axis's profile's of a joint motion, the path's
-    /// profile's of a Cartesian one moved by it (none for a timed path or corner ramps:
-    /// they change only at their knots, which the samples around them check).
+    /// profile's of a Cartesian one moved by it. Not yet those of a timed path (its path
+    /// acceleration steps at every knot) nor of corner ramps: a corner with one of them
+    /// is checked at its samples only.
     pub(super) fn phase_ends(&self, mut visit: impl FnMut(f64)) {
         let mut each = |p: &Profile| p.breakpoints().into_iter().for_each(&mut visit);
         match self {
