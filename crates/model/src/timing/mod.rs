@@ -106,6 +106,13 @@ impl JointPath {
         &self.knots
     }
 
+    /// The step `s` lies in (from its knot up to the next; the last step for `s` = 1).
+    pub fn step_at(&self, s: f64) -> usize {
+        self.knots[..SEGMENTS]
+            .partition_point(|k| *k <= s)
+            .saturating_sub(1)
+    }
+
     /// How long step `k` (from knot `k` to `k + 1`) is, in `s`.
     pub fn step(&self, k: usize) -> f64 {
         let k = k.min(SEGMENTS - 1);

@@ -282,12 +282,9 @@ pub(super) fn take_over(
         if speed <= 0.0 || gap / speed > 1e-3 {
             return None;
         }
-        // The first nanosecond there (the robot only moves on along its path): from the
-        // estimate at its speed now, searched by bisection within its motion.
-        let (mut lo, mut hi) = (start, (start + 2 * to_ns(gap / speed)).min(f.end()));
-        if before(hi) > 0.0 {
-            hi = f.end();
-        }
+        // The first nanosecond there, by bisection within its motion (the robot only
+        // moves on along its path).
+        let (mut lo, mut hi) = (start, f.end());
         while hi - lo > 1 {
             let mid = lo + (hi - lo) / 2;
             if before(mid) > 0.0 {

@@ -675,9 +675,7 @@ fn check_profile(
             }
             last = t;
             let s = (profile.at(t) / profile.dist).clamp(0.0, 1.0);
-            let k = joints.knots()[..SEGMENTS]
-                .partition_point(|v| *v <= s)
-                .saturating_sub(1);
+            let k = joints.step_at(s);
             let steps = [k.saturating_sub(1), k, (k + 1).min(SEGMENTS - 1)];
             for step in steps {
                 kinks[step] = if s_curve { Kink::Accel } else { Kink::Speed };
@@ -765,9 +763,7 @@ fn profile_samples(
     // at most that fast.
     let peak_s = profile.at(0.5 * profile.t_total) / profile.dist.max(f64::MIN_POSITIVE);
     let peak = profile.speed_at(0.5 * profile.t_total);
-    let peak_step = joints.knots()[..SEGMENTS]
-        .partition_point(|s| *s <= peak_s)
-        .saturating_sub(1);
+    let peak_step = joints.step_at(peak_s);
     let mut step_speed = [0.0f64; SEGMENTS];
     for (k, v) in step_speed.iter_mut().enumerate() {
         *v = if k == peak_step {

@@ -1,9 +1,9 @@
 //! A sampled path checked between its knots: the joints at each step's quarter points
 //! ([`Inner`]), solved only where an axis comes near a limit, and every axis's speed and
-//! acceleration there (finite differences) and, where the path's state is smooth through
-//! the step, between them: the peak of the cubic through four points for a speed (a
-//! chord between two points is the mean speed, below a peak), of the parabola through
-//! three for an acceleration.
+//! acceleration there (finite differences) and, for an axis near a limit, between them
+//! where no phase end of the profile kinks the curve ([`Kink`]): the peak of the cubic
+//! through four points for a speed (a chord between two points is the mean speed, below
+//! a peak), of the parabola through three for an acceleration.
 
 use vworks_model::timing::{JointPath, SEGMENTS};
 
@@ -82,20 +82,20 @@ impl Inner {
                 let q = [0, 1, 2, 3, 4].map(|j| p(j)[i]);
                 // Slopes and curvatures: central at the quarter points.
                 let mut acc = [0.0f64; 5];
-                let mut here = 0.0f64;
+                let mut at_points = 0.0f64;
                 for j in 1..4 {
                     let d1 = (q[j + 1] - q[j - 1]) / (2.0 * h);
                     let d2 = (q[j + 1] - 2.0 * q[j] + q[j - 1]) / (h * h);
                     let v = (d1 * sd[j]).abs() / speed[i];
                     acc[j] = d1 * xu[j].1 + d2 * xu[j].0;
-                    here = here.max(v).max(acc[j].abs() / accel[i]);
+                    at_points = at_points.max(v).max(acc[j].abs() / accel[i]);
                     rv = rv.max(v);
                     ra = ra.max(acc[j].abs() / accel[i]);
                 }
-                *r = r.max(here);
+                *r = r.max(at_points);
                 // (A smooth curve rises above its quarter points by far less than
                 // [`PEAKS_FROM`] leaves.)
-                if here < PEAKS_FROM || kink == Kink::Speed {
+                if at_points < PEAKS_FROM || kink == Kink::Speed {
                     continue;
                 }
                 // The speed's peak in each quarter: the slope's from the cubic through
