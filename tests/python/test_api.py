@@ -175,7 +175,7 @@ def test_a_rapid_cell_runs_from_python():
 
 
 def test_the_readme_line():
-    assert vworks.load_cell(str(HANDOFF)).run().end_time == pytest.approx(46.491262735)
+    assert vworks.load_cell(str(HANDOFF)).run().end_time == pytest.approx(46.491264457)
 
 
 def test_cell_properties():
@@ -204,7 +204,7 @@ def test_result_fields():
     assert r.cycles > 11000
     r1, r2 = r.robots
     assert (r1.name, r2.name) == ("r1", "r2")
-    assert r1.end_time == pytest.approx(46.491262735) and r1.ended == "ended"
+    assert r1.end_time == pytest.approx(46.491264457) and r1.ended == "ended"
     assert r1.moving + r1.waiting + r1.idle == pytest.approx(r.end_time, abs=1e-6)
     assert r1.motions == 41 and not hasattr(r1, "handler")
     assert r.globals == {"handed": 3}
@@ -424,7 +424,7 @@ def test_stepping_gives_the_same_run_as_run():
     stepped = [e.trace_line() for e in sim.events_since()]
     assert stepped == golden("handoff")[0]
     r = sim.result()
-    assert r.outcome == "completed" and r.end_time_ns == 46_491_262_735
+    assert r.outcome == "completed" and r.end_time_ns == 46_491_264_457
     assert sim.result() is r
     with pytest.raises(vworks.Error, match="ended"):
         sim.step_event()
@@ -433,7 +433,7 @@ def test_stepping_gives_the_same_run_as_run():
 
 def test_simulation_run_and_early_result():
     cell = vworks.load_cell(HANDOFF)
-    assert cell.simulation().run().end_time_ns == 46_491_262_735
+    assert cell.simulation().run().end_time_ns == 46_491_264_457
     sim = cell.simulation()
     sim.run_until(10)
     early = sim.result()

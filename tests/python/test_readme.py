@@ -18,8 +18,8 @@ def test_the_readme_python_example_runs(tmp_path, monkeypatch):
     with contextlib.redirect_stdout(out):
         exec(compile(block, "README.md", "exec"), {})
     printed = out.getvalue()
-    assert "completed 46.491262735" in printed, printed
-    assert "r1 46.491262735" in printed
+    assert "completed 46.491264457" in printed, printed
+    assert "r1 46.491264457" in printed
     assert "error[E0021]" in printed  # the compile error, rendered
     assert (tmp_path / "run.mcap").stat().st_size > 100_000
     assert "<svg id=\"gantt\"" in (tmp_path / "run.html").read_text()

@@ -52,7 +52,7 @@ def test_the_local_table_has_every_variant_and_outcome(local):
     assert {"completed", "collision"} <= outcomes, outcomes
     # The workcell as written (r2 at 600, 600 mm, 4 ms) ends at 46.491 s, as `vworks run`.
     (base,) = [r for r in local if (r["robot.r2.base.xyz.0"], r["robot.r2.base.xyz.1"], r["cycle"]) == (0.6, 0.6, 0.004)]
-    assert round(base["end_time"], 6) == 46.491263
+    assert round(base["end_time"], 6) == 46.491264
     assert base["outcome"] == "completed" and base["collisions"] == 0 and base["error"] == ""
     assert base["min_clearance"] is None  # no two bodies came within the cell's clearance
     collided = [r for r in local if r["outcome"] == "collision"]

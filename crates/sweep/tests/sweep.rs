@@ -169,7 +169,7 @@ fn a_row_is_the_run_of_the_workcell_written_with_its_values() {
     let _ = std::fs::remove_dir_all(&dir);
     assert_eq!(row.outcome, RowOutcome::Run(plain.outcome));
     assert_eq!(row.end_time, plain.end_time_ns as f64 / 1e9);
-    assert_eq!(row.end_time, 46.022069386);
+    assert_eq!(row.end_time, 46.022072698);
     assert_eq!(
         row.cycle_times,
         plain

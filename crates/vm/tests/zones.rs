@@ -458,6 +458,33 @@ fn a_delay_after_a_zoned_point_waits_for_the_robot_with_one_warning() {
     assert_eq!(delays, fine_delays);
 }
 
+/// A Cartesian motion with another tool than the zoned one before it does not blend
+/// (docs/language.md, `tool`): it starts at the point, from its own TCP there — the flange
+/// at the point with the new tool, 100 mm below the old TCP — without a jump (`run`
+/// checks the joints at every event), and ends at its target with that tool. (It used to
+/// start its path from the old tool's TCP: its axes jumped by 0.29 rad.)
+#[test]
+fn a_motion_with_another_tool_after_a_zoned_point_starts_there_with_its_own_tcp() {
+    let src = "proc main() {\n    move_j pose(400mm, 0mm, 300mm, 180deg, 0deg, 0deg);\n    move_l pose(400mm, 100mm, 300mm, 180deg, 0deg, 0deg) speed 200mm/s zone 10mm;\n    move_l pose(450mm, 100mm, 300mm, 180deg, 0deg, 0deg) speed 200mm/s tool pose(0mm, 0mm, 100mm, 0deg, 0deg, 0deg);\n}\n";
+    let mut v = vm(src, None);
+    let r = run(&mut v, 50.0);
+    let starts: Vec<(i64, Option<f64>)> = r
+        .events
+        .iter()
+        .filter_map(|e| match e.kind {
+            EventKind::MotionStart { blend_m, .. } => Some((e.time, blend_m)),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(starts[2].1, None, "{:?}", r.events);
+    let at = |t: i64| r.samples.iter().find(|s| s.0 >= t).unwrap().2;
+    // The new TCP at the start: the point, 100 mm down the flange's z (pointing down); the
+    // first sample, less than 1 ms after it, within what 28 m/s² moves it in 1 ms.
+    let start = at(starts[2].0);
+    assert!(norm(sub(start, [0.4, 0.1, 0.2])) < 1.4e-5, "{start:?}");
+    assert!(norm(sub(v.tcp_at(r.end).t, [0.45, 0.1, 0.3])) < 1e-9);
+}
+
 /// A line whose axis 1 would pass its speed limit at the programmed speed (close to axis
 /// 1 at 2 m/s), on an IRB 120 whose axes ramp their accelerations up in 20 ms: no S-curve
 /// at 2 m/s fits, so the line keeps its S-curve at the highest lower speed that does

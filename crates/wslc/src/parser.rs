@@ -41,6 +41,9 @@ fn describe(t: &TokKind, text: &str) -> String {
     }
 }
 
+/// The options a motion statement takes, by name.
+const MOVE_OPTIONS: [&str; 6] = ["speed", "accel", "orient", "duration", "zone", "tool"];
+
 impl Parser<'_, '_, Token> {
     fn kind(&self) -> &TokKind {
         &self.tok().kind
@@ -599,7 +602,22 @@ impl Parser<'_, '_, Token> {
                     self.bump();
                     Zone::Fine
                 } else {
-                    Zone::Radius(self.expr()?)
+                    let radius = self.expr()?;
+                    if self.at_ident("ori") {
+                        self.bump();
+                        let ori = self.expr()?;
+                        // (An angle follows unless the statement or its next option does.)
+                        let option = matches!(self.kind(), TokKind::Ident)
+                            && MOVE_OPTIONS.iter().any(|o| self.at_ident(o));
+                        let angle = if self.at_p(Punct::Semi) || option {
+                            None
+                        } else {
+                            Some(self.expr()?)
+                        };
+                        Zone::Extended(Box::new(ExtendedZone { radius, ori, angle }))
+                    } else {
+                        Zone::Radius(radius)
+                    }
                 };
                 if zone.is_some() {
                     return Err(self.given_twice(&t));

@@ -416,4 +416,19 @@ pub enum Zone {
     Fine,
     /// `zone e`: fly by within the radius `e` (a length).
     Radius(Expr),
+    /// `zone e ori d [a]`: fly by within the radius `e`, the tool turning towards the next
+    /// motion from where the TCP comes within `d` of the point (RAPID's `pzone_ori`),
+    /// turning it by at most `a` there (an angle, `zone_ori`).
+    Extended(Box<ExtendedZone>),
+}
+
+/// A zone with an orientation zone: `zone e ori d [a]` ([`Zone::Extended`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExtendedZone {
+    /// The zone's radius (a length).
+    pub radius: Expr,
+    /// The orientation zone's radius (a length).
+    pub ori: Expr,
+    /// The most the orientation zone turns the tool (an angle), if bounded.
+    pub angle: Option<Expr>,
 }

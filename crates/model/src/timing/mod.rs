@@ -49,7 +49,7 @@ pub struct JointPath {
     graded: bool,
     /// Knots where the path's second derivative may jump (where two pieces of it meet):
     /// there each step takes the derivatives of its own side. 0: none.
-    breaks: [usize; 2],
+    breaks: [usize; 4],
 }
 
 impl JointPath {
@@ -62,15 +62,15 @@ impl JointPath {
             end_slopes: [[0.0; MAX_AXES]; 2],
             knots: std::array::from_fn(|k| k as f64 / SEGMENTS as f64),
             graded: false,
-            breaks: [0; 2],
+            breaks: [0; 4],
         }
     }
 
-    /// Marks knots (up to two; 0 for none) where the path's second derivative may jump, as
+    /// Marks knots (up to four; 0 for none) where the path's second derivative may jump, as
     /// where a curve meets a straight piece: the steps on either side take their
     /// derivatives there from their own side (one-sided differences), so neither sees the
     /// other's curvature.
-    pub fn set_breaks(&mut self, breaks: [usize; 2]) {
+    pub fn set_breaks(&mut self, breaks: [usize; 4]) {
         self.breaks = breaks.map(|k| if k < SEGMENTS { k } else { 0 });
     }
 

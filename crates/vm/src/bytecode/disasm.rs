@@ -261,6 +261,9 @@ fn operands(m: &Module, ins: &Instr) -> String {
             if f.has(MoveFlags::ZONE) {
                 parts.push("zone");
             }
+            if f.has(MoveFlags::ZONE | MoveFlags::ZONE_ORI) {
+                parts.push("ori-zone");
+            }
             if f.has(MoveFlags::TOOL) {
                 parts.push("tool");
             }

@@ -92,8 +92,12 @@ impl MoveFlags {
     /// A `duration` operand (s: how long the motion takes, instead of its speed) is on
     /// the stack, on top (above `tool`).
     pub const DURATION: u16 = 256;
+    /// An orientation zone follows the `zone` operand, above it: its radius (m, a TCP
+    /// distance from the point, RAPID's `pzone_ori`) and its angle (rad, `zone_ori`; π
+    /// bounds nothing). Only with `ZONE`.
+    pub const ZONE_ORI: u16 = 512;
     /// Every flag.
-    pub const ALL: u16 = 511;
+    pub const ALL: u16 = 1023;
 
     /// True if every bit of `bit` is set.
     pub fn has(self, bit: u16) -> bool {
@@ -156,7 +160,13 @@ impl Operand for MoveFlags {
                 MoveFlags::ALL
             )));
         }
-        Ok(MoveFlags(b))
+        let f = MoveFlags(b);
+        if f.has(MoveFlags::ZONE_ORI) && !f.has(MoveFlags::ZONE) {
+            return Err(r.error(format!(
+                "motion flags 0x{b:04x} give an orientation zone without a zone"
+            )));
+        }
+        Ok(f)
     }
 }
 
@@ -464,6 +474,7 @@ impl Instr {
                 let extra = u32::from(f.has(MoveFlags::SPEED))
                     + u32::from(f.has(MoveFlags::ACCEL))
                     + u32::from(f.has(MoveFlags::ZONE))
+                    + 2 * u32::from(f.has(MoveFlags::ZONE | MoveFlags::ZONE_ORI))
                     + u32::from(f.has(MoveFlags::ORIENT))
                     + u32::from(f.has(MoveFlags::DURATION))
                     + if f.has(MoveFlags::TOOL) { P } else { 0 };

@@ -193,12 +193,23 @@ impl Arm {
             Some(z) if z > 0.0 => Some(z),
             _ => None,
         };
+        // RAPID's rule: an orientation zone smaller than the zone is the zone.
+        let ori_zone = match ops.ori_zone {
+            Some((rho, alpha)) if rho.is_nan() || rho < 0.0 || alpha.is_nan() || alpha < 0.0 => {
+                return Err(PlanError::OriZone(rho, alpha));
+            }
+            Some((rho, alpha)) => programmed.filter(|r| rho > *r).map(|_| (rho, alpha)),
+            None => None,
+        };
         if let Some(tool) = ops.tool {
             self.tool = tool;
         }
+        // (A motion with another tool than the zoned one starts at the point with its own
+        // TCP there: it does not blend.)
         let tcp = match (&self.fading, ops.is_cartesian()) {
             (_, false) => Iso::IDENTITY,
-            (Some(f), true) => f.corner_pose,
+            (Some(f), true) if f.motion.tool == self.tool => f.corner_pose,
+            (Some(f), true) => self.model.tcp(&f.corner[..self.model.dof()], &self.tool),
             (None, true) => self.tcp_at(time),
         };
         let from = PlanFrom {
@@ -239,7 +250,12 @@ impl Arm {
             // Two lines fly by with ramps and look-ahead where they can (where that cannot
             // beat stopping and superposing them would break their TCP acceleration, they
             // are timed as one path, or stop).
+            // (A tool turning over an orientation zone wider than the curve: the corner
+            // timed as one path turns it so; corner ramps would turn it within the curve.)
+            let turns = corner::turn_radius(f, &traj, 0.0)
+                .is_some_and(|rho| rho > f.motion.zone * (1.0 + 1e-9));
             let stops = match blend::corner_ramps(model, time, f, &traj) {
+                Some(blend::RampCorner::Flies(_)) if turns => false,
                 Some(blend::RampCorner::Flies(c)) => {
                     let (first, next) = blend::with_corner(f, &traj, &c);
                     *f = first;
@@ -274,6 +290,22 @@ impl Arm {
         });
         if let Some((_, _, point, at, true)) = corner {
             notes.corner_failure = Some((point, at));
+            // It starts from rest at the point, planned as after a `fine` point there (from
+            // the TCP of the point's joints, not the programmed pose: the two differ by
+            // rounding, and a path timed within its axes' limits would by a little more).
+            if ops.is_cartesian() {
+                let from = PlanFrom {
+                    tcp: model.tcp(&self.rest[..model.dof()], &tool),
+                    ..from
+                };
+                let again = plan::plan(model, &from, ops, &mut self.memo)?;
+                traj = again.traj;
+                point_ns = again.duration_ns;
+                look_ahead = again.look_ahead;
+                notes.longer = again.longer;
+                notes.slowed = again.slowed;
+                notes.capped = again.capped;
+            }
         }
         let (start, blend) = match corner {
             Some((ts, ..)) if tool_changed => (ts, None),
@@ -282,7 +314,14 @@ impl Arm {
         };
         let (mut end_ns, zone, entry_ns) = match programmed {
             // A TCP that does not move (a turntable's, on its axis) enters no zone.
-            Some(r) => match blend::zone_entry(model, &self.tool, &self.rest, &traj, point_ns, r) {
+            Some(r) => match blend::zone_entry(
+                model,
+                &self.tool,
+                &self.rest,
+                &traj,
+                point_ns,
+                (r, ori_zone),
+            ) {
                 (_, z, _) if z <= 1e-9 => (point_ns, 0.0, point_ns),
                 entry => entry,
             },
@@ -307,6 +346,7 @@ impl Arm {
             entry_ns,
             zone: if end_ns < point_ns { zone } else { 0.0 },
             programmed,
+            ori_zone,
             blend,
             tool: self.tool,
         });

@@ -21,7 +21,7 @@
 //! model, the motions and the times in, a time or a radius out.
 
 use vworks_model::RobotModel;
-use vworks_model::math::{Iso, V3, axpy, norm, sub};
+use vworks_model::math::{Iso, V3, axpy, mat_mul, norm, rotation_vector, sub, transpose};
 
 use super::plan::{JOINT_SPEED_TOLERANCE, Trajectory};
 use super::quarters::chord_peak;
@@ -70,6 +70,9 @@ pub(super) struct Planned {
     pub(super) zone: f64,
     /// The zone as programmed (or the workcell's default); `None`: `fine`.
     pub(super) programmed: Option<f64>,
+    /// Its orientation zone (RAPID's extended zone), larger than its zone: radius (m) and
+    /// angle (rad).
+    pub(super) ori_zone: Option<(f64, f64)>,
     /// The radius within which it blends out of the previous zoned point, if it does.
     pub(super) blend: Option<f64>,
     /// Its TCP in the tool link's frame.
@@ -147,26 +150,42 @@ pub(super) fn blend_pose(
 /// ([`ramp_profile`]) looks ahead from where it would have to begin braking for the
 /// sharpest corner (a reversal: `1 − s = ṡ²/2a + r/2`), if that is before the zone. A
 /// joint motion's zone begins where the TCP comes within `r` of the point, and not
-/// before half its duration.
+/// before half its duration. With an orientation zone `ori` (radius, angle: RAPID's
+/// extended zone, where the tool begins to turn towards the next motion), the
+/// `motion_end` is no later than where the robot enters it ([`extended_share`]).
 pub(super) fn zone_entry(
     model: &RobotModel,
     tool: &Iso,
     rest: &[f64; MAX_AXES],
     traj: &Trajectory,
     point_ns: i64,
-    r: f64,
+    (r, ori): (f64, Option<(f64, f64)>),
 ) -> (i64, f64, i64) {
     let total = point_ns as f64 / NS;
     let to_ns = |t: f64| ((t * NS).ceil() as i64).clamp(0, point_ns);
-    if let Trajectory::Cartesian { path, profile, .. } = traj {
+    if let Trajectory::Cartesian {
+        path,
+        profile,
+        from,
+        to,
+        ..
+    } = traj
+    {
         let len = path.length();
         if len <= 1e-7 || profile.dist <= 0.0 {
             return (point_ns, 0.0, point_ns);
         }
         let r1 = r.min(0.5 * len);
         let boundary = traj.time_at_own_fraction(1.0 - r1 / len);
+        // (Where the tool begins to turn towards the next motion: the extended zone.)
+        let share = extended_share(r1 / len, ori, len, turn_angle(from, to));
+        let extended = if share > r1 / len {
+            traj.time_at_own_fraction(1.0 - share)
+        } else {
+            boundary
+        };
         let Some(ramps) = ramp_profile(traj) else {
-            return (to_ns(boundary), r1, to_ns(boundary));
+            return (to_ns(extended), r1, to_ns(boundary));
         };
         let (a, rf) = (ramps.accel, r1 / len);
         let must_brake = |t: f64| {
@@ -190,7 +209,7 @@ pub(super) fn zone_entry(
             }
         }
         // (Rounded down: the decision is never past the braking point or the zone.)
-        let decision = ((hi.min(boundary) * NS).floor() as i64).clamp(0, point_ns);
+        let decision = ((hi.min(extended) * NS).floor() as i64).clamp(0, point_ns);
         return (decision, r1, to_ns(boundary));
     }
     let n = model.dof();
@@ -209,16 +228,48 @@ pub(super) fn zone_entry(
         let t = to_ns(0.5 * total);
         return (t, farthest, t);
     };
-    let (mut lo, mut hi) = (at(k), at(k + 1));
-    for _ in 0..60 {
-        let mid = 0.5 * (lo + hi);
-        if dist(mid) > r {
-            lo = mid;
-        } else {
-            hi = mid;
+    let within = |r: f64, k: usize| {
+        let (mut lo, mut hi) = (at(k), at(k + 1));
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if dist(mid) > r {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
         }
+        hi
+    };
+    let entry = within(r, k);
+    // (An extended zone: where the TCP comes within its radius, from the middle on.)
+    let decision = match ori {
+        Some((rho, _)) if rho > r => match (0..STEPS).rev().find(|&k| dist(at(k)) > rho) {
+            Some(k) => within(rho, k),
+            None => 0.5 * total,
+        },
+        _ => entry,
+    };
+    (to_ns(decision.min(entry)), r, to_ns(entry))
+}
+
+/// The angle (rad) a Cartesian motion turns its tool by, from `from` to `to`.
+pub(super) fn turn_angle(from: &Iso, to: &Iso) -> f64 {
+    norm(rotation_vector(&mat_mul(&transpose(&from.r), &to.r)))
+}
+
+/// The share of a Cartesian motion's path (of length `len`, turning its tool by `angle`)
+/// that its extended zone covers, from its point back: RAPID's `pzone_ori` as a share
+/// (at most half the path) and no more than turns the tool by `zone_ori`, and never less
+/// than the TCP zone's share `tcp`.
+pub(super) fn extended_share(tcp: f64, ori: Option<(f64, f64)>, len: f64, angle: f64) -> f64 {
+    let Some((rho, alpha)) = ori else {
+        return tcp;
+    };
+    let mut share = (rho / len).min(0.5);
+    if angle > 1e-9 {
+        share = share.min(alpha / angle);
     }
-    (to_ns(hi), r, to_ns(hi))
+    share.max(tcp)
 }
 
 /// The profile of a straight line that can fly by a corner with ramps (a trapezoid in

@@ -18,12 +18,17 @@
 //! first motion's to the second's across the curve), its whole acceleration (along and
 //! across the path, knot by knot) and each motion's own path speed (its orientation speed
 //! on its own pieces; in the curve the two rotations compose).
+//!
+//! With an orientation zone wider than the curve (RAPID's `pzone_ori`, [`Turn`]), the
+//! tool turns over that wider stretch, centred on the curve, with progressions of the same
+//! form of its own; the position's curve is unchanged (docs/engine.md, "Orientation
+//! zones").
 
 use vworks_model::RobotModel;
 use vworks_model::math::{Iso, V3, add, axpy, dot, mat_mul, norm, sub, transpose};
 use vworks_model::timing::{JointPath, KNOTS, KnotLimits, SEGMENTS};
 
-use super::blend::Fading;
+use super::blend::{Fading, turn_angle};
 use super::path::{
     Memo, PathLimits, Untimed, axis_limits, knot_derivatives, knot_joints, sample_knots, seeds_of,
     timed_rates,
@@ -31,7 +36,7 @@ use super::path::{
 use super::plan::{Trajectory, to_ns};
 use super::quarters::Inner;
 use crate::MAX_AXES;
-use crate::motion::{NS, Path, cartesian_at};
+use crate::motion::{NS, Path, cartesian_at, slerp};
 use std::convert::Infallible;
 
 /// How a trajectory that flies out of a zone follows the previous motion's path and its
@@ -51,6 +56,20 @@ pub(super) struct TimedCorner {
     /// Where the curve begins and ends in `s`.
     pub(super) s_in: f64,
     pub(super) s_out: f64,
+    /// Where the tool turns over a wider stretch than the curve (an orientation zone).
+    pub(super) turn: Option<Turn>,
+}
+
+/// Where the tool turns from the first motion's orientation to the second's over more
+/// than the curve (RAPID's orientation zone, module docs): from `s_in` to `s_out`, centred
+/// on the curve, the first path's orientation running out from its fraction `f_in` and
+/// the second's running in to its fraction `f_out`, as the curve's progressions do.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Turn {
+    pub(super) s_in: f64,
+    pub(super) s_out: f64,
+    pub(super) f_in: f64,
+    pub(super) f_out: f64,
 }
 
 /// The fractions of both paths at `s` and their first and second derivatives by `s`.
@@ -118,9 +137,42 @@ impl TimedCorner {
         }
     }
 
+    /// Inside the turn, the fractions of both paths the orientation follows at `s` and
+    /// their rates by `s` (`o1, o1', o2, o2'`); `None` outside it (the orientation follows
+    /// the position's progressions).
+    fn turning(&self, s: f64) -> Option<[f64; 4]> {
+        let w = self.turn.as_ref().filter(|w| s > w.s_in && s < w.s_out)?;
+        let width = w.s_out - w.s_in;
+        let u = (s - w.s_in) / width;
+        let (g, gd, _) = run_out(u);
+        let (r1, r2) = (1.0 - w.f_in, w.f_out);
+        Some([
+            w.f_in + r1 * g,
+            r1 * gd / width,
+            r2 * u * u,
+            2.0 * r2 * u / width,
+        ])
+    }
+
+    /// Where the corner is over: the curve, or the turn if it ends later (the pose is
+    /// the motion's own path's from there on).
+    pub(super) fn end(&self) -> f64 {
+        self.turn.map_or(self.s_out, |w| w.s_out.max(self.s_out))
+    }
+
     /// The TCP pose at `s` of the motion whose own path is `path` from `from` to `to`.
     pub(super) fn pose(&self, path: &Path, from: &Iso, to: &Iso, s: f64) -> Iso {
         let p = self.progress(s);
+        if let Some([o1, _, o2, _]) = self.turning(s) {
+            let one = cartesian_at(&self.first, &self.first_from, &self.first_to, p.f1);
+            let two = cartesian_at(path, from, to, p.f2);
+            let r1 = slerp(&self.first_from.r, &self.first_to.r, o1);
+            let r2 = slerp(&from.r, &to.r, o2);
+            return Iso {
+                r: mat_mul(&r2, &mat_mul(&transpose(&self.first_to.r), &r1)),
+                t: sub(add(one.t, two.t), self.first_to.t),
+            };
+        }
         if p.f2 <= 0.0 {
             return cartesian_at(&self.first, &self.first_from, &self.first_to, p.f1);
         }
@@ -159,29 +211,30 @@ impl TimedCorner {
     }
 }
 
-/// Knots for a path of three pieces meeting at `joins` (fractions, increasing; a piece of
-/// no length gets no steps): each piece in equal steps, as many as its share (at least
-/// two; the curve, the middle one, at least [`CURVE_STEPS`]), and the knots where they
-/// meet.
-fn piece_knots(joins: [f64; 2]) -> ([f64; KNOTS], [usize; 2]) {
-    let ends = [0.0, joins[0], joins[1], 1.0];
-    let mut steps = [0usize; 3];
+/// Knots for a path of five pieces meeting at `joins` (fractions, increasing; a piece of
+/// no length gets no steps): the turn's stretch before the curve, the curve (the middle
+/// one) and the turn's stretch after it between the straight pieces at both ends. Each
+/// piece in equal steps, as many as its share (at least two; the curve at least
+/// [`CURVE_STEPS`]), and the knots where they meet.
+fn piece_knots(joins: [f64; 4]) -> ([f64; KNOTS], [usize; 4]) {
+    let ends = [0.0, joins[0], joins[1], joins[2], joins[3], 1.0];
+    let mut steps = [0usize; 5];
     for (j, st) in steps.iter_mut().enumerate() {
         let share = ends[j + 1] - ends[j];
         if share > 0.0 {
-            let least = if j == 1 { CURVE_STEPS } else { 2 };
+            let least = if j == 2 { CURVE_STEPS } else { 2 };
             *st = ((share * SEGMENTS as f64).round() as usize).max(least);
         }
     }
     // The largest piece takes what the rounding leaves over or short.
     let total: usize = steps.iter().sum();
-    let big = (0..3).max_by_key(|&j| steps[j]).unwrap_or(2);
+    let big = (0..5).max_by_key(|&j| steps[j]).unwrap_or(4);
     steps[big] = (steps[big] + SEGMENTS).saturating_sub(total);
     let mut knots = [0.0f64; KNOTS];
     let mut k = 0;
     for (j, st) in steps.iter().enumerate() {
         for m in 0..*st {
-            // (The steps sum to SEGMENTS: CURVE_STEPS + 4 ≤ SEGMENTS.)
+            // (The steps sum to SEGMENTS: CURVE_STEPS + 8 ≤ SEGMENTS.)
             if let Some(knot) = knots.get_mut(k) {
                 *knot = ends[j] + (ends[j + 1] - ends[j]) * m as f64 / *st as f64;
             }
@@ -189,7 +242,13 @@ fn piece_knots(joins: [f64; 2]) -> ([f64; KNOTS], [usize; 2]) {
         }
     }
     knots[SEGMENTS] = 1.0;
-    (knots, [steps[0], steps[0] + steps[1]])
+    let mut breaks = [0usize; 4];
+    let mut at = 0;
+    for (b, st) in breaks.iter_mut().zip(steps) {
+        at += st;
+        *b = at;
+    }
+    (knots, breaks)
 }
 
 /// The first path's progression through the curve, `g(u) = 2u − u² = 1 − (1 − u)²`, and
@@ -202,7 +261,7 @@ fn run_out(u: f64) -> (f64, f64, f64) {
 /// The fewest steps of a corner's curve: it turns the TCP within the zone, often a small
 /// share of the path, and its axes' accelerations change along it.
 const CURVE_STEPS: usize = 64;
-const _: () = assert!(CURVE_STEPS + 4 <= SEGMENTS);
+const _: () = assert!(CURVE_STEPS + 8 <= SEGMENTS);
 
 /// How much faster (in `ṡ²`) the robot may be than the fastest start a corner's timing
 /// finds, for that start to be taken: half the timing's margin below the limits.
@@ -298,7 +357,7 @@ pub(super) fn take_over(
     let dt = (start - f.motion.start) as f64 / NS;
     let s_now = first.fraction_at(dt);
     // (Its motion_end is where its curve ends, or later: the same knot within rounding.)
-    if corner1.as_ref().is_some_and(|c| s_now < c.s_out - 1e-9) {
+    if corner1.as_ref().is_some_and(|c| s_now < c.end() - 1e-9) {
         return None;
     }
     let f_now = first.own_fraction_at(dt);
@@ -320,7 +379,7 @@ pub(super) fn take_over(
     let (rho1, c1, c2, rho2) = (f_in - f_now, 2.0 * (1.0 - f_in), 2.0 * f_out, 1.0 - f_out);
     let sigma = 1.0 / (1.0 + rho1 / c1 + rho2 / c2);
     let s_in = sigma * rho1 / c1;
-    let corner = TimedCorner {
+    let mut corner = TimedCorner {
         first: p1.clone(),
         first_from: *from1,
         first_to: *to1,
@@ -329,7 +388,30 @@ pub(super) fn take_over(
         f_out,
         s_in,
         s_out: s_in + sigma,
+        turn: None,
     };
+    // The orientation zone: the TCP covers 2r/σ of either path per unit of s on the
+    // straight pieces, so a turn of radius ρ is ρσ/r wide in s, centred on the curve,
+    // and its progressions meet the straight pieces' with the same rates.
+    let rho = turn_radius(f, next, f_now).filter(|rho| *rho > r * (1.0 + 1e-9));
+    if let Some(rho) = rho {
+        let (mid, half) = (s_in + 0.5 * sigma, 0.5 * rho * sigma / r);
+        // (Within a nanometre of where the robot is or of the path's end, there: a piece
+        // of rounding would get steps of its own, and its differences would be noise.)
+        let nm = 1e-9 * sigma / (2.0 * r);
+        let w_in = if mid - half < nm { 0.0 } else { mid - half };
+        let w_out = if mid + half > 1.0 - nm {
+            1.0
+        } else {
+            mid + half
+        };
+        corner.turn = Some(Turn {
+            s_in: w_in,
+            s_out: w_out,
+            f_in: corner.progress(w_in).f1,
+            f_out: corner.progress(w_out).f2,
+        });
+    }
     let q_now = first.joints_at(model, dt)?;
     let own_speed = first.own_speed_at(dt);
     // The same corner from the same state (a program repeating its moves) is timed once.
@@ -341,6 +423,7 @@ pub(super) fn take_over(
         .iter()
         .chain(end_joints)
         .chain([&f_now, &own_speed, &r, &zone_key, vs1, as1, vs2, as2])
+        .chain([&rho.unwrap_or(f64::NAN)])
         .chain(from1.r.iter().flatten().chain(&from1.t))
         .chain(to1.r.iter().flatten().chain(&to1.t))
         .chain(from2.r.iter().flatten().chain(&from2.t))
@@ -382,9 +465,9 @@ pub(super) type CornerMemo = Memo<CORNER_KEY, Option<Taken>>;
 
 /// Corners a VM remembers.
 pub(super) const CORNER_MEMO: usize = 16;
-/// A corner's key: joints now and at the end, 8 numbers, 5 poses, 2 midpoints, the next
+/// A corner's key: joints now and at the end, 9 numbers, 5 poses, 2 midpoints, the next
 /// motion's profile, the branch.
-pub(super) const CORNER_KEY: usize = 2 * MAX_AXES + 8 + 5 * 12 + 6 + 7 + 1;
+pub(super) const CORNER_KEY: usize = 2 * MAX_AXES + 9 + 5 * 12 + 6 + 7 + 1;
 
 /// The corner `corner` from the robot's joints and own-path speed `now` on the first
 /// path into `next`, timed (`take_over`'s work once the corner is known).
@@ -414,7 +497,10 @@ fn time_corner(
     let pose = |s: f64| corner.pose(p2, from2, to2, s);
     let joints_at = knot_joints(model, tool, *branch, &pose);
     // Knots on both joins, each piece in equal steps by its share of s (at least two).
-    let (knots, breaks) = piece_knots([corner.s_in, corner.s_out]);
+    let (w_in, w_out) = corner
+        .turn
+        .map_or((corner.s_in, corner.s_out), |w| (w.s_in, w.s_out));
+    let (knots, breaks) = piece_knots([w_in, corner.s_in, corner.s_out, w_out]);
     let mut joints = JointPath::new(n);
     sample_knots(&mut joints, &q_now, Some(&knots), &joints_at).ok()?;
     joints.set_breaks(breaks);
@@ -446,7 +532,10 @@ fn time_corner(
                 ((1.0 - u) * v1 + u * v2, a1.min(a2))
             };
             let mut x_max = f64::INFINITY;
-            for (rate, vs) in [(p.d1, vs1), (p.d2, *vs2)] {
+            // (In the turn the orientation follows progressions of its own: each within
+            // its motion's path speed too.)
+            let [_, od1, _, od2] = corner.turning(*s).unwrap_or_default();
+            for (rate, vs) in [(p.d1, vs1), (p.d2, *vs2), (od1, vs1), (od2, *vs2)] {
                 if rate > 0.0 {
                     x_max = x_max.min((vs / rate).powi(2));
                 }
@@ -503,8 +592,9 @@ fn time_corner(
         }
         Err(_) => return None,
     };
-    // (Its own motion_end, and so the next corner, never before its curve has ended.)
-    let curve_end = timing.time_at(corner.s_out);
+    // (Its own motion_end, and so the next corner, never before its curve and its turn
+    // have ended.)
+    let curve_end = timing.time_at(corner.end());
     let look_ahead = look_ahead.map(|t| t.max(curve_end));
     let rates = timed_rates(&joints, &timing);
     let point_ns = to_ns(timing.duration());
@@ -530,4 +620,42 @@ fn time_corner(
         look_ahead,
         radius: r,
     })
+}
+
+/// The radius (m, a TCP distance from the point) over which the tool turns from the rest
+/// of `f` into `next` (two Cartesian motions) with the robot at fraction `f_now` of the
+/// first path: `f`'s orientation zone, at most half of either path and where the robot
+/// is, and no wider than turns either motion's tool by its angle (`zone_ori`); `None`
+/// where neither motion turns the tool or there is no orientation zone.
+pub(super) fn turn_radius(f: &Fading, next: &Trajectory, f_now: f64) -> Option<f64> {
+    let (rho, alpha) = f.motion.ori_zone?;
+    let (
+        Trajectory::Cartesian {
+            path: p1,
+            from: from1,
+            to: to1,
+            ..
+        },
+        Trajectory::Cartesian {
+            path: p2,
+            from: from2,
+            to: to2,
+            ..
+        },
+    ) = (&f.motion.traj, next)
+    else {
+        return None;
+    };
+    let (l1, l2) = (p1.length(), p2.length());
+    let (a1, a2) = (turn_angle(from1, to1), turn_angle(from2, to2));
+    if (a1 <= 1e-9 && a2 <= 1e-9) || l1 <= 1e-7 || l2 <= 1e-7 {
+        return None;
+    }
+    let mut radius = rho.min(0.5 * l1).min(0.5 * l2).min((1.0 - f_now) * l1);
+    for (len, angle) in [(l1, a1), (l2, a2)] {
+        if angle > 1e-9 {
+            radius = radius.min(alpha * len / angle);
+        }
+    }
+    Some(radius)
 }

@@ -607,11 +607,18 @@ fn fastest_axis(derivatives: &KnotDerivatives, timing: &Timing, speed: &[f64]) -
     (axis, best)
 }
 
+/// How far over a limit an axis may be measured (relative) where it runs exactly at it:
+/// the joints' finite differences from numeric IK round by about 5e-9 (a slide joint whose
+/// speed is its TCP's, exactly at its limit). A profile measured further over is
+/// stretched in time ([`profile_samples`]).
+const MEASURED_OVER: f64 = 1e-8;
+
 /// How far to each side of a profile's breakpoint (a share of its time) its acceleration
 /// is taken on that side: a step of a trapezoid's acceleration is exactly at it.
 const PHASE_SIDE: f64 = 1e-12;
 
 /// How a profile keeps the axis limits along a sampled path.
+#[derive(Clone)]
 struct ProfileCheck {
     /// Every axis within its speed and acceleration at the knots, and between them where
     /// one comes near a limit.
@@ -620,6 +627,9 @@ struct ProfileCheck {
     worst_axis: usize,
     /// The path speed at each knot.
     sd: [f64; KNOTS],
+    /// How much slower (in time) the profile must run for every axis the check found
+    /// within its tolerance over a limit to be within it: 1 if none.
+    over: f64,
 }
 
 /// Checks `profile` against every axis's speed and acceleration at the knots (axis speed
@@ -733,6 +743,9 @@ fn check_profile(
         }
     }
     let mut fits = worst >= 1.0 - JOINT_SPEED_TOLERANCE;
+    // (A ratio below 1 is a speed's or an acceleration's: stretching the profile's time by
+    // its inverse keeps both.)
+    let mut over = 1.0 / worst.min(1.0);
     if fits && (worst < 1.0 / NEAR_LIMIT || peaks) {
         inner.fill(joints, &near, joints_at)?;
         let state = |_: usize, s: f64| {
@@ -742,11 +755,13 @@ fn check_profile(
         let mut ratios = [0.0f64; SEGMENTS];
         let (rv, ra) = inner.ratios(joints, (speed, accel), state, &kinks, &mut ratios);
         fits = rv.max(ra) <= 1.0 + JOINT_SPEED_TOLERANCE;
+        over = over.max(rv).max(ra.sqrt());
     }
     Ok(ProfileCheck {
         fits,
         worst_axis,
         sd,
+        over,
     })
 }
 
@@ -759,6 +774,18 @@ fn profile_samples(
     executed: Option<Profile>,
     end: [f64; MAX_AXES],
 ) -> PathSamples {
+    // A profile accepted within the check's tolerance over a limit (up to 1e-6, for the
+    // rounding of the joints' differences) runs that much slower where the check
+    // measured more than [`MEASURED_OVER`]: every axis within its limits as measured.
+    if check.over > 1.0 + MEASURED_OVER {
+        let stretched = executed.unwrap_or(*profile).stretched(check.over);
+        let mut within = check.clone();
+        within.over = 1.0;
+        for sd in within.sd.iter_mut() {
+            *sd /= check.over;
+        }
+        return profile_samples(joints, &stretched, &within, Some(stretched), end);
+    }
     // The profile's top speed is halfway through its time: the step it falls in moves
     // at most that fast.
     let peak_s = profile.at(0.5 * profile.t_total) / profile.dist.max(f64::MIN_POSITIVE);

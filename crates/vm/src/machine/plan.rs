@@ -126,6 +126,13 @@ pub enum PlanError {
         fmt_quantity(*.0, Dim::LENGTH)
     )]
     Zone(f64),
+    /// A negative orientation zone: its radius (m) or angle (rad).
+    #[error(
+        "the orientation zone cannot be negative (got {} and {}); write a radius and an angle such as `ori 15mm 1.5deg`",
+        fmt_quantity(*.0, Dim::LENGTH),
+        fmt_quantity(*.1, Dim::ANGLE)
+    )]
+    OriZone(f64, f64),
 }
 
 /// Up to 12 slots of a pose (6) or joints (12) operand, without allocating.
@@ -161,6 +168,8 @@ pub(super) struct MotionOperands {
     accel: Option<f64>,
     /// `zone` radius (m; 0 for `zone fine`), if given.
     pub(super) zone: Option<f64>,
+    /// Its orientation zone, if given: radius (m) and angle (rad).
+    pub(super) ori_zone: Option<(f64, f64)>,
     /// `tool` (the TCP in the tool link's frame), if given.
     pub(super) tool: Option<Iso>,
     /// The `speed` of a `move_j` is a TCP speed (m/s), not a ratio.
@@ -197,6 +206,13 @@ impl MotionOperands {
         let tool = f.has(MoveFlags::TOOL).then(|| {
             k += 6;
             to_iso(&s[s.len() - k..s.len() - k + 6])
+        });
+        let ori_zone = f.has(MoveFlags::ZONE | MoveFlags::ZONE_ORI).then(|| {
+            k += 2;
+            (
+                f64::from_bits(s[s.len() - k]),
+                f64::from_bits(s[s.len() - k + 1]),
+            )
         });
         let zone = f.has(MoveFlags::ZONE).then(|| {
             k += 1;
@@ -242,6 +258,7 @@ impl MotionOperands {
             speed,
             accel,
             zone,
+            ori_zone,
             tool,
             orient,
             duration,

@@ -908,20 +908,19 @@ impl Compiler<'_> {
             }
             Some(Zone::Radius(e)) => {
                 flags |= MoveFlags::ZONE;
-                let out = self.expr(e);
-                let what = format!("the zone of `{}`", kind.keyword());
-                let out = self.coerce(out, Ty::Num(Dim::LENGTH), e.span, &what);
-                if let Some(ConstValue::Num(x)) = out.k
-                    && (x.is_nan() || x < 0.0)
-                {
-                    self.err(
-                        Diagnostic::error(
-                            Code::E0025,
-                            format!("{what} cannot be negative"),
-                            e.span,
-                        )
-                        .with_help("write a radius such as `zone 10mm`, or `zone fine` to stop at the point"),
-                    );
+                self.zone_size(kind, e, Dim::LENGTH, "zone");
+            }
+            Some(Zone::Extended(z)) => {
+                let ExtendedZone { radius, ori, angle } = &**z;
+                flags |= MoveFlags::ZONE | MoveFlags::ZONE_ORI;
+                self.zone_size(kind, radius, Dim::LENGTH, "zone");
+                self.zone_size(kind, ori, Dim::LENGTH, "orientation zone");
+                match angle {
+                    Some(a) => self.zone_size(kind, a, Dim::ANGLE, "orientation zone's angle"),
+                    // (No bound: no motion turns its tool by more than π.)
+                    None => {
+                        self.emit(Instr::PushNum(std::f64::consts::PI), ori.span);
+                    }
                 }
             }
         }
@@ -962,6 +961,25 @@ impl Compiler<'_> {
 
     /// The `speed`/`accel` option of a motion: a ratio for `move_j`, else `dim` (> 0).
     /// A `move_j` may also take a TCP speed (`speed 250mm/s`): then it returns true.
+    /// A zone's size `e` (a `dim`, not negative), pushed.
+    fn zone_size(&mut self, kind: MoveKind, e: &Expr, dim: Dim, what: &str) {
+        let out = self.expr(e);
+        let what = format!("the {what} of `{}`", kind.keyword());
+        let out = self.coerce(out, Ty::Num(dim), e.span, &what);
+        if let Some(ConstValue::Num(x)) = out.k
+            && (x.is_nan() || x < 0.0)
+        {
+            self.err(
+                Diagnostic::error(Code::E0025, format!("{what} cannot be negative"), e.span)
+                    .with_help(if what.starts_with("the zone ") {
+                        "write a radius such as `zone 10mm`, or `zone fine` to stop at the point"
+                    } else {
+                        "write an orientation zone such as `zone 10mm ori 15mm 1.5deg`: a radius, and the most it turns the tool"
+                    }),
+            );
+        }
+    }
+
     pub(super) fn motion_rate(&mut self, kind: MoveKind, e: &Expr, dim: Dim, what: &str) -> bool {
         let out = self.expr(e);
         let what = format!("the {what} of `{}`", kind.keyword());

@@ -99,7 +99,11 @@ impl Ty {
                 (".v_tcp", Type::Num(Dim::SPEED)),
                 (".v_ori", Type::Num(Dim::ANGSPEED)),
             ],
-            Ty::Zone => &[(".pzone_tcp", Type::Num(Dim::LENGTH))],
+            Ty::Zone => &[
+                (".pzone_tcp", Type::Num(Dim::LENGTH)),
+                (".pzone_ori", Type::Num(Dim::LENGTH)),
+                (".zone_ori", Type::Num(Dim::ANGLE)),
+            ],
             Ty::Tool => &[(".tframe", Type::Pose)],
             Ty::Wobj => &[(".uframe", Type::Pose), (".oframe", Type::Pose)],
             Ty::Str | Ty::Load | Ty::Conf | Ty::Extax | Ty::Syncident | Ty::Tasks => &[],
@@ -151,23 +155,25 @@ pub(crate) const SPEEDS: &[(&str, f64, f64)] = &[
     ("vmax", 5000.0, 500.0),
 ];
 
-/// Predefined `zonedata`: (name, pzone_tcp mm); `fine` stops at the point.
-pub(crate) const ZONES: &[(&str, f64)] = &[
-    ("fine", 0.0),
-    ("z0", 0.3),
-    ("z1", 1.0),
-    ("z5", 5.0),
-    ("z10", 10.0),
-    ("z15", 15.0),
-    ("z20", 20.0),
-    ("z30", 30.0),
-    ("z40", 40.0),
-    ("z50", 50.0),
-    ("z60", 60.0),
-    ("z80", 80.0),
-    ("z100", 100.0),
-    ("z150", 150.0),
-    ("z200", 200.0),
+/// Predefined `zonedata`: (name, pzone_tcp mm, pzone_ori mm, zone_ori degrees), as the
+/// RAPID reference lists them (`pzone_eax`, `zone_leax` and `zone_reax`, for external
+/// axes, are not simulated); `fine` stops at the point.
+pub(crate) const ZONES: &[(&str, f64, f64, f64)] = &[
+    ("fine", 0.0, 0.0, 0.0),
+    ("z0", 0.3, 0.3, 0.03),
+    ("z1", 1.0, 1.0, 0.1),
+    ("z5", 5.0, 8.0, 0.8),
+    ("z10", 10.0, 15.0, 1.5),
+    ("z15", 15.0, 23.0, 2.3),
+    ("z20", 20.0, 30.0, 3.0),
+    ("z30", 30.0, 45.0, 4.5),
+    ("z40", 40.0, 60.0, 6.0),
+    ("z50", 50.0, 75.0, 7.5),
+    ("z60", 60.0, 90.0, 9.0),
+    ("z80", 80.0, 120.0, 12.0),
+    ("z100", 100.0, 150.0, 15.0),
+    ("z150", 150.0, 225.0, 23.0),
+    ("z200", 200.0, 300.0, 30.0),
 ];
 
 /// RAPID's unit of a dimension, as an SI factor: mm, degrees, seconds.

@@ -417,7 +417,9 @@ impl Tr<'_> {
             (Ty::Pos, "x" | "y" | "z") => num_of(b::field(v.leaf(), &key), Dim::LENGTH),
             (Ty::Speed, "v_tcp") => num_of(v.parts[0].clone(), Dim::SPEED),
             (Ty::Speed, "v_ori") => num_of(v.parts[1].clone(), Dim::ANGSPEED),
-            (Ty::Zone, "pzone_tcp") => num_of(v.leaf(), Dim::LENGTH),
+            (Ty::Zone, "pzone_tcp") => num_of(v.parts[0].clone(), Dim::LENGTH),
+            (Ty::Zone, "pzone_ori") => num_of(v.parts[1].clone(), Dim::LENGTH),
+            (Ty::Zone, "zone_ori") => num_of(v.parts[2].clone(), Dim::ANGLE),
             (Ty::Tool, "tframe") => Some(Val::one(Ty::Pose, v.leaf())),
             (Ty::Wobj, "uframe") => Some(Val::one(Ty::Pose, v.parts[0].clone())),
             (Ty::Wobj, "oframe") => Some(Val::one(Ty::Pose, v.parts[1].clone())),
@@ -440,7 +442,7 @@ impl Tr<'_> {
                 self.unsupported(
                     &format!("the component `{}` of {}", f.text, article(v.ty)),
                     f.span,
-                    "docs/rapid.md lists the components vworks reads: trans, rot, x, y, z, robax.rax_1…6, v_tcp, v_ori, pzone_tcp, tframe, uframe, oframe",
+                    "docs/rapid.md lists the components vworks reads: trans, rot, x, y, z, robax.rax_1…6, v_tcp, v_ori, pzone_tcp, pzone_ori, zone_ori, tframe, uframe, oframe",
                 );
                 None
             }
@@ -594,11 +596,20 @@ impl Tr<'_> {
                 })
             }
             Ty::Zone => {
+                // [finep, pzone_tcp, pzone_ori, pzone_eax, zone_ori, zone_leax, zone_reax]
                 let finep = self.value(&items[0], Ty::Bool)?.leaf();
                 let v = nums(self, 1, 6)?;
-                let radius = match finep.kind {
-                    w::ExprKind::Bool(true) => b::quantity(0.0, Dim::LENGTH, span),
-                    w::ExprKind::Bool(false) => b::with_unit(v[0].clone(), Dim::LENGTH),
+                let parts = match finep.kind {
+                    w::ExprKind::Bool(true) => vec![
+                        b::quantity(0.0, Dim::LENGTH, span),
+                        b::quantity(0.0, Dim::LENGTH, span),
+                        b::quantity(0.0, Dim::ANGLE, span),
+                    ],
+                    w::ExprKind::Bool(false) => vec![
+                        b::with_unit(v[0].clone(), Dim::LENGTH),
+                        b::with_unit(v[1].clone(), Dim::LENGTH),
+                        b::with_unit(v[3].clone(), Dim::ANGLE),
+                    ],
                     _ => {
                         self.unsupported(
                             "a zonedata whose finep is not TRUE or FALSE",
@@ -608,7 +619,11 @@ impl Tr<'_> {
                         return None;
                     }
                 };
-                Some(Val::one(Ty::Zone, radius))
+                Some(Val {
+                    ty: Ty::Zone,
+                    parts,
+                    text: None,
+                })
             }
             Ty::Tool => {
                 self.robhold(

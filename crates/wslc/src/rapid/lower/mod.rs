@@ -887,9 +887,13 @@ fn predefined(key: &str) -> Option<Data> {
         ]);
         return Some(d);
     }
-    if let Some((_, z)) = data::ZONES.iter().find(|(n, _)| *n == key) {
+    if let Some((_, z, zo, a)) = data::ZONES.iter().find(|(n, ..)| *n == key) {
         d.ty = Ty::Zone;
-        d.inline = Some(vec![b::quantity(z * 0.001, vworks_vm::Dim::LENGTH, span)]);
+        d.inline = Some(vec![
+            b::quantity(z * 0.001, vworks_vm::Dim::LENGTH, span),
+            b::quantity(zo * 0.001, vworks_vm::Dim::LENGTH, span),
+            b::quantity(a.to_radians(), vworks_vm::Dim::ANGLE, span),
+        ]);
         return Some(d);
     }
     match key {

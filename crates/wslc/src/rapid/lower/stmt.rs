@@ -363,6 +363,13 @@ impl Tr<'_> {
                 Vec::new()
             }
             (Ty::Zone, ["pzone_tcp"]) => set(leaf(0), num(self, Dim::LENGTH)?),
+            (Ty::Zone, ["pzone_ori"]) => set(leaf(1), num(self, Dim::LENGTH)?),
+            (Ty::Zone, ["zone_ori"]) => set(leaf(2), num(self, Dim::ANGLE)?),
+            (Ty::Zone, ["pzone_eax" | "zone_leax" | "zone_reax"]) => {
+                // External axes are not simulated (docs/rapid.md).
+                self.value(value, Ty::Num)?;
+                Vec::new()
+            }
             (Ty::Tool, ["tframe"]) => set(leaf(0), self.value(value, Ty::Pose)?.leaf()),
             (Ty::Wobj, ["uframe"]) => set(leaf(0), self.value(value, Ty::Pose)?.leaf()),
             (Ty::Wobj, ["oframe"]) => set(leaf(1), self.value(value, Ty::Pose)?.leaf()),
@@ -388,7 +395,7 @@ impl Tr<'_> {
                 self.unsupported(
                     &format!("assigning the component `{}` of {}", f.text, article(d.ty)),
                     f.span,
-                    "assign the whole value, or trans.x/y/z, rot, v_tcp, v_ori, pzone_tcp, tframe, uframe, oframe, robax.rax_1…6",
+                    "assign the whole value, or trans.x/y/z, rot, v_tcp, v_ori, pzone_tcp, pzone_ori, zone_ori, tframe, uframe, oframe, robax.rax_1…6",
                 );
                 return None;
             }
@@ -785,7 +792,7 @@ impl Tr<'_> {
         };
         let rest = &p[n - 3..];
         let speed = self.value(rest[0], Ty::Speed)?;
-        let zone = self.value(rest[1], Ty::Zone)?.leaf();
+        let zone = self.value(rest[1], Ty::Zone)?;
         let tool = self.value(rest[2], Ty::Tool)?.leaf();
         // A target in a work object: uframe · oframe · p, in the base frame.
         let in_wobj = |e: w::Expr| match &wobj {
@@ -805,10 +812,20 @@ impl Tr<'_> {
             (via.map(in_wobj), in_wobj(target))
         };
         let v_tcp = v_override.unwrap_or_else(|| speed.parts[0].clone());
-        let zone = z_override.unwrap_or(zone);
-        let zone = match b::literal(&zone) {
-            Some(0.0) => w::Zone::Fine,
-            _ => w::Zone::Radius(zone),
+        // (`\Z` gives the TCP zone; an orientation zone smaller than it is it.)
+        let mut parts = zone.parts.into_iter();
+        let (radius, ori, angle) = (parts.next(), parts.next(), parts.next());
+        let radius = z_override
+            .or(radius)
+            .unwrap_or_else(|| b::quantity(0.0, Dim::LENGTH, span));
+        let zone = match (b::literal(&radius), ori, angle) {
+            (Some(0.0), ..) => w::Zone::Fine,
+            (_, Some(ori), Some(angle)) => w::Zone::Extended(Box::new(w::ExtendedZone {
+                radius,
+                ori,
+                angle: Some(angle),
+            })),
+            _ => w::Zone::Radius(radius),
         };
         let kind = match key {
             "movel" => w::MoveKind::L,
