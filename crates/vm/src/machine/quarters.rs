@@ -88,11 +88,11 @@ impl Inner {
                     let d2 = (q[j + 1] - 2.0 * q[j] + q[j - 1]) / (h * h);
                     let v = (d1 * sd[j]).abs() / speed[i];
                     acc[j] = d1 * xu[j].1 + d2 * xu[j].0;
-                    at_points = at_points.max(v).max(acc[j].abs() / accel[i]);
-                    rv = rv.max(v);
-                    ra = ra.max(acc[j].abs() / accel[i]);
+                    at_points = worse(worse(at_points, v), acc[j].abs() / accel[i]);
+                    rv = worse(rv, v);
+                    ra = worse(ra, acc[j].abs() / accel[i]);
                 }
-                *r = r.max(at_points);
+                *r = worse(*r, at_points);
                 // (A smooth curve rises above its quarter points by far less than
                 // [`PEAKS_FROM`] leaves.)
                 if at_points < PEAKS_FROM || kink == Kink::Speed {
@@ -114,8 +114,8 @@ impl Inner {
                 ];
                 for (j, slope) in slopes.iter().enumerate() {
                     let v = slope * sd[j].max(sd[j + 1]) / speed[i];
-                    rv = rv.max(v);
-                    *r = r.max(v);
+                    rv = worse(rv, v);
+                    *r = worse(*r, v);
                 }
                 if kink == Kink::Accel {
                     continue;
@@ -138,12 +138,22 @@ impl Inner {
                 }
                 for j in 1..4 {
                     let a = parabola_peak([acc[j - 1], acc[j], acc[j + 1]]) / accel[i];
-                    ra = ra.max(a);
-                    *r = r.max(a);
+                    ra = worse(ra, a);
+                    *r = worse(*r, a);
                 }
             }
         }
         (rv, ra)
+    }
+}
+
+/// The larger of a ratio so far and a new one, where a ratio that is not a number (joints
+/// of NaN: never a limit kept) counts as infinitely over (`f64::max` would drop it).
+fn worse(so_far: f64, ratio: f64) -> f64 {
+    if ratio.is_nan() {
+        f64::INFINITY
+    } else {
+        so_far.max(ratio)
     }
 }
 
@@ -205,7 +215,32 @@ pub(super) fn chord_peak(d: [f64; 3], m: f64) -> f64 {
 
 #[cfg(test)]
 mod tests {
-    use super::{chord_peak, parabola_peak};
+    use super::{Inner, Kink, chord_peak, parabola_peak};
+    use vworks_model::timing::{JointPath, SEGMENTS};
+
+    /// A quarter point whose joint is not a number fails the check (infinitely over),
+    /// where `f64::max` would have dropped it and passed the step.
+    #[test]
+    fn a_joint_that_is_not_a_number_is_never_within_a_limit() {
+        let mut joints = JointPath::new(1);
+        for (k, q) in joints.q.iter_mut().enumerate() {
+            q[0] = k as f64 * 1e-3;
+        }
+        let mut inner = Inner::new();
+        let all = [true; SEGMENTS];
+        inner
+            .fill(&joints, &all, |s, _| Ok([s * SEGMENTS as f64 * 1e-3; 12]))
+            .unwrap();
+        let state = |_: usize, _: f64| (1.0, 0.0);
+        let mut out = [0.0; SEGMENTS];
+        let kinks = [Kink::None; SEGMENTS];
+        let (rv, ra) = inner.ratios(&joints, (&[1.0], &[1.0]), state, &kinks, &mut out);
+        assert!(rv.is_finite() && ra.is_finite() && rv > 0.0, "{rv} {ra}");
+        inner.q[7][1][0] = f64::NAN;
+        let (rv, ra) = inner.ratios(&joints, (&[1.0], &[1.0]), state, &kinks, &mut out);
+        assert!(rv.is_infinite() && ra.is_infinite(), "{rv} {ra}");
+        assert!(out[7].is_infinite());
+    }
 
     /// By hand: v(s) = 1 + 0.2·s − 3·s² has means A + B·m + C·(m² + 1/12) over the unit
     /// intervals centred on m = −1, 0, 1: 1 − 0.2 − 3.25 = −2.45, 1 − 0.25 = 0.75 and
