@@ -2,11 +2,10 @@
 //! "Timing"): random `move_l`, `move_c` and `move_j` of the four built-in arms, each sampled
 //! at 1 kHz through `Vm::joints_at` as the engine samples it. Axis speeds are first
 //! differences of the samples and accelerations second differences, averages over 1 or
-//! 2 ms. The planner holds the limits at five points of each of a path's 256 steps (its
-//! knots, quarter points and middle) and at points down to 1/4096 of a step from its ends;
-//! between them, near a singularity, the path's curvature can add a little: 1 % is allowed
-//! (the worst found, on an arc passing near the irb120's axis 1, is 0.59 % with samples
-//! 0.05 ms apart).
+//! 2 ms: within 1e-9 of the limit (and 1e-8 rad/s² for rounding in a second difference),
+//! as issue 30 asks. (Before the UR5's numeric IK took its last steps to the pose's
+//! rounding, its joints were 1e-10 rad off by an amount that drifts along a path: 1e-4
+//! rad/s² at 1 kHz, 9e-6 of its 10 rad/s², in 5 of 600 random motions.)
 //!
 //! A motion the VM refuses (a point out of reach, a singularity on the way, a self-made
 //! joint limit) is no case: the property is about the motions that run.
@@ -112,7 +111,8 @@ fn peaks(model: &RobotModel, samples: &[[f64; 12]]) -> (f64, f64) {
         }
         for w in even.windows(3) {
             let acc = (w[2][i] - 2.0 * w[1][i] + w[0][i]) / (h * h);
-            a = a.max(acc.abs() / j.max_accel);
+            // (Less the rounding of a second difference of joints of about 1: 1e-8 rad/s².)
+            a = a.max((acc.abs() - 1e-8).max(0.0) / j.max_accel);
         }
     }
     (v, a)
@@ -139,11 +139,11 @@ fn check(
     for samples in &motions {
         let (v, a) = peaks(&model, samples);
         assert!(
-            v <= 1.01,
+            v <= 1.0 + 1e-9,
             "{model_name}: axis speed {v} of its limit\n{src}"
         );
         assert!(
-            a <= 1.01,
+            a <= 1.0 + 1e-9,
             "{model_name}: axis acceleration {a} of its limit\n{src}"
         );
     }
