@@ -254,18 +254,24 @@ impl Arm {
             // timed as one path turns it so; corner ramps would turn it within the curve.)
             let turns = corner::turn_radius(f, &traj, 0.0)
                 .is_some_and(|rho| rho > f.motion.zone * (1.0 + 1e-9));
-            let stops = match blend::corner_ramps(model, time, f, &traj) {
-                Some(blend::RampCorner::Flies(_)) if turns => false,
-                Some(blend::RampCorner::Flies(c)) => {
-                    let (first, next) = blend::with_corner(f, &traj, &c);
-                    *f = first;
-                    traj = next;
-                    point_ns = (traj.path_duration() * NS).ceil() as i64;
-                    return (c.start, c.radius, f.end(), f.pos, false);
-                }
-                Some(blend::RampCorner::Stops) => true,
-                None => false,
+            let ramps = blend::corner_ramps(model, time, f, &traj);
+            let stops = matches!(ramps, Some(blend::RampCorner::Stops));
+            let flies = match ramps {
+                Some(blend::RampCorner::Flies(c)) => Some(c),
+                _ => None,
             };
+            let with_ramps = |f: &mut Fading, c: &blend::Corner, traj: &mut Trajectory| {
+                let (first, next) = blend::with_corner(f, traj, c);
+                *f = first;
+                *traj = next;
+                let point_ns = (traj.path_duration() * NS).ceil() as i64;
+                ((c.start, c.radius, f.end(), f.pos, false), point_ns)
+            };
+            if let Some(c) = flies.as_ref().filter(|_| !turns) {
+                let (out, ns) = with_ramps(f, c, &mut traj);
+                point_ns = ns;
+                return out;
+            }
             // Else the next takes the robot over now, through a corner timed with the rest of
             // the first as one path, where it can.
             let corners = &mut self.corners;
@@ -280,6 +286,12 @@ impl Arm {
                 point_ns = taken.point_ns;
                 look_ahead = taken.look_ahead;
                 return (start, taken.radius, start, f.pos, false);
+            }
+            // (With ramps after all where no timing turned the tool over its zone.)
+            if let Some(c) = &flies {
+                let (out, ns) = with_ramps(f, c, &mut traj);
+                point_ns = ns;
+                return out;
             }
             if stops {
                 return (f.end(), 0.0, f.end(), f.pos, true);

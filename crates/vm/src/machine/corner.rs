@@ -219,17 +219,31 @@ impl TimedCorner {
 fn piece_knots(joins: [f64; 4]) -> ([f64; KNOTS], [usize; 4]) {
     let ends = [0.0, joins[0], joins[1], joins[2], joins[3], 1.0];
     let mut steps = [0usize; 5];
+    let mut least = [0usize; 5];
     for (j, st) in steps.iter_mut().enumerate() {
         let share = ends[j + 1] - ends[j];
         if share > 0.0 {
-            let least = if j == 2 { CURVE_STEPS } else { 2 };
-            *st = ((share * SEGMENTS as f64).round() as usize).max(least);
+            least[j] = if j == 2 { CURVE_STEPS } else { 2 };
+            *st = ((share * SEGMENTS as f64).round() as usize).max(least[j]);
         }
     }
-    // The largest piece takes what the rounding leaves over or short.
-    let total: usize = steps.iter().sum();
+    // The largest piece takes what the rounding leaves over or short, where it keeps its
+    // least; else the pieces furthest above theirs give up a step each in turn (the
+    // least of all five, CURVE_STEPS + 8, fit in SEGMENTS).
+    let mut total: usize = steps.iter().sum();
     let big = (0..5).max_by_key(|&j| steps[j]).unwrap_or(4);
-    steps[big] = (steps[big] + SEGMENTS).saturating_sub(total);
+    if steps[big] + SEGMENTS >= total + least[big] {
+        steps[big] = steps[big] + SEGMENTS - total;
+    } else {
+        while total > SEGMENTS {
+            let j = (0..5).max_by_key(|&j| steps[j] - least[j]).unwrap_or(4);
+            if steps[j] <= least[j] {
+                break;
+            }
+            steps[j] -= 1;
+            total -= 1;
+        }
+    }
     let mut knots = [0.0f64; KNOTS];
     let mut k = 0;
     for (j, st) in steps.iter().enumerate() {
@@ -354,10 +368,34 @@ pub(super) fn take_over(
         }
         start = hi;
     }
+    // Its motion_end is where its own corner ends, or later — but rounded down to the
+    // nanosecond, a few nanometres before it: from the first nanosecond past it, where the
+    // robot is on its own path again (within a microsecond; else it is in its corner).
+    if let Some(c) = corner1 {
+        let left = first.time_at_fraction(c.end()) - (start - f.motion.start) as f64 / NS;
+        if left > 1e-6 {
+            return None;
+        }
+        if left > 0.0 {
+            let past = |at: i64| first.fraction_at((at - f.motion.start) as f64 / NS) >= c.end();
+            let (mut lo, mut hi) = (start, start + 1_000);
+            if !past(hi) {
+                return None;
+            }
+            while hi - lo > 1 {
+                let mid = lo + (hi - lo) / 2;
+                if past(mid) {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            start = hi.max(start);
+        }
+    }
     let dt = (start - f.motion.start) as f64 / NS;
     let s_now = first.fraction_at(dt);
-    // (Its motion_end is where its curve ends, or later: the same knot within rounding.)
-    if corner1.as_ref().is_some_and(|c| s_now < c.end() - 1e-9) {
+    if corner1.as_ref().is_some_and(|c| s_now < c.end()) {
         return None;
     }
     let f_now = first.own_fraction_at(dt);
@@ -444,16 +482,31 @@ pub(super) fn take_over(
         key[k] = x.to_bits();
     }
     key[CORNER_KEY - 1] = branch.map_or(u64::MAX, u64::from);
-    let Ok(taken) = memo.get_or_try(key, || {
-        Ok::<_, Infallible>(time_corner(
-            model,
-            tool,
-            (corner, r, [*vs1, *as1]),
-            (q_now, own_speed),
-            (next, next_zone),
-        ))
+    let mut time = |corner: TimedCorner, key| {
+        let timed = memo.get_or_try(key, || {
+            Ok::<_, Infallible>(time_corner(
+                model,
+                tool,
+                (corner, r, [*vs1, *as1]),
+                (q_now, own_speed),
+                (next, next_zone),
+            ))
+        });
+        timed.ok().flatten()
+    };
+    // A turn over the orientation zone that no timing keeps from the robot's speed: the
+    // tool turns within the curve, as without one (never a corner lost to it).
+    let plain = rho.is_some().then(|| TimedCorner {
+        turn: None,
+        ..corner.clone()
     });
-    Some((start, taken?))
+    if let Some(taken) = time(corner, key) {
+        return Some((start, taken));
+    }
+    let plain = plain?;
+    // (Keyed as a corner without an orientation zone.)
+    key[2 * MAX_AXES + 8] = f64::NAN.to_bits();
+    time(plain, key).map(|taken| (start, taken))
 }
 
 /// Corners timed already ([`Memo`]), by the bits of what they depend on: the robot's
@@ -507,6 +560,11 @@ fn time_corner(
     let mut derivatives = knot_derivatives(&joints);
     let mut inner = Inner::new();
     let limits = axis_limits(model);
+    // How far each motion turns the tool (rad).
+    let (turn1, turn2) = (
+        turn_angle(&corner.first_from, &corner.first_to),
+        turn_angle(from2, to2),
+    );
     // The TCP's speed and acceleration along each motion (m/s, m/s²) and each motion's
     // own fraction speed (which holds its orientation speed too).
     let (v1, v2) = (vs1 * l1, vs2 * l2);
@@ -534,11 +592,18 @@ fn time_corner(
             let mut x_max = f64::INFINITY;
             // (In the turn the orientation follows progressions of its own: each within
             // its motion's path speed too.)
-            let [_, od1, _, od2] = corner.turning(*s).unwrap_or_default();
+            let [_, od1, _, od2] = corner.turning(*s).unwrap_or([0.0, p.d1, 0.0, p.d2]);
             for (rate, vs) in [(p.d1, vs1), (p.d2, *vs2), (od1, vs1), (od2, *vs2)] {
                 if rate > 0.0 {
                     x_max = x_max.min((vs / rate).powi(2));
                 }
+            }
+            // Where both motions turn the tool, their rotations compose: the orientation's
+            // speed is at most the sum of their rates, held within the faster of the two
+            // motions' own orientation speeds (each at most its `orient`).
+            let turning = turn1 * od1 + turn2 * od2;
+            if turn1 > 0.0 && turn2 > 0.0 && turning > 0.0 {
+                x_max = x_max.min(((turn1 * vs1).max(turn2 * *vs2) / turning).powi(2));
             }
             let len = norm(d);
             if len > 1e-12 {
@@ -658,4 +723,41 @@ pub(super) fn turn_radius(f: &Fading, next: &Trajectory, f_now: f64) -> Option<f
         }
     }
     Some(radius)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{CURVE_STEPS, piece_knots};
+    use vworks_model::timing::SEGMENTS;
+
+    /// Every piece of some length keeps at least its least steps (the curve
+    /// [`CURVE_STEPS`], the others two) and the steps sum to the path's: a long turn on a
+    /// short path, whose curve is a sliver, once left its last piece no step at all (its
+    /// first knot off the robot).
+    #[test]
+    fn every_piece_keeps_its_least_steps() {
+        for joins in [
+            [0.252, 0.499, 0.501, 0.748],
+            [0.0, 0.4999, 0.5001, 1.0],
+            [0.01, 0.02, 0.03, 0.99],
+            [0.3, 0.3, 0.6, 0.6],
+            [0.45, 0.499, 0.501, 0.999],
+        ] {
+            let (knots, breaks) = piece_knots(joins);
+            let ends = [0.0, joins[0], joins[1], joins[2], joins[3], 1.0];
+            let mut at = 0;
+            for (j, b) in breaks.iter().chain([&SEGMENTS]).enumerate() {
+                let steps = b - at;
+                if ends[j + 1] > ends[j] {
+                    let least = if j == 2 { CURVE_STEPS } else { 2 };
+                    assert!(steps >= least, "{joins:?}: piece {j} has {steps} steps");
+                    assert_eq!(knots[at], ends[j], "{joins:?}: piece {j}");
+                } else {
+                    assert_eq!(steps, 0, "{joins:?}: piece {j}");
+                }
+                at = *b;
+            }
+            assert_eq!(knots[SEGMENTS], 1.0);
+        }
+    }
 }

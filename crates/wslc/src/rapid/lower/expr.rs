@@ -720,6 +720,9 @@ impl Tr<'_> {
             Some(Sym::Routine(sig)) if sig.kind == r::RoutineKind::Func => {
                 let wargs = self.call_args(f, &sig.params, args, span)?;
                 let ret = sig.ret.unwrap_or(Ty::Num);
+                // (A FUNC of a type held in more than one WSL value, a speeddata or a
+                // zonedata, is E0300 where it is declared: no value here.)
+                ret.leaf_type()?;
                 Some(Val::one(ret, b::call(&sig.wsl, wargs, span)))
             }
             Some(Sym::Routine(_)) => {
