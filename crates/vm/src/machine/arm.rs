@@ -275,13 +275,15 @@ impl Arm {
             // Else the next takes the robot over now, through a corner timed with the rest of
             // the first as one path, where it can.
             let corners = &mut self.corners;
-            // (Never slower than stopping at the point and starting again: two timings on
-            // their own steps may differ by a little the other way — 117 ns found on a
-            // 1 mm zone; then as if it did not apply.)
-            if let Some((start, taken)) =
-                corner::take_over(model, &tool, time, (f, &traj, programmed), corners)
-                && start + taken.point_ns <= f.end() + point_ns
-            {
+            // (Never slower than stopping at the point and starting again.)
+            let stop_end = f.end() + point_ns;
+            if let Some((start, taken)) = corner::take_over(
+                model,
+                &tool,
+                (time, stop_end),
+                (f, &traj, programmed),
+                corners,
+            ) {
                 traj = taken.traj;
                 point_ns = taken.point_ns;
                 look_ahead = taken.look_ahead;

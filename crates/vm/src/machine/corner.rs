@@ -296,13 +296,14 @@ pub(super) struct Taken {
 /// limits (module docs); `next_zone` its own zone. `None` where this corner does not
 /// apply (a motion with a `duration`, jerk limits, corner ramps, a path of no length, the
 /// robot already inside the zone or still in a corner of its own) or has no timing that
-/// starts at the robot's speed: the caller superposes them instead. With the corner, the
-/// instant it takes over: `time`, or the few nanoseconds later at which the robot reaches
-/// its zone if it is within a micrometre of it.
+/// starts at the robot's speed and ends by `stop_end` (where stopping at the point would):
+/// the caller superposes them instead. With the corner, the instant it takes over:
+/// `time`, or the few nanoseconds later at which the robot reaches its zone if it is
+/// within a micrometre of it (or leaves its own corner).
 pub(super) fn take_over(
     model: &RobotModel,
     tool: &Iso,
-    time: i64,
+    (time, stop_end): (i64, i64),
     (f, next, next_zone): (&Fading, &Trajectory, Option<f64>),
     memo: &mut CornerMemo,
 ) -> Option<(i64, Taken)> {
@@ -315,7 +316,7 @@ pub(super) fn take_over(
         ramps: None,
         timed: false,
         corner: corner1,
-        path_limits: [vs1, as1],
+        path_limits: [vs1, as1, ws1],
         ..
     } = first
     else {
@@ -331,7 +332,7 @@ pub(super) fn take_over(
         corner: None,
         end_joints,
         branch,
-        path_limits: [vs2, as2],
+        path_limits: [vs2, as2, ws2],
         ..
     } = next
     else {
@@ -461,7 +462,7 @@ pub(super) fn take_over(
         .iter()
         .chain(end_joints)
         .chain([&f_now, &own_speed, &r, &zone_key, vs1, as1, vs2, as2])
-        .chain([&rho.unwrap_or(f64::NAN)])
+        .chain([&rho.unwrap_or(f64::NAN), ws1, ws2])
         .chain(from1.r.iter().flatten().chain(&from1.t))
         .chain(to1.r.iter().flatten().chain(&to1.t))
         .chain(from2.r.iter().flatten().chain(&from2.t))
@@ -487,15 +488,22 @@ pub(super) fn take_over(
             Ok::<_, Infallible>(time_corner(
                 model,
                 tool,
-                (corner, r, [*vs1, *as1]),
+                (corner, r, [*vs1, *as1, *ws1]),
                 (q_now, own_speed),
                 (next, next_zone),
             ))
         });
-        timed.ok().flatten()
+        // (Never slower than stopping at the point and starting again, at `stop_end`: two
+        // timings on their own steps may differ by a little the other way — 117 ns found
+        // on a 1 mm zone; then as if it did not apply.)
+        timed
+            .ok()
+            .flatten()
+            .filter(|t| start + t.point_ns <= stop_end)
     };
-    // A turn over the orientation zone that no timing keeps from the robot's speed: the
-    // tool turns within the curve, as without one (never a corner lost to it).
+    // A turn over the orientation zone that no timing keeps from the robot's speed (or
+    // slower than stopping): the tool turns within the curve, as without one (never a
+    // corner lost to it).
     let plain = rho.is_some().then(|| TimedCorner {
         turn: None,
         ..corner.clone()
@@ -518,16 +526,16 @@ pub(super) type CornerMemo = Memo<CORNER_KEY, Option<Taken>>;
 
 /// Corners a VM remembers.
 pub(super) const CORNER_MEMO: usize = 16;
-/// A corner's key: joints now and at the end, 9 numbers, 5 poses, 2 midpoints, the next
+/// A corner's key: joints now and at the end, 11 numbers, 5 poses, 2 midpoints, the next
 /// motion's profile, the branch.
-pub(super) const CORNER_KEY: usize = 2 * MAX_AXES + 9 + 5 * 12 + 6 + 7 + 1;
+pub(super) const CORNER_KEY: usize = 2 * MAX_AXES + 11 + 5 * 12 + 6 + 7 + 1;
 
 /// The corner `corner` from the robot's joints and own-path speed `now` on the first
 /// path into `next`, timed (`take_over`'s work once the corner is known).
 fn time_corner(
     model: &RobotModel,
     tool: &Iso,
-    (corner, r, [vs1, as1]): (TimedCorner, f64, [f64; 2]),
+    (corner, r, [vs1, as1, ws1]): (TimedCorner, f64, [f64; 3]),
     (q_now, own_speed): ([f64; MAX_AXES], f64),
     (next, next_zone): (&Trajectory, Option<f64>),
 ) -> Option<Taken> {
@@ -538,7 +546,7 @@ fn time_corner(
         profile: prof2,
         end_joints,
         branch,
-        path_limits: [vs2, as2],
+        path_limits: [vs2, as2, ws2],
         ..
     } = next
     else {
@@ -591,19 +599,19 @@ fn time_corner(
             };
             let mut x_max = f64::INFINITY;
             // (In the turn the orientation follows progressions of its own: each within
-            // its motion's path speed too.)
+            // its motion's orientation speed, not its TCP's.)
             let [_, od1, _, od2] = corner.turning(*s).unwrap_or([0.0, p.d1, 0.0, p.d2]);
-            for (rate, vs) in [(p.d1, vs1), (p.d2, *vs2), (od1, vs1), (od2, *vs2)] {
+            for (rate, vs) in [(p.d1, vs1), (p.d2, *vs2), (od1, ws1), (od2, *ws2)] {
                 if rate > 0.0 {
                     x_max = x_max.min((vs / rate).powi(2));
                 }
             }
             // Where both motions turn the tool, their rotations compose: the orientation's
             // speed is at most the sum of their rates, held within the faster of the two
-            // motions' own orientation speeds (each at most its `orient`).
+            // motions' orientation speeds (each its `orient`).
             let turning = turn1 * od1 + turn2 * od2;
             if turn1 > 0.0 && turn2 > 0.0 && turning > 0.0 {
-                x_max = x_max.min(((turn1 * vs1).max(turn2 * *vs2) / turning).powi(2));
+                x_max = x_max.min(((turn1 * ws1).max(turn2 * *ws2) / turning).powi(2));
             }
             let len = norm(d);
             if len > 1e-12 {
@@ -679,7 +687,7 @@ fn time_corner(
             seeds: seeds_of(&joints),
             tool: *tool,
             corner: Some(corner.clone()),
-            path_limits: [*vs2, *as2],
+            path_limits: [*vs2, *as2, *ws2],
         },
         point_ns,
         look_ahead,

@@ -574,7 +574,7 @@ fn plan_cartesian(
             seeds: [start_joints; SEEDS],
             tool,
             corner: None,
-            path_limits: [vs, as_],
+            path_limits: [vs, as_, f64::INFINITY],
         };
         return Ok(Plan {
             traj,
@@ -660,7 +660,15 @@ fn plan_cartesian(
     }
     Ok(cartesian_plan(
         (path, start, goal, tool, branch),
-        [vs, as_],
+        [
+            vs,
+            as_,
+            if angle > 1e-7 {
+                w / angle
+            } else {
+                f64::INFINITY
+            },
+        ],
         sampled,
         profile,
         duration_ns.is_some(),
@@ -672,7 +680,7 @@ fn plan_cartesian(
 /// `timed`: it was given a duration, so a slower speed than the fastest is no slowdown).
 fn cartesian_plan(
     (path, start, goal, tool, branch): (Path, Iso, Iso, Iso, Option<u8>),
-    path_limits: [f64; 2],
+    path_limits: [f64; 3],
     sampled: PathSamples,
     profile: Profile,
     timed: bool,

@@ -64,8 +64,10 @@ pub(super) enum Trajectory {
         /// of that motion's path, the corner and this one's.
         corner: Option<TimedCorner>,
         /// The largest speed and acceleration of its own path's fraction (1/s, 1/s²:
-        /// the TCP's, or the orientation's speed, over the path).
-        path_limits: [f64; 2],
+        /// the TCP's, or the orientation's speed, over the path), and the largest speed
+        /// of its orientation's fraction (1/s: its orientation speed over the angle it
+        /// turns the tool by; infinite if it does not).
+        path_limits: [f64; 3],
     },
 }
 
