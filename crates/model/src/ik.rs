@@ -503,7 +503,7 @@ impl RobotModel {
     }
 
     /// Damped least squares from `seed`, then from deterministic restarts across the
-    /// joint ranges. Converges to 1e-10 m and rad, then takes up to [`POLISH`] more steps
+    /// joint ranges. Converges to 1e-10 m and rad, then takes up to two more steps
     /// towards the pose's rounding.
     pub fn ik_numeric(&self, target: &Iso, seed: &[f64], q: &mut [f64]) -> Result<(), IkError> {
         let n = self.dof();
