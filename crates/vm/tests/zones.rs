@@ -146,6 +146,17 @@ fn run(v: &mut Vm, vel_tol: f64) -> Run {
     }
 }
 
+/// Each motion_start of a run: its time and the radius it blends out of a zone within.
+fn motion_starts(r: &Run) -> Vec<(i64, Option<f64>)> {
+    r.events
+        .iter()
+        .filter_map(|e| match e.kind {
+            EventKind::MotionStart { blend_m, .. } => Some((e.time, blend_m)),
+            _ => None,
+        })
+        .collect()
+}
+
 fn zone_text(z: u32) -> String {
     if z == 0 {
         "zone fine".into()
@@ -468,14 +479,7 @@ fn a_motion_with_another_tool_after_a_zoned_point_starts_there_with_its_own_tcp(
     let src = "proc main() {\n    move_j pose(400mm, 0mm, 300mm, 180deg, 0deg, 0deg);\n    move_l pose(400mm, 100mm, 300mm, 180deg, 0deg, 0deg) speed 200mm/s zone 10mm;\n    move_l pose(450mm, 100mm, 300mm, 180deg, 0deg, 0deg) speed 200mm/s tool pose(0mm, 0mm, 100mm, 0deg, 0deg, 0deg);\n}\n";
     let mut v = vm(src, None);
     let r = run(&mut v, 50.0);
-    let starts: Vec<(i64, Option<f64>)> = r
-        .events
-        .iter()
-        .filter_map(|e| match e.kind {
-            EventKind::MotionStart { blend_m, .. } => Some((e.time, blend_m)),
-            _ => None,
-        })
-        .collect();
+    let starts = motion_starts(&r);
     assert_eq!(starts[2].1, None, "{:?}", r.events);
     let at = |t: i64| r.samples.iter().find(|s| s.0 >= t).unwrap().2;
     // The new TCP at the start: the point, 100 mm down the flange's z (pointing down); the
@@ -625,14 +629,7 @@ fn a_corner_timed_as_one_path_takes_over_and_keeps_every_limit() {
         .filter(|e| matches!(e.kind, EventKind::MotionEnd { .. }))
         .map(|e| e.time)
         .collect();
-    let starts: Vec<(i64, Option<f64>)> = r
-        .events
-        .iter()
-        .filter_map(|e| match e.kind {
-            EventKind::MotionStart { blend_m, .. } => Some((e.time, blend_m)),
-            _ => None,
-        })
-        .collect();
+    let starts = motion_starts(&r);
     assert_eq!(starts[2].0, ends[1], "{:?}", r.events);
     assert!(
         starts[2].1.is_some_and(|b| (b - 0.0125).abs() < 1e-12),
