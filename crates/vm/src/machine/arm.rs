@@ -277,10 +277,12 @@ impl Arm {
             let corners = &mut self.corners;
             // (Never slower than stopping at the point and starting again.)
             let stop_end = f.end() + point_ns;
+            // (Where two lines fly with ramps, a timed corner only to turn the tool over its
+            // orientation zone: else the ramps, as without one.)
             if let Some((start, taken)) = corner::take_over(
                 model,
                 &tool,
-                (time, stop_end),
+                (time, stop_end, flies.is_none()),
                 (f, &traj, programmed),
                 corners,
             ) {

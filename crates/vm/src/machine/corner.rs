@@ -277,6 +277,10 @@ fn run_out(u: f64) -> (f64, f64, f64) {
 const CURVE_STEPS: usize = 64;
 const _: () = assert!(CURVE_STEPS + 8 <= SEGMENTS);
 
+/// How much wider (relative) than a corner's curve its orientation zone must be for the
+/// tool to turn over it: below, it turns within the curve.
+pub(super) const TURN_WIDER: f64 = 1e-3;
+
 /// How much faster (in `ṡ²`) the robot may be than the fastest start a corner's timing
 /// finds, for that start to be taken: half the timing's margin below the limits.
 const START_TOLERANCE: f64 = 4e-4;
@@ -297,13 +301,15 @@ pub(super) struct Taken {
 /// apply (a motion with a `duration`, jerk limits, corner ramps, a path of no length, the
 /// robot already inside the zone or still in a corner of its own) or has no timing that
 /// starts at the robot's speed and ends by `stop_end` (where stopping at the point would):
-/// the caller superposes them instead. With the corner, the instant it takes over:
+/// the caller superposes them instead. With `plain` false, only a corner that turns the
+/// tool over its orientation zone (where the caller has corner ramps to fall back on, as
+/// without an orientation zone). With the corner, the instant it takes over:
 /// `time`, or the few nanoseconds later at which the robot reaches its zone if it is
 /// within a micrometre of it (or leaves its own corner).
 pub(super) fn take_over(
     model: &RobotModel,
     tool: &Iso,
-    (time, stop_end): (i64, i64),
+    (time, stop_end, plain): (i64, i64, bool),
     (f, next, next_zone): (&Fading, &Trajectory, Option<f64>),
     memo: &mut CornerMemo,
 ) -> Option<(i64, Taken)> {
@@ -373,13 +379,13 @@ pub(super) fn take_over(
     // nanosecond, a few nanometres before it: from the first nanosecond past it, where the
     // robot is on its own path again (within a microsecond; else it is in its corner).
     if let Some(c) = corner1 {
-        let left = first.time_at_fraction(c.end()) - (start - f.motion.start) as f64 / NS;
-        if left > 1e-6 {
-            return None;
-        }
-        if left > 0.0 {
-            let past = |at: i64| first.fraction_at((at - f.motion.start) as f64 / NS) >= c.end();
-            let (mut lo, mut hi) = (start, start + 1_000);
+        let past = |at: i64| first.fraction_at((at - f.motion.start) as f64 / NS) >= c.end();
+        if !past(start) {
+            let left = first.time_at_fraction(c.end()) - (start - f.motion.start) as f64 / NS;
+            if left > 1e-6 {
+                return None;
+            }
+            let (mut lo, mut hi) = (start, start + (left.max(0.0) * NS).ceil() as i64 + 2);
             if !past(hi) {
                 return None;
             }
@@ -391,7 +397,7 @@ pub(super) fn take_over(
                     lo = mid;
                 }
             }
-            start = hi.max(start);
+            start = hi;
         }
     }
     let dt = (start - f.motion.start) as f64 / NS;
@@ -432,7 +438,12 @@ pub(super) fn take_over(
     // The orientation zone: the TCP covers 2r/σ of either path per unit of s on the
     // straight pieces, so a turn of radius ρ is ρσ/r wide in s, centred on the curve,
     // and its progressions meet the straight pieces' with the same rates.
-    let rho = turn_radius(f, next, f_now).filter(|rho| *rho > r * (1.0 + 1e-9));
+    // (Only a turn wider than the curve by more than TURN_WIDER: a sliver of a turn on
+    // either side would get steps of its own, its differences rounding noise.)
+    let rho = turn_radius(f, next, f_now).filter(|rho| *rho > r * (1.0 + TURN_WIDER));
+    if rho.is_none() && !plain {
+        return None;
+    }
     if let Some(rho) = rho {
         let (mid, half) = (s_in + 0.5 * sigma, 0.5 * rho * sigma / r);
         // (Within a nanometre of where the robot is or of the path's end, there: a piece
@@ -504,14 +515,14 @@ pub(super) fn take_over(
     // A turn over the orientation zone that no timing keeps from the robot's speed (or
     // slower than stopping): the tool turns within the curve, as without one (never a
     // corner lost to it).
-    let plain = rho.is_some().then(|| TimedCorner {
+    let plain_corner = rho.is_some().then(|| TimedCorner {
         turn: None,
         ..corner.clone()
     });
     if let Some(taken) = time(corner, key) {
         return Some((start, taken));
     }
-    let plain = plain?;
+    let plain = plain_corner.filter(|_| plain)?;
     // (Keyed as a corner without an orientation zone.)
     key[2 * MAX_AXES + 8] = f64::NAN.to_bits();
     time(plain, key).map(|taken| (start, taken))
