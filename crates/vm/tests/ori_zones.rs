@@ -115,6 +115,13 @@ fn motion_ends(r: &Run) -> Vec<i64> {
         .collect()
 }
 
+/// How far from `b` the TCP is at the first line's motion_end (its first sample after it:
+/// less than 0.1 ms, 50 µm at 500 mm/s).
+fn from_b_at_motion_end(r: &Run) -> f64 {
+    let end = motion_ends(r)[1];
+    norm(sub(r.samples.iter().find(|s| s.0 >= end).unwrap().1.t, B))
+}
+
 /// The sampled TCP at `t` (a multiple of `STEP`).
 fn at(r: &Run, t: i64) -> &(i64, Iso, [f64; 12]) {
     let k = (t / STEP) as usize;
@@ -167,8 +174,7 @@ fn the_tool_turns_over_the_orientation_zone_and_leaves_it_as_from_a_stop_point()
     let ends = motion_ends(&r);
     // The motion_end where the TCP enters the orientation zone: 30 mm before b.
     let end = ends[1];
-    let tcp_at_end = r.samples.iter().find(|s| s.0 >= end).unwrap();
-    let d = norm(sub(tcp_at_end.1.t, B));
+    let d = from_b_at_motion_end(&r);
     // (At 500 mm/s, the first sample is less than 0.1 ms, 50 µm, after it.)
     assert!(d <= 0.030 && d > 0.030 - 5.1e-5, "{d}");
     // Largest angle 30°·(1 − 30/200) = 25.5° (sampled every 0.1 ms at 500 mm/s: u within
@@ -213,8 +219,7 @@ fn without_an_orientation_zone_the_tool_turns_within_the_tcp_zone() {
     assert!((top - 28.5).abs() < 1e-3, "{top}");
     // The motion_end no later than where the TCP enters the zone (here a look-ahead point
     // before it, where braking for the sharpest corner would have to begin).
-    let end = motion_ends(&r)[1];
-    let d = norm(sub(r.samples.iter().find(|s| s.0 >= end).unwrap().1.t, B));
+    let d = from_b_at_motion_end(&r);
     assert!(d >= 0.010 - 5.1e-5, "{d}");
 }
 
@@ -225,8 +230,7 @@ fn zone_ori_narrows_the_orientation_zone_to_the_angle_it_allows() {
     within_limits(&r);
     let top = largest_angle(&r);
     assert!((top - 27.0).abs() < 1e-4, "{top}");
-    let end = motion_ends(&r)[1];
-    let d = norm(sub(r.samples.iter().find(|s| s.0 >= end).unwrap().1.t, B));
+    let d = from_b_at_motion_end(&r);
     assert!(d <= 0.020 && d > 0.020 - 5.1e-5, "{d}");
     // 10° allows 33 mm: the 30 mm zone, as without an angle.
     let wide = run(&program("zone 10mm ori 30mm 10deg"));

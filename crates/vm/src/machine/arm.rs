@@ -253,7 +253,7 @@ impl Arm {
             // (A tool turning over an orientation zone wider than the curve: the corner
             // timed as one path turns it so; corner ramps would turn it within the curve.)
             let turns = corner::turn_radius(f, &traj, 0.0)
-                .is_some_and(|rho| rho > f.motion.zone * (1.0 + 1e-9));
+                .is_some_and(|rho| rho > f.motion.zone * (1.0 + corner::TURN_WIDER));
             let ramps = blend::corner_ramps(model, time, f, &traj);
             let stops = matches!(ramps, Some(blend::RampCorner::Stops));
             let flies = match ramps {

@@ -364,16 +364,7 @@ pub(super) fn take_over(
         }
         // The first nanosecond there, by bisection within its motion (the robot only
         // moves on along its path).
-        let (mut lo, mut hi) = (start, f.end());
-        while hi - lo > 1 {
-            let mid = lo + (hi - lo) / 2;
-            if before(mid) > 0.0 {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        start = hi;
+        start = first_ns((start, f.end()), |at| before(at) <= 0.0);
     }
     // Its motion_end is where its own corner ends, or later — but rounded down to the
     // nanosecond, a few nanometres before it: from the first nanosecond past it, where the
@@ -385,19 +376,11 @@ pub(super) fn take_over(
             if left > 1e-6 {
                 return None;
             }
-            let (mut lo, mut hi) = (start, start + (left.max(0.0) * NS).ceil() as i64 + 2);
+            let hi = start + (left.max(0.0) * NS).ceil() as i64 + 2;
             if !past(hi) {
                 return None;
             }
-            while hi - lo > 1 {
-                let mid = lo + (hi - lo) / 2;
-                if past(mid) {
-                    hi = mid;
-                } else {
-                    lo = mid;
-                }
-            }
-            start = hi;
+            start = first_ns((start, hi), past);
         }
     }
     let dt = (start - f.motion.start) as f64 / NS;
@@ -526,6 +509,20 @@ pub(super) fn take_over(
     // (Keyed as a corner without an orientation zone.)
     key[2 * MAX_AXES + 8] = f64::NAN.to_bits();
     time(plain, key).map(|taken| (start, taken))
+}
+
+/// The first nanosecond in `(lo, hi]` at which `reached` holds, by bisection: it holds at
+/// `hi` and, once it does, ever after (the robot only moves on along its path).
+fn first_ns((mut lo, mut hi): (i64, i64), reached: impl Fn(i64) -> bool) -> i64 {
+    while hi - lo > 1 {
+        let mid = lo + (hi - lo) / 2;
+        if reached(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    hi
 }
 
 /// Corners timed already ([`Memo`]), by the bits of what they depend on: the robot's
