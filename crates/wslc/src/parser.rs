@@ -79,6 +79,25 @@ impl Parser<'_, '_, Token> {
         self.report(d)
     }
 
+    /// `zone Z ori D A` with an operator after D: D is one term.
+    fn ori_term(&mut self, distance: Span) -> Reported {
+        let t = self.tok().clone();
+        let d = Diagnostic::error(
+            Code::E0005,
+            format!(
+                "expected the orientation zone's angle or the next option, found `{}`",
+                self.text(t.span)
+            ),
+            t.span,
+        )
+        .with_help(format!(
+            "the distance after `ori` is one term: put it in parentheses, `ori ({} {} …)`",
+            self.text(distance),
+            self.text(t.span)
+        ));
+        self.report(d)
+    }
+
     fn unexpected(&mut self, expected: &str) -> Reported {
         let t = self.tok().clone();
         let found = describe(&t.kind, self.text(t.span));
@@ -605,7 +624,18 @@ impl Parser<'_, '_, Token> {
                     let radius = self.expr()?;
                     if self.at_ident("ori") {
                         self.bump();
-                        let ori = self.expr()?;
+                        // One term (a literal, a name, a call, or parentheses), so that
+                        // `ori 15mm -2deg` is a distance and an angle, not a difference.
+                        self.enter()?;
+                        let ori = self.unary_expr();
+                        self.leave();
+                        let ori = ori?;
+                        let operator = [Punct::Plus, Punct::Star, Punct::Slash]
+                            .iter()
+                            .any(|p| self.at_p(*p));
+                        if operator || self.at_kw(Kw::Mod) {
+                            return Err(self.ori_term(ori.span));
+                        }
                         // (An angle follows unless the statement or its next option does.)
                         let option = matches!(self.kind(), TokKind::Ident)
                             && MOVE_OPTIONS.iter().any(|o| self.at_ident(o));
