@@ -16,10 +16,17 @@ places and prints them all:
   place are always `fine` (the gripper works there).
 
 A cycle is the mean of 10 back-and-forth rounds after a first `move_j` to `a`, from the
-programs' own `now()`. `--accel-time T` runs a copy of the model whose axes reach full speed
+programs' own `now()`.
+
+`--oracle` also times the fly-by `move_l` half-cycle (rest at `a`, up, across, down to rest
+at `b`: two corners timed as one path) against toppra on the same joint path, recorded
+from vworks at 1 ms, within the same axis and TCP limits, the TCP's whole acceleration
+(along the path and towards a corner's centre) within the model's (bench/fidelity.py's
+oracle, the path's plane being the y-z plane): how far the `move_l` cycle is from the
+fastest timing of its own path. `--accel-time T` runs a copy of the model whose axes reach full speed
 in T seconds (the way the IRB 120's estimate was fitted: docs/models.md).
 
-    .venv/bin/python bench/cycle.py [--models irb120 kr6r900] [--accel-time 0.07]
+    .venv/bin/python bench/cycle.py [--models irb120 kr6r900] [--accel-time 0.07] [--oracle]
 
 The places suit the IRB 120; another arm may not reach them or pass a singularity on the
 way, which the table says instead of a time.
@@ -102,12 +109,50 @@ def cycle(vworks, folder, model, motion, zone, x, z, accel_time=None):
     return float(result.logs[-1].text.split()[0].rstrip("s"))
 
 
+def toppra_half(vworks, folder, model, x, z):
+    """The fly-by `move_l` half-cycle a → b: (vworks's time, toppra's time on the same path) in s."""
+    import warnings
+
+    sys.path.insert(0, str(ROOT / "bench"))
+    import fidelity
+    import numpy as np
+
+    folder.joinpath("cell.toml").write_text(
+        f'name = "half"\n[[robot]]\nname = "r1"\nmodel = "{model}"\nprogram = "r1.wsl"\n'
+        f'default_speed = "{tcp_speed(model) * 1000.0:g}mm/s"\n'
+        'home = ["0deg", "0deg", "0deg", "0deg", "90deg", "0deg"]\n')
+    folder.joinpath("r1.wsl").write_text(f"""
+const a = pose({x}mm, -150mm, {z}mm, 180deg, 0deg, 0deg);
+const b = pose({x}mm, 150mm, {z}mm, 180deg, 0deg, 0deg);
+proc main() {{
+    move_j a;
+    move_l offset(a, 0mm, 0mm, 25mm) zone 25mm;
+    move_l offset(b, 0mm, 0mm, 25mm) zone 25mm;
+    move_l b zone fine;
+}}
+""")
+    cell = vworks.load_cell(str(folder / "cell.toml"))
+    events = [e for e in cell.run().events if e.kind in ("motion_start", "motion_end")]
+    t0, t1 = events[2].time_ns, events[-1].time_ns  # the first move_l's start, the last's end
+    _, q, p = fidelity.record(cell, t0, t1)
+    s, qk, pk = fidelity.path_samples(q, p)
+    limits = fidelity.urdf_limits(model)
+    speed, accel = fidelity.urdf_tcp(model)
+    plane = (pk, np.array([0.0, 1.0, 0.0]), np.array([0.0, 0.0, 1.0]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        best = fidelity.toppra_time(s, qk, limits[:, 2], limits[:, 3], speed, accel, plane)
+    return (t1 - t0) * 1e-9, best
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--models", nargs="+", default=list(PUBLISHED),
                         choices=["irb120", "kr6r900", "lrmate200id", "ur5"],
                         help="default: the models with a published cycle")
     parser.add_argument("--accel-time", type=float, help="axes reach full speed in this time (s)")
+    parser.add_argument("--oracle", action="store_true",
+                        help="also time the fly-by move_l half-cycle against toppra on its own path")
     args = parser.parse_args()
     import vworks
 
@@ -133,6 +178,18 @@ def main():
                             cells.append(t)
                 pub = f"{published[0]:.2f} ({published[1]})" if published else "none published"
                 print(f"| {model} | ({x:g}, {z:g}) | " + " | ".join(cells) + f" | {pub} |")
+    if args.oracle and not args.accel_time:
+        print()
+        print("fly-by move_l half-cycle (rest at a to rest at b) against toppra on the same path:")
+        print()
+        print("| model | (x, z) mm | vworks | toppra | ratio |")
+        print("|---|---|---|---|---|")
+        with tempfile.TemporaryDirectory() as tmp:
+            for model in args.models:
+                for x, z in PLACES:
+                    ours, best = toppra_half(vworks, Path(tmp), model, x, z)
+                    ratio = f"{ours / best:.4f}" if best else "toppra found no profile"
+                    print(f"| {model} | ({x:g}, {z:g}) | {ours:.4f} s | {best or 0:.4f} s | {ratio} |")
 
 
 if __name__ == "__main__":
