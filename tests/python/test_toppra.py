@@ -88,3 +88,24 @@ def test_a_line_that_ends_near_a_singularity_is_timed_on_finer_steps_there():
     assert "skipped" not in row and "jump" not in row, row
     assert 0.999 <= row["ratio"] <= 1.01, row
     assert row["peak_joint_accel_ratio"] <= 1.001, row
+
+
+@pytest.mark.oracle
+@pytest.mark.parametrize("place", [(400.0, 200.0), (450.0, 100.0)])
+def test_the_fly_by_picking_cycle_is_timed_as_fast_as_its_path_allows(place):
+    # The IRB 120's 25 x 300 x 25 mm cycle in straight lines with 25 mm zones, from rest at
+    # one end to rest at the other: two corners (12.5 mm: half the lifts) timed as one path
+    # with the lines. toppra, given the joint path vworks runs and the same limits (axes,
+    # TCP speed, the TCP's whole acceleration within 28 m/s² in the path's plane), may be at
+    # most 1 % faster, and never slower by more than its grid's 0.1 %.
+    pytest.importorskip("toppra")
+    import logging
+
+    import cycle
+    import vworks
+
+    logging.getLogger("toppra").setLevel(logging.ERROR)
+    with tempfile.TemporaryDirectory() as tmp:
+        ours, best = cycle.toppra_half(vworks, Path(tmp), "irb120", *place)
+    assert best is not None
+    assert 0.999 <= ours / best <= 1.01, (place, ours, best)
