@@ -157,7 +157,9 @@ pub(crate) const SPEEDS: &[(&str, f64, f64)] = &[
 
 /// Predefined `zonedata`: (name, pzone_tcp mm, pzone_ori mm, zone_ori degrees), as the
 /// RAPID reference lists them (`pzone_eax`, `zone_leax` and `zone_reax`, for external
-/// axes, are not simulated); `fine` stops at the point.
+/// axes, are not simulated); `fine` stops at the point. The same fifteen, value for value,
+/// are tabulated by RobotComponents (`RobotComponents/Actions/ZoneData.cs`), an open RAPID
+/// generator.
 pub(crate) const ZONES: &[(&str, f64, f64, f64)] = &[
     ("fine", 0.0, 0.0, 0.0),
     ("z0", 0.3, 0.3, 0.03),
