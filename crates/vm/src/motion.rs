@@ -298,6 +298,33 @@ impl Profile {
         }
     }
 
+    /// Jerk at time `t` (s): ±j in the jerk phases, 0 elsewhere (and 0 for a trapezoid,
+    /// whose acceleration steps instead); at a phase boundary, the value of the phase
+    /// that starts there.
+    pub fn jerk_at(&self, t: f64) -> f64 {
+        if t < 0.0 || t >= self.t_total || self.t_jerk == 0.0 || !self.j.is_finite() {
+            return 0.0;
+        }
+        let (ta, tt, tj) = (self.t_acc, self.t_total, self.t_jerk);
+        // The acceleration phase: up, hold, down; the braking mirrors it.
+        let ramp = |tau: f64| {
+            if tau < tj {
+                self.j
+            } else if tau >= ta - tj {
+                -self.j
+            } else {
+                0.0
+            }
+        };
+        if t < ta {
+            ramp(t)
+        } else if t < tt - ta {
+            0.0
+        } else {
+            -ramp(t - (tt - ta))
+        }
+    }
+
     /// The times where a phase begins or ends (acceleration or jerk changes): within
     /// each stretch between two of them the acceleration is linear in time.
     pub fn breakpoints(&self) -> [f64; 8] {
@@ -580,7 +607,7 @@ mod tests {
     }
 
     #[test]
-    fn acceleration_is_the_derivative_of_speed_and_time_at_inverts_at() {
+    fn acceleration_and_jerk_are_the_derivatives_of_speed_and_time_at_inverts_at() {
         for p in [
             Profile::with_jerk(1.0, 1.0, 2.0, 10.0),
             Profile::with_jerk(0.002, 1.0, 2.0, 10.0),
@@ -598,6 +625,14 @@ mod tests {
                 assert!(
                     (fd - p.accel_at(t)).abs() < 1e-5 * p.a.max(1.0),
                     "{p:?} at {t}"
+                );
+                // And the jerk its derivative (0 on a trapezoid's ramps).
+                let fd = (p.accel_at(t + dt) - p.accel_at(t - dt)) / (2.0 * dt);
+                let jerk = if p.j.is_finite() { p.j } else { 1.0 };
+                assert!(
+                    (fd - p.jerk_at(t)).abs() < 1e-6 * jerk,
+                    "{p:?} at {t}: {fd} against {}",
+                    p.jerk_at(t)
                 );
                 let d = p.at(t);
                 assert!((p.at(p.time_at(d)) - d).abs() < 1e-12);

@@ -708,8 +708,15 @@ fn corner_bounds(
                     break;
                 };
                 let j = model.axis(i);
-                let (speed, acc) = window_extremes(window, [(p1, off1, k1), (p2, 0.0, k2)]);
+                let parts = [(p1, off1, k1), (p2, 0.0, k2)];
+                let (speed, acc) = window_extremes(window, parts);
                 if speed > j.max_velocity * (1.0 + 1e-9) || acc > j.max_accel * (1.0 + 1e-9) {
+                    return None;
+                }
+                // (Two S-curves' jerk phases overlapping add up too.)
+                if j.max_jerk
+                    .is_some_and(|jerk| window_jerk(window, parts) > jerk * (1.0 + 1e-9))
+                {
                     return None;
                 }
             }
@@ -768,6 +775,9 @@ fn corner_samples(
     // (Where a profile changes phase the speed may turn at a kink, which the curves
     // through the samples round off.)
     if !both_joint && !phase_ends_within(model, f, next, ts) {
+        return None;
+    }
+    if !both_joint && !jerks_within(model, f, next, ts) {
         return None;
     }
     Some(farthest)
@@ -844,6 +854,80 @@ fn phase_ends_within(model: &RobotModel, f: &Fading, next: &Trajectory, ts: i64)
     ok
 }
 
+/// The longest step of the third differences [`jerks_within`] takes (ns): short enough to
+/// stay inside a phase of both motions, long enough that the joints' rounding stays far
+/// below a jerk limit.
+const JERK_STEP: i64 = 500_000;
+
+/// Every axis with a jerk limit within it through the corner starting at `ts` (a corner
+/// with a Cartesian motion: its joints come from the blended poses). Between two instants
+/// where either motion's profile changes phase, each motion's path jerk holds (S-curves)
+/// or is none (trapezoids), and the axes' jerks change only with their slopes and the
+/// speeds, so each such stretch is checked by third differences [`JERK_STEP`] apart
+/// inside it, end to end (each a mean of the jerk over three steps). Two
+/// S-curves' jerk phases overlapping — the next motion jerking up as the first jerks into
+/// its braking — add up, as their accelerations do.
+fn jerks_within(model: &RobotModel, f: &Fading, next: &Trajectory, ts: i64) -> bool {
+    let n = model.dof();
+    if (0..n).all(|i| model.axis(i).max_jerk.is_none()) {
+        return true;
+    }
+    let end = f.end();
+    // (Each motion has up to 8 phase ends per profile, a joint motion one profile per axis.)
+    let mut cuts = [0i64; 2 + 2 * 8 * MAX_AXES];
+    let mut count = 0;
+    let mut push = |t: i64| {
+        if t >= ts && t <= end && count < cuts.len() {
+            cuts[count] = t;
+            count += 1;
+        }
+    };
+    push(ts);
+    push(end);
+    let to_ns = |origin: i64, b: f64| origin + (b * NS).round() as i64;
+    f.motion.traj.phase_ends(|b| push(to_ns(f.motion.start, b)));
+    next.phase_ends(|b| push(to_ns(ts, b)));
+    let cuts = &mut cuts[..count];
+    cuts.sort_unstable();
+    for w in cuts.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        let h = ((b - a) / 4).min(JERK_STEP);
+        if h < 1_000 {
+            continue;
+        }
+        // Windows of three steps end to end from its start, the last one ending at its end.
+        let mut first = a;
+        loop {
+            let last = first + 3 * h >= b;
+            if last {
+                first = b - 3 * h;
+            }
+            let mut q = [[0.0; MAX_AXES]; 4];
+            for (k, q) in q.iter_mut().enumerate() {
+                match blend_joints(model, f, next, ts, first + k as i64 * h) {
+                    Some(joints) => *q = joints,
+                    None => return false,
+                }
+            }
+            let dt = h as f64 / NS;
+            let over = (0..n).any(|i| {
+                model.axis(i).max_jerk.is_some_and(|jerk| {
+                    let d3 = q[3][i] - 3.0 * q[2][i] + 3.0 * q[1][i] - q[0][i];
+                    d3.abs() / (dt * dt * dt) > jerk * (1.0 + JOINT_SPEED_TOLERANCE)
+                })
+            });
+            if over {
+                return false;
+            }
+            if last {
+                break;
+            }
+            first += 3 * h;
+        }
+    }
+    true
+}
+
 /// Every axis within its speed and acceleration at the last of four samples `dt` apart
 /// (`q[3]` is sample `k`):
 ///
@@ -896,13 +980,15 @@ pub(super) fn stop_point_reason(ins: Option<Instr>, remote: bool) -> Option<&'st
     })
 }
 
-/// The largest |summed speed| and |summed acceleration| over `[0, window]` of motions
-/// `k·p(t + offset)`: exact for these piecewise-polynomial profiles (acceleration linear
-/// between phase boundaries), as every boundary (and a point just before it) is
-/// evaluated, and the speed also where the summed acceleration crosses zero.
-fn window_extremes(window: f64, parts: [(&Profile, f64, f64); 2]) -> (f64, f64) {
+/// Instants to evaluate two motions `k·p(t + offset)` at over `[0, window]`, in order: an
+/// even grid, and every phase boundary of either inside the window with a point just
+/// before it (how many there are: the rest of the array is unused).
+fn window_instants(
+    window: f64,
+    parts: [(&Profile, f64, f64); 2],
+) -> ([f64; WINDOW_INSTANTS], usize) {
     const GRID: usize = 8;
-    let mut ts = [0.0f64; GRID + 1 + 2 * 2 * 8];
+    let mut ts = [0.0f64; WINDOW_INSTANTS];
     let mut n = 0;
     for k in 0..=GRID {
         ts[n] = window * k as f64 / GRID as f64;
@@ -918,8 +1004,37 @@ fn window_extremes(window: f64, parts: [(&Profile, f64, f64); 2]) -> (f64, f64) 
             }
         }
     }
-    let ts = &mut ts[..n];
-    ts.sort_unstable_by(f64::total_cmp);
+    ts[..n].sort_unstable_by(f64::total_cmp);
+    (ts, n)
+}
+
+/// The grid's 9 instants and two for each of the two profiles' 8 phase boundaries.
+const WINDOW_INSTANTS: usize = 9 + 2 * 2 * 8;
+
+/// The largest summed jerk of two profiles (each shifted by `off` and scaled by `k`) over
+/// `[0, window]`: both are piecewise constant, so it is taken halfway between each two of
+/// the instants of [`window_instants`], which hold every phase boundary.
+fn window_jerk(window: f64, parts: [(&Profile, f64, f64); 2]) -> f64 {
+    let (ts, n) = window_instants(window, parts);
+    let jerk = |t: f64| {
+        parts
+            .iter()
+            .map(|(p, off, k)| k * p.jerk_at(t + off))
+            .sum::<f64>()
+    };
+    ts[..n]
+        .windows(2)
+        .map(|w| jerk(0.5 * (w[0] + w[1])).abs())
+        .fold(0.0, f64::max)
+}
+
+/// The largest |summed speed| and |summed acceleration| over `[0, window]` of motions
+/// `k·p(t + offset)`: exact for these piecewise-polynomial profiles (acceleration linear
+/// between phase boundaries), as every boundary (and a point just before it) is
+/// evaluated, and the speed also where the summed acceleration crosses zero.
+fn window_extremes(window: f64, parts: [(&Profile, f64, f64); 2]) -> (f64, f64) {
+    let (ts, n) = window_instants(window, parts);
+    let ts = &ts[..n];
     let speed = |t: f64| {
         parts
             .iter()

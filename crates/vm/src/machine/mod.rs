@@ -19,6 +19,7 @@ mod corner;
 mod describe;
 mod handlers;
 mod interp;
+mod jerks;
 mod names;
 mod path;
 mod plan;

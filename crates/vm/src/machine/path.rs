@@ -9,6 +9,7 @@ use vworks_model::RobotModel;
 use vworks_model::math::Iso;
 use vworks_model::timing::{JointPath, KNOTS, KnotLimits, Limits, SEGMENTS, Timing, TimingError};
 
+use super::jerks::{KnotJerks, NEAR_JERK, axis_jerk_load, axis_jerks};
 use super::plan::{JOINT_SPEED_TOLERANCE, PlanError, ik_tcp};
 use super::quarters::{Inner, Kink};
 use crate::MAX_AXES;
@@ -129,10 +130,11 @@ pub(super) fn sample_path(
     let mut joints = JointPath::new(n);
     sample_knots(&mut joints, from, None, &joints_at)?;
     let (speed, accel) = axis_limits(model);
+    let jerk = axis_jerks(model);
     let end = joints.q[SEGMENTS];
     let mut derivatives = knot_derivatives(&joints);
     let mut inner = Inner::new();
-    let limits_of = (&speed[..n], &accel[..n]);
+    let limits_of = (&speed[..n], &accel[..n], &jerk[..n]);
     // Without an acceleration of its own (no `accel`, no TCP limit in the model) the path
     // accelerates as fast as its axes let it: never the programmed profile as it is.
     let bounded = profile.a.is_finite();
@@ -615,7 +617,10 @@ const MEASURED_OVER: f64 = 1e-8;
 
 /// How far to each side of a profile's breakpoint (a share of its time) its acceleration
 /// is taken on that side: a step of a trapezoid's acceleration is exactly at it.
-const PHASE_SIDE: f64 = 1e-12;
+pub(super) const PHASE_SIDE: f64 = 1e-12;
+
+/// How much more jerk the quarter points' q‴ must show than the knots' to count.
+const FINER_JERK: f64 = 1e-5;
 
 /// How a profile keeps the axis limits along a sampled path.
 #[derive(Clone)]
@@ -640,7 +645,7 @@ fn check_profile(
     joints: &JointPath,
     derivatives: &KnotDerivatives,
     profile: &Profile,
-    (speed, accel): (&[f64], &[f64]),
+    (speed, accel, jerk): (&[f64], &[f64], &[f64]),
     inner: &mut Inner,
     joints_at: &impl Fn(f64, &[f64; MAX_AXES]) -> Result<[f64; MAX_AXES], PlanError>,
 ) -> Result<ProfileCheck, PlanError> {
@@ -648,13 +653,30 @@ fn check_profile(
     let mut worst_axis = 0;
     let mut sd = [0.0f64; KNOTS];
     let mut near = [false; SEGMENTS];
+    // (An S-curve on an arm with jerk limits: each axis's jerk at the knots too, as a
+    // ratio whose cube root stretches the time enough: jerk goes as the time cubed.)
+    let knot_jerks = KnotJerks::of(joints, profile).filter(|_| jerk.iter().any(|j| j.is_finite()));
+    // (The steps where an axis's jerk comes near its limit at the knots: checked again with
+    // its q‴ from the quarter points, below.)
+    let mut jerk_near = [false; SEGMENTS];
     for (k, sd_k) in sd.iter_mut().enumerate() {
         let s = joints.knot(k);
-        let (v_path, a_path) = state_at_distance(profile, s * profile.dist);
+        let (v_path, a_path) = match &knot_jerks {
+            Some(kj) => kj.state(profile, k),
+            None => state_at_distance(profile, s * profile.dist),
+        };
         *sd_k = v_path;
         for i in 0..joints.axes {
             let (v, a) = axis_load(derivatives[k][i], v_path, a_path);
-            let ratio = (speed[i] / v).min(accel[i] / a);
+            let mut ratio = (speed[i] / v).min(accel[i] / a);
+            if let Some(kj) = knot_jerks.as_ref().filter(|_| jerk[i].is_finite()) {
+                let load = axis_jerk_load(joints, derivatives, (k, i), kj.near[k], 0.0);
+                ratio = ratio.min((jerk[i] / load).cbrt());
+                if load > NEAR_JERK * jerk[i] {
+                    jerk_near[k.min(SEGMENTS - 1)] = true;
+                    jerk_near[k.saturating_sub(1)] = true;
+                }
+            }
             if ratio < worst {
                 worst = ratio;
                 worst_axis = i;
@@ -740,6 +762,32 @@ fn check_profile(
                 near[step] = true;
             }
             peaks = true;
+        }
+    }
+    // The jerk where it came near a limit, with each step's q‴ from its quarter points: a
+    // sharp peak of q‴ (a path close to a singularity, at speed) falls between the knots'
+    // differences.
+    if let Some(kj) = &knot_jerks
+        && jerk_near.iter().any(|n| *n)
+    {
+        inner.fill(joints, &jerk_near, joints_at)?;
+        for k in 0..KNOTS {
+            for i in (0..joints.axes).filter(|i| jerk[*i].is_finite()) {
+                let finer = [k.saturating_sub(1), k.min(SEGMENTS - 1)]
+                    .iter()
+                    .filter_map(|step| inner.third_slope(joints, *step, i))
+                    .fold(0.0f64, f64::max);
+                let load = axis_jerk_load(joints, derivatives, (k, i), kj.near[k], finer);
+                // (Only a q‴ sharper than the knots' counts: third differences a quarter
+                // step apart carry the joints' rounding, ~1e-7 of a limit, even on a line.)
+                let knots = axis_jerk_load(joints, derivatives, (k, i), kj.near[k], 0.0);
+                if load > knots * (1.0 + FINER_JERK) {
+                    let ratio = (jerk[i] / load).cbrt();
+                    if ratio < worst {
+                        (worst, worst_axis) = (ratio, i);
+                    }
+                }
+            }
         }
     }
     let mut fits = worst >= 1.0 - JOINT_SPEED_TOLERANCE;
@@ -831,7 +879,7 @@ fn lower_profile(
     derivatives: &KnotDerivatives,
     profile: &Profile,
     (vs, ramp, normal, whole): (f64, f64, f64, f64),
-    limits: (&[f64], &[f64]),
+    limits: (&[f64], &[f64], &[f64]),
     inner: &mut Inner,
     joints_at: &impl Fn(f64, &[f64; MAX_AXES]) -> Result<[f64; MAX_AXES], PlanError>,
 ) -> Result<Option<(Profile, ProfileCheck)>, PlanError> {
@@ -936,15 +984,27 @@ fn fits_at_knots(
     joints: &JointPath,
     derivatives: &KnotDerivatives,
     profile: &Profile,
-    (speed, accel): (&[f64], &[f64]),
+    (speed, accel, jerk): (&[f64], &[f64], &[f64]),
 ) -> bool {
+    let knot_jerks = KnotJerks::of(joints, profile).filter(|_| jerk.iter().any(|j| j.is_finite()));
     derivatives.iter().enumerate().all(|(k, row)| {
         let s = joints.knot(k);
-        let (v_path, a_path) = state_at_distance(profile, s * profile.dist);
+        let (v_path, a_path) = match &knot_jerks {
+            Some(kj) => kj.state(profile, k),
+            None => state_at_distance(profile, s * profile.dist),
+        };
         row[..joints.axes].iter().enumerate().all(|(i, &d)| {
             let (v, a) = axis_load(d, v_path, a_path);
+            let jerk_within = match &knot_jerks {
+                Some(kj) if jerk[i].is_finite() => {
+                    axis_jerk_load(joints, derivatives, (k, i), kj.near[k], 0.0)
+                        <= jerk[i] * (1.0 + JOINT_SPEED_TOLERANCE)
+                }
+                _ => true,
+            };
             v <= speed[i] * (1.0 + JOINT_SPEED_TOLERANCE)
                 && a <= accel[i] * (1.0 + JOINT_SPEED_TOLERANCE)
+                && jerk_within
         })
     })
 }

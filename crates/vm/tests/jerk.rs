@@ -1,0 +1,160 @@
+//! Property tests of jerk limits, from `docs/engine.md` ("Timing", "Jerk limits"): random
+//! programs on an IRB 120 whose axes ramp their accelerations up in 20 to 150 ms, run by
+//! one VM and sampled at 1 kHz. Every axis keeps its jerk: the third difference of its
+//! joint every millisecond (a mean of its jerk over three) is within its limit, to
+//! [`JERK_TOLERANCE`] of it.
+
+#![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)] // tests fail by panicking
+
+use std::sync::Arc;
+
+use proptest::prelude::*;
+use vworks_model::builtin;
+use vworks_vm::machine::{EventKind, Next, Vm, VmConfig};
+
+const HOME: &str = "joints(0deg, -30deg, 30deg, 0deg, 60deg, 0deg)";
+const MS: i64 = 1_000_000;
+/// How far over its jerk limit an axis's third difference may be: a path's jerk is
+/// bounded at its knots (with its q‴ from quarter points where it comes near a limit) and
+/// a corner's by third differences, not exactly (the worst seen: 1.0017, at the start of a
+/// joint motion taking over from a slow arc).
+const JERK_TOLERANCE: f64 = 1e-2;
+
+fn vm(src: &str, ramp: f64) -> (Vm, [f64; 6]) {
+    let out = vworks_wslc::compile("t.wsl", src).unwrap_or_else(|e| panic!("{e}\n{src}"));
+    let m = Arc::new(out.module);
+    let entry = m.proc_index("main").unwrap();
+    let mut model = builtin::load("irb120").unwrap();
+    let mut jerks = [0.0; 6];
+    for (k, jerk) in jerks.iter_mut().enumerate() {
+        let j = model.axes[k];
+        *jerk = model.joints[j].max_accel / ramp;
+        model.joints[j].max_jerk = Some(*jerk);
+    }
+    let cfg = VmConfig {
+        start_joints: vec![
+            0.0,
+            -30f64.to_radians(),
+            30f64.to_radians(),
+            0.0,
+            60f64.to_radians(),
+            0.0,
+        ],
+        ..VmConfig::default()
+    };
+    (Vm::new(m, Arc::new(model), cfg, Some(entry)), jerks)
+}
+
+/// The largest third difference of each axis every millisecond over the whole run, as a
+/// share of its jerk limit; `None` if the program stops with a runtime error (a random
+/// arc out of reach).
+fn jerk_ratios(src: &str, ramp: f64) -> Option<[f64; 6]> {
+    let (mut v, jerks) = vm(src, ramp);
+    let mut samples: Vec<[f64; 12]> = Vec::new();
+    let mut tick = 0i64;
+    let mut end = 0;
+    while let Next::Event(e) = v.next_event() {
+        if let EventKind::Error { .. } = e.kind {
+            return None;
+        }
+        while tick < e.time {
+            samples.push(v.joints_at(tick));
+            tick += MS;
+        }
+        end = e.time;
+        v.perform();
+    }
+    while tick <= end + 3 * MS {
+        samples.push(v.joints_at(tick));
+        tick += MS;
+    }
+    let mut out = [0.0f64; 6];
+    for w in samples.windows(4) {
+        for i in 0..6 {
+            let d3 = (w[3][i] - 3.0 * w[2][i] + 3.0 * w[1][i] - w[0][i]).abs() / 1e-9;
+            out[i] = out[i].max(d3 / jerks[i]);
+        }
+    }
+    Some(out)
+}
+
+/// Runs `src` and checks every axis's jerk; a runtime error fails the test unless
+/// `out_of_reach_rejected` (random arcs may leave the arm's reach): then the case is
+/// rejected.
+fn jerks_within(src: &str, ramp: f64, out_of_reach_rejected: bool) -> Result<(), TestCaseError> {
+    let Some(r) = jerk_ratios(src, ramp) else {
+        prop_assert!(out_of_reach_rejected, "a runtime error\n{src}");
+        return Err(TestCaseError::reject("out of reach"));
+    };
+    let worst = r.iter().cloned().fold(0.0, f64::max);
+    prop_assert!(worst <= 1.0 + JERK_TOLERANCE, "{r:?}\n{src}");
+    Ok(())
+}
+
+fn zone_text(z: u32) -> String {
+    if z == 0 {
+        "zone fine".into()
+    } else {
+        format!("zone {z}mm")
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    #[test]
+    fn jerk_limited_lines_keep_every_axis_jerk(
+        pts in prop::collection::vec((-120i32..120, -120i32..120, -100i32..100), 1..4),
+        speeds in prop::collection::vec(prop_oneof![Just(50u32), 100u32..2000], 4),
+        zones in prop::collection::vec(prop_oneof![Just(0u32), 1u32..40], 4),
+        ramp in prop_oneof![Just(0.02), Just(0.05), Just(0.15)],
+    ) {
+        let mut src = format!("proc main() {{\n    move_j {HOME};\n    var p = current_pose();\n");
+        for ((x, y, z), (v, zone)) in pts.iter().zip(speeds.iter().zip(&zones)) {
+            src += &format!("    move_l offset(p, {x}mm, {y}mm, {z}mm) speed {v}mm/s {};\n", zone_text(*zone));
+        }
+        src += "}\n";
+        jerks_within(&src, ramp, false)?;
+    }
+
+    #[test]
+    fn jerk_limited_joint_corners_keep_every_axis_jerk(
+        targets in prop::collection::vec(prop::array::uniform6(-60i32..60), 2..5),
+        speeds in prop::collection::vec(10u32..100, 5),
+        zones in prop::collection::vec(prop_oneof![Just(0u32), 1u32..60], 5),
+        ramp in prop_oneof![Just(0.02), Just(0.05), Just(0.15)],
+    ) {
+        let mut src = format!("proc main() {{\n    move_j {HOME};\n");
+        let home = [0, -30, 30, 0, 60, 0];
+        for (t, (v, zone)) in targets.iter().zip(speeds.iter().zip(&zones)) {
+            let q: Vec<String> = t.iter().zip(home).map(|(d, h)| format!("{}deg", h + d / 2)).collect();
+            src += &format!("    move_j joints({}) speed {v}% {};\n", q.join(", "), zone_text(*zone));
+        }
+        src += "}\n";
+        jerks_within(&src, ramp, false)?;
+    }
+
+    #[test]
+    fn jerk_limited_mixed_corners_and_arcs_keep_every_axis_jerk(
+        moves in prop::collection::vec((0u8..3, (-100i32..100, -100i32..100, -80i32..80)), 2..5),
+        speeds in prop::collection::vec(100u32..1500, 5),
+        zones in prop::collection::vec(prop_oneof![Just(0u32), 1u32..40], 5),
+        ramp in prop_oneof![Just(0.02), Just(0.05), Just(0.15)],
+    ) {
+        // A line, a joint motion to a pose, or an arc through a point off the chord.
+        let mut src = format!("proc main() {{\n    move_j {HOME};\n    var p = current_pose();\n");
+        for ((kind, (x, y, z)), (v, zone)) in moves.iter().zip(speeds.iter().zip(&zones)) {
+            let target = format!("offset(p, {x}mm, {y}mm, {z}mm)");
+            src += &match kind {
+                0 => format!("    move_l {target} speed {v}mm/s {};\n", zone_text(*zone)),
+                1 => format!("    move_j {target} speed {}% {};\n", v / 20, zone_text(*zone)),
+                _ => format!(
+                    "    move_c offset(current_pose(), {}mm, {}mm, 30mm), {target} speed {v}mm/s {};\n",
+                    y / 3, -x / 3, zone_text(*zone)
+                ),
+            };
+        }
+        src += "}\n";
+        jerks_within(&src, ramp, true)?;
+    }
+}
