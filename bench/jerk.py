@@ -164,6 +164,8 @@ def jerk_time(s, dq, ddq, vlim, alim, jlim, speed=math.inf, accel=math.inf):
         if previous is not None and abs(previous - duration) <= TOLERANCE * duration:
             break
         previous = duration
+    else:
+        warnings.warn(f"jerk_time: no fixed point after {MAX_ROUNDS} rounds (last {duration:.9f} s)")
     return duration, x, u, without
 
 
@@ -200,6 +202,7 @@ def line_case(vworks, folder, case, ramp, steps, seed=1):
     length = s[-1] - s[0]
     ends = length * np.geomspace(1e-6, 2.0 / steps, END_KNOTS)
     grid = np.unique(np.concatenate([np.linspace(s[0], s[-1], steps + 1), s[0] + ends, s[-1] - ends]))
+    grid = grid[np.concatenate([[True], np.diff(grid) > 1e-12 * length])]  # (no step of no length)
     tcp_speed, tcp_accel = fidelity.urdf_tcp(model)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

@@ -16,7 +16,7 @@ const HOME: &str = "joints(0deg, -30deg, 30deg, 0deg, 60deg, 0deg)";
 const MS: i64 = 1_000_000;
 /// How far over its jerk limit an axis's third difference may be: a path's jerk is
 /// bounded at its knots (with its q‴ from quarter points where it comes near a limit) and
-/// a corner's by third differences, not exactly (the worst seen: 1.0017, at the start of a
+/// a corner's by third differences, not exactly (the worst seen: 1.0018, at the start of a
 /// joint motion taking over from a slow arc).
 const JERK_TOLERANCE: f64 = 1e-2;
 

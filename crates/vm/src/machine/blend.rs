@@ -854,25 +854,35 @@ fn phase_ends_within(model: &RobotModel, f: &Fading, next: &Trajectory, ts: i64)
     ok
 }
 
-/// The longest step of the third differences [`jerks_within`] takes (ns): short enough to
-/// stay inside a phase of both motions, long enough that the joints' rounding stays far
-/// below a jerk limit.
+/// The longest step of the third differences [`jerks_within`] takes (ns): a mean over three
+/// of them stays close to the jerk of a phase of either motion.
 const JERK_STEP: i64 = 500_000;
+/// A quarter of the shortest corner [`jerks_within`] lets an axis with a jerk limit take (ns).
+const JERK_MIN_CORNER: i64 = 250_000;
 
 /// Every axis with a jerk limit within it through the corner starting at `ts` (a corner
 /// with a Cartesian motion: its joints come from the blended poses). Between two instants
 /// where either motion's profile changes phase, each motion's path jerk holds (S-curves)
 /// or is none (trapezoids), and the axes' jerks change only with their slopes and the
-/// speeds, so each such stretch is checked by third differences [`JERK_STEP`] apart
-/// inside it, end to end (each a mean of the jerk over three steps). Two
-/// S-curves' jerk phases overlapping — the next motion jerking up as the first jerks into
-/// its braking — add up, as their accelerations do.
+/// speeds, so each such stretch is checked by third differences inside it, a quarter of it
+/// and at most [`JERK_STEP`] apart, end to end (each a mean of the jerk over three steps;
+/// a stretch shorter than 4 µs is left out). Two S-curves' jerk phases overlapping — the
+/// next motion jerking up as the first jerks into its braking — add up, as their
+/// accelerations do. A corner shorter than four [`JERK_MIN_CORNER`]s is not taken: it
+/// would save less than a millisecond, and its own stretches would be too short to
+/// measure.
 fn jerks_within(model: &RobotModel, f: &Fading, next: &Trajectory, ts: i64) -> bool {
     let n = model.dof();
     if (0..n).all(|i| model.axis(i).max_jerk.is_none()) {
         return true;
     }
     let end = f.end();
+    if end <= ts {
+        return true;
+    }
+    if end - ts < 4 * JERK_MIN_CORNER {
+        return false;
+    }
     // (Each motion has up to 8 phase ends per profile, a joint motion one profile per axis.)
     let mut cuts = [0i64; 2 + 2 * 8 * MAX_AXES];
     let mut count = 0;
@@ -895,6 +905,7 @@ fn jerks_within(model: &RobotModel, f: &Fading, next: &Trajectory, ts: i64) -> b
         if h < 1_000 {
             continue;
         }
+        let dt = h as f64 / NS;
         // Windows of three steps end to end from its start, the last one ending at its end.
         let mut first = a;
         loop {
@@ -909,7 +920,6 @@ fn jerks_within(model: &RobotModel, f: &Fading, next: &Trajectory, ts: i64) -> b
                     None => return false,
                 }
             }
-            let dt = h as f64 / NS;
             let over = (0..n).any(|i| {
                 model.axis(i).max_jerk.is_some_and(|jerk| {
                     let d3 = q[3][i] - 3.0 * q[2][i] + 3.0 * q[1][i] - q[0][i];

@@ -730,8 +730,17 @@ impl Vm {
         }
         if let Some((point, at)) = notes.corner_failure {
             self.warn_once(self.main.pc, point, WarningKind::Corner, |vm| {
+                // (With jerk limits, S-curves that ramp an axis the same way at its full jerk
+                // add their jerks wherever they overlap: no zone lets them.)
+                let model = vm.arm.model();
+                let jerky = (0..model.dof()).any(|i| model.axis(i).max_jerk.is_some());
+                let hint = if jerky {
+                    "with jerk limits, two motions that ramp an axis the same way at its full jerk cannot overlap (their jerks add up): a zone helps where the axes reverse, or between motions that do not ramp at full jerk"
+                } else {
+                    "a larger zone, a lower speed or a jerk limit can let it fly by"
+                };
                 format!(
-                    "this motion cannot start inside the zone of the motion at line {} of {} within the zone and the TCP's and axes' limits (or faster than stopping): the robot stops at that point first (a corner path failure); a larger zone, a lower speed or a jerk limit can let it fly by",
+                    "this motion cannot start inside the zone of the motion at line {} of {} within the zone and the TCP's and axes' limits (or faster than stopping): the robot stops at that point first (a corner path failure); {hint}",
                     at.line,
                     vm.m.file_name_of(at)
                 )
