@@ -6,13 +6,13 @@
 
 #![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)] // tests fail by panicking
 
-use std::sync::Arc;
+mod common;
 
+use common::HOME;
 use proptest::prelude::*;
 use vworks_model::builtin;
-use vworks_vm::machine::{EventKind, Next, Vm, VmConfig};
+use vworks_vm::machine::{EventKind, Next, Vm};
 
-const HOME: &str = "joints(0deg, -30deg, 30deg, 0deg, 60deg, 0deg)";
 const MS: i64 = 1_000_000;
 /// How far over its jerk limit an axis's third difference may be: a path's jerk is
 /// bounded at its knots (with its q‴ from quarter points where it comes near a limit) and
@@ -20,29 +20,11 @@ const MS: i64 = 1_000_000;
 /// joint motion taking over from a slow arc).
 const JERK_TOLERANCE: f64 = 1e-2;
 
+/// The VM of `src` with jerk limits ramping in `ramp` seconds, and those limits.
 fn vm(src: &str, ramp: f64) -> (Vm, [f64; 6]) {
-    let out = vworks_wslc::compile("t.wsl", src).unwrap_or_else(|e| panic!("{e}\n{src}"));
-    let m = Arc::new(out.module);
-    let entry = m.proc_index("main").unwrap();
-    let mut model = builtin::load("irb120").unwrap();
-    let mut jerks = [0.0; 6];
-    for (k, jerk) in jerks.iter_mut().enumerate() {
-        let j = model.axes[k];
-        *jerk = model.joints[j].max_accel / ramp;
-        model.joints[j].max_jerk = Some(*jerk);
-    }
-    let cfg = VmConfig {
-        start_joints: vec![
-            0.0,
-            -30f64.to_radians(),
-            30f64.to_radians(),
-            0.0,
-            60f64.to_radians(),
-            0.0,
-        ],
-        ..VmConfig::default()
-    };
-    (Vm::new(m, Arc::new(model), cfg, Some(entry)), jerks)
+    let model = builtin::load("irb120").unwrap();
+    let jerks: [f64; 6] = std::array::from_fn(|k| model.joints[model.axes[k]].max_accel / ramp);
+    (common::irb120_vm(src, Some(ramp)), jerks)
 }
 
 /// The largest third difference of each axis every millisecond over the whole run, as a

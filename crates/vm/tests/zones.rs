@@ -21,14 +21,14 @@
 
 #![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)] // tests fail by panicking
 
-use std::sync::Arc;
+mod common;
 
+use common::HOME;
 use proptest::prelude::*;
 use vworks_model::builtin;
 use vworks_model::math::{norm, sub};
-use vworks_vm::machine::{Event, EventKind, Next, Vm, VmConfig, WarningKind};
+use vworks_vm::machine::{Event, EventKind, Next, Vm, WarningKind};
 
-const HOME: &str = "joints(0deg, -30deg, 30deg, 0deg, 60deg, 0deg)";
 const MS: i64 = 1_000_000;
 /// Joint-space corners keep the TCP in the zone at the 32 instants the VM checks (the
 /// TCP is not a linear function of the joints, so no closed-form bound): between them it
@@ -37,29 +37,7 @@ const MS: i64 = 1_000_000;
 const JOINT_CORNER_TOLERANCE: f64 = 1e-4;
 
 fn vm(src: &str, jerk: Option<f64>) -> Vm {
-    let out = vworks_wslc::compile("t.wsl", src).unwrap_or_else(|e| panic!("{e}\n{src}"));
-    let m = Arc::new(out.module);
-    let entry = m.proc_index("main").unwrap();
-    let mut model = builtin::load("irb120").unwrap();
-    if let Some(ramp) = jerk {
-        // Jerk limits that ramp each axis's acceleration up in `ramp` seconds.
-        for k in 0..model.dof() {
-            let j = model.axes[k];
-            model.joints[j].max_jerk = Some(model.joints[j].max_accel / ramp);
-        }
-    }
-    let cfg = VmConfig {
-        start_joints: vec![
-            0.0,
-            -30f64.to_radians(),
-            30f64.to_radians(),
-            0.0,
-            60f64.to_radians(),
-            0.0,
-        ],
-        ..VmConfig::default()
-    };
-    Vm::new(m, Arc::new(model), cfg, Some(entry))
+    common::irb120_vm(src, jerk)
 }
 
 /// What a run gives: its events, and at every millisecond (and every event, on both

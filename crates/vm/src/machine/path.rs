@@ -661,10 +661,7 @@ fn check_profile(
     let mut jerk_near = [false; SEGMENTS];
     for (k, sd_k) in sd.iter_mut().enumerate() {
         let s = joints.knot(k);
-        let (v_path, a_path) = match &knot_jerks {
-            Some(kj) => kj.state(profile, k),
-            None => state_at_distance(profile, s * profile.dist),
-        };
+        let (v_path, a_path) = knot_state(knot_jerks.as_ref(), profile, s, k);
         *sd_k = v_path;
         for i in 0..joints.axes {
             let (v, a) = axis_load(derivatives[k][i], v_path, a_path);
@@ -777,6 +774,10 @@ fn check_profile(
                     .iter()
                     .filter_map(|step| inner.third_slope(joints, *step, i))
                     .fold(0.0f64, f64::max);
+                // (No step solved next to this knot: its bound is the knots' own, above.)
+                if finer <= 0.0 {
+                    continue;
+                }
                 let load = axis_jerk_load(joints, derivatives, (k, i), kj.near[k], finer);
                 // (Only a q‴ sharper than the knots' counts: third differences a quarter
                 // step apart carry the joints' rounding, ~1e-7 of a limit, even on a line.)
@@ -989,10 +990,7 @@ fn fits_at_knots(
     let knot_jerks = KnotJerks::of(joints, profile).filter(|_| jerk.iter().any(|j| j.is_finite()));
     derivatives.iter().enumerate().all(|(k, row)| {
         let s = joints.knot(k);
-        let (v_path, a_path) = match &knot_jerks {
-            Some(kj) => kj.state(profile, k),
-            None => state_at_distance(profile, s * profile.dist),
-        };
+        let (v_path, a_path) = knot_state(knot_jerks.as_ref(), profile, s, k);
         row[..joints.axes].iter().enumerate().all(|(i, &d)| {
             let (v, a) = axis_load(d, v_path, a_path);
             let jerk_within = match &knot_jerks {
@@ -1007,6 +1005,15 @@ fn fits_at_knots(
                 && jerk_within
         })
     })
+}
+
+/// The path's speed and acceleration at knot `k` (at `s`): from the knot's time where
+/// [`KnotJerks`] has it, else by distance.
+fn knot_state(knot_jerks: Option<&KnotJerks>, profile: &Profile, s: f64, k: usize) -> (f64, f64) {
+    match knot_jerks {
+        Some(kj) => kj.state(profile, k),
+        None => state_at_distance(profile, s * profile.dist),
+    }
 }
 
 /// An axis's speed and acceleration (magnitudes) where its path derivatives are `(q′, q″)`
