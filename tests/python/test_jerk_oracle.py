@@ -3,7 +3,7 @@ of the same path within the same axis speeds, accelerations and jerks, as sequen
 programs. First the oracle itself against Ruckig (exact for one axis), then vworks's lines,
 which keep every axis's jerk (docs/engine.md, "Jerk limits") and so can never be faster
 than the oracle, beyond the oracle's own discretisation (it is up to 0.2 % fast on 200
-steps)."""
+steps), and are timed within 1 % of it (their own jerk-limited timing)."""
 
 import os
 import sys
@@ -47,8 +47,8 @@ def test_the_oracle_times_one_axis_as_ruckig_does(dist, speed, accel, jerk_limit
 
 
 @pytest.mark.oracle
-@pytest.mark.parametrize("case", [1, 2, 6, 15])
-def test_jerk_limited_lines_are_never_faster_than_the_oracle(case):
+@pytest.mark.parametrize("case", [1, 2, 6, 15, 33, 40])
+def test_jerk_limited_lines_are_within_1_percent_of_the_oracle_never_faster(case):
     pytest.importorskip("scipy")
     import vworks
 
@@ -58,4 +58,7 @@ def test_jerk_limited_lines_are_never_faster_than_the_oracle(case):
     # Faster than the oracle would be a jerk (or an acceleration) over its limit: before
     # vworks checked its lines' axis jerks, case 15 (250 mm at 0.1 m/s) ran 0.3 % faster.
     assert row["ratio"] >= 0.998, row
+    # Cases 40 (103 mm at 4 m/s) and 33 (297 mm at 2 m/s) took 1.137x and 1.087x as an
+    # S-curve slowed as a whole where an axis binds.
+    assert row["ratio"] <= 1.01, row
     assert row["oracle_s"] >= row["without_jerk_s"], row

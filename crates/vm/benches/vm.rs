@@ -1,5 +1,6 @@
 //! Interpreter dispatch (target ≥ 100 M simple instructions/s on an int loop) and motion
-//! sampling (the robot's joints at a time inside a move_l, target ≤ 5 µs per sample).
+//! sampling (the robot's joints at a time inside a move_l, target ≤ 5 µs per sample), and
+//! planning a `move_l` with and without jerk limits.
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // benches fail by panicking
 
@@ -126,5 +127,56 @@ fn corner_sampling(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, dispatch, sampling, corner_sampling);
+/// Planning one `move_l` (sampling its path, checking and timing it): 300 mm past axis 1 of
+/// an IRB 120 at 2 m/s, an axis's speed binding; without jerk limits (TOPP-RA), and with
+/// axes ramping their accelerations in 20 ms (the jerk-limited timing's linear programs).
+fn planning(c: &mut Criterion) {
+    let src = "
+        proc main() {
+            move_j pose(300mm, -150mm, 400mm, 180deg, 0deg, 0deg);
+            move_l pose(300mm, 150mm, 400mm, 180deg, 0deg, 0deg) speed 2000mm/s;
+        }";
+    let m = Arc::new(vworks_wslc::compile("b.wsl", src).unwrap().module);
+    let entry = m.proc_index("main");
+    let mut g = c.benchmark_group("plan");
+    g.sample_size(10);
+    for (name, ramp) in [("move_l", None), ("move_l_jerk_limited", Some(0.02))] {
+        let mut model = builtin::load("irb120").unwrap();
+        if let Some(ramp) = ramp {
+            for k in 0..model.dof() {
+                let j = model.axes[k];
+                model.joints[j].max_jerk = Some(model.joints[j].max_accel / ramp);
+            }
+        }
+        let model = Arc::new(model);
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                // (A new VM each time: its memo would remember the path.)
+                let mut v = Vm::new(m.clone(), model.clone(), VmConfig::default(), entry);
+                loop {
+                    match v.next_event() {
+                        Next::Event(e) => {
+                            let line = matches!(
+                                e.kind,
+                                EventKind::MotionStart {
+                                    command: "move_l",
+                                    ..
+                                }
+                            );
+                            v.perform();
+                            if line {
+                                break;
+                            }
+                        }
+                        _ => panic!("no move_l"),
+                    }
+                }
+                black_box(v.joints_at(0))
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, dispatch, sampling, corner_sampling, planning);
 criterion_main!(benches);

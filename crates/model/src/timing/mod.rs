@@ -365,12 +365,22 @@ pub enum TimingError {
 }
 
 /// The time-optimal timing of a path: `ṡ²` and the time at each knot.
+///
+/// Within each step `ṡ² = x_k + 2·b_k·σ + c_k·σ²` at `σ = s − s_k`: `s̈ = b_k + c_k·σ`.
+/// A timing within the axes' accelerations ([`Timing::optimal`]) has `c_k = 0`: `s̈`
+/// is constant on each step, `s(t)` a parabola. A *smooth* one ([`Timing::jerk_limited`])
+/// has `s̈` continuous, linear in `s` on each step (`s⃛ = c_k·ṡ`), and its first and last
+/// steps move from and to rest at a constant `s⃛` (`s ∝ t³`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Timing {
     x: [f64; KNOTS],
     t: [f64; KNOTS],
     /// The path's knots ([`JointPath::knots`]).
     s: [f64; KNOTS],
+    /// Per step, `(b_k, c_k)`.
+    curve: [(f64, f64); SEGMENTS],
+    /// `s̈` continuous (see above).
+    smooth: bool,
 }
 
 /// Where on the path, how fast and how it accelerates at a time.
@@ -768,10 +778,16 @@ impl Timing {
                 .map_or(0, |p| p + 1);
             return Err(TimingError::Stuck { knot, axis: 0 });
         }
+        let mut curve = [(0.0, 0.0); SEGMENTS];
+        for (k, bc) in curve.iter_mut().enumerate() {
+            bc.0 = (x[k + 1] - x[k]) / (2.0 * path.step(k));
+        }
         Ok(Timing {
             x,
             t,
             s: path.knots,
+            curve,
+            smooth: false,
         })
     }
 
@@ -824,6 +840,10 @@ impl Timing {
         for t in &mut out.t {
             *t *= factor;
         }
+        for (b, c) in &mut out.curve {
+            *b /= factor * factor;
+            *c /= factor * factor;
+        }
         out
     }
 
@@ -842,7 +862,25 @@ impl Timing {
 
     /// The largest path speed `ṡ` it reaches (1/s).
     pub fn top_speed(&self) -> f64 {
-        self.x.iter().fold(0.0f64, |m, x| m.max(*x)).sqrt()
+        let knots = self.x.iter().fold(0.0f64, |m, x| m.max(*x));
+        if !self.smooth {
+            return knots.sqrt();
+        }
+        // (A step whose s̈ falls through 0 peaks inside it.)
+        let mut top = knots;
+        for k in 1..SEGMENTS - 1 {
+            let (b, c) = self.curve[k];
+            let sigma = if c < 0.0 { -b / c } else { -1.0 };
+            if sigma > 0.0 && sigma < self.s[k + 1] - self.s[k] {
+                top = top.max(self.x[k] + b * sigma);
+            }
+        }
+        top.sqrt()
+    }
+
+    /// Whether `s̈` is continuous ([`Timing::jerk_limited`]).
+    pub fn is_smooth(&self) -> bool {
+        self.smooth
     }
 
     /// The path speed at knot `k` (1/s).
@@ -877,6 +915,9 @@ impl Timing {
             };
         }
         let (k, tau) = self.step_of(time);
+        if self.smooth {
+            return self.smooth_at(k, tau);
+        }
         let (_, u) = self.step_state(k);
         let v0 = self.x[k].sqrt();
         let s = (self.s[k] + v0 * tau + 0.5 * u * tau * tau).clamp(0.0, 1.0);
@@ -900,6 +941,9 @@ impl Timing {
             .partition_point(|sk| *sk <= s)
             .saturating_sub(1);
         let ds = s - self.s[k];
+        if self.smooth {
+            return self.t[k] + self.smooth_time_in(k, ds);
+        }
         let (_, u) = self.step_state(k);
         let v0 = self.x[k].sqrt();
         // ½u·τ² + v0·τ = ds, in the form that does not cancel.
@@ -913,5 +957,7 @@ impl Timing {
     }
 }
 
+mod jerk;
+mod lp;
 #[cfg(test)]
 mod tests;

@@ -9,7 +9,7 @@ use super::*;
 const BIG: f64 = 1e12;
 
 /// A path whose axes are functions of s.
-fn path(axes: usize, f: impl Fn(f64, usize) -> f64) -> JointPath {
+pub(super) fn path(axes: usize, f: impl Fn(f64, usize) -> f64) -> JointPath {
     let mut p = JointPath::new(axes);
     for k in 0..KNOTS {
         let s = k as f64 / SEGMENTS as f64;
@@ -29,7 +29,7 @@ fn trapezoid(d: f64, v: f64, a: f64) -> f64 {
     }
 }
 
-fn limits<'a>(speed: &'a [f64], accel: &'a [f64], ps: f64, pa: f64) -> Limits<'a> {
+pub(super) fn limits<'a>(speed: &'a [f64], accel: &'a [f64], ps: f64, pa: f64) -> Limits<'a> {
     Limits {
         axis_speed: speed,
         axis_accel: accel,

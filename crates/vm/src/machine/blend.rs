@@ -22,6 +22,7 @@
 
 use vworks_model::RobotModel;
 use vworks_model::math::{Iso, V3, axpy, mat_mul, norm, rotation_vector, sub, transpose};
+use vworks_model::timing::KNOTS;
 
 use super::plan::{JOINT_SPEED_TOLERANCE, Trajectory};
 use super::quarters::chord_peak;
@@ -883,8 +884,9 @@ fn jerks_within(model: &RobotModel, f: &Fading, next: &Trajectory, ts: i64) -> b
     if end - ts < 4 * JERK_MIN_CORNER {
         return false;
     }
-    // (Each motion has up to 8 phase ends per profile, a joint motion one profile per axis.)
-    let mut cuts = [0i64; 2 + 2 * 8 * MAX_AXES];
+    // (Each motion has up to 8 phase ends per profile, a joint motion one profile per
+    // axis, a smooth timing its knots.)
+    let mut cuts = [0i64; 2 + 2 * (8 * MAX_AXES + KNOTS)];
     let mut count = 0;
     let mut push = |t: i64| {
         if t >= ts && t <= end && count < cuts.len() {
@@ -895,8 +897,10 @@ fn jerks_within(model: &RobotModel, f: &Fading, next: &Trajectory, ts: i64) -> b
     push(ts);
     push(end);
     let to_ns = |origin: i64, b: f64| origin + (b * NS).round() as i64;
-    f.motion.traj.phase_ends(|b| push(to_ns(f.motion.start, b)));
-    next.phase_ends(|b| push(to_ns(ts, b)));
+    f.motion
+        .traj
+        .jerk_breaks(|b| push(to_ns(f.motion.start, b)));
+    next.jerk_breaks(|b| push(to_ns(ts, b)));
     let cuts = &mut cuts[..count];
     cuts.sort_unstable();
     for w in cuts.windows(2) {

@@ -26,6 +26,7 @@ mod plan;
 mod pulses;
 mod quarters;
 mod remote;
+mod smooth;
 mod state;
 mod trajectory;
 mod view;

@@ -12,6 +12,7 @@ use vworks_model::timing::{JointPath, KNOTS, KnotLimits, Limits, SEGMENTS, Timin
 use super::jerks::{KnotJerks, NEAR_JERK, axis_jerk_load, axis_jerks};
 use super::plan::{JOINT_SPEED_TOLERANCE, PlanError, ik_tcp};
 use super::quarters::{Inner, Kink};
+use super::smooth::smooth_timing;
 use crate::MAX_AXES;
 use crate::motion::{Path, Profile, cartesian_at};
 
@@ -23,7 +24,7 @@ pub(super) const MAX_KNOT_TURN: f64 = std::f64::consts::FRAC_PI_4;
 /// How much of every axis limit a time-optimal path timing leaves unused: the timing keeps
 /// the limits exactly at its knots and halfway between them, and the path's curvature
 /// within one step (1/256 of the path) moves them by less than this.
-const TIMING_MARGIN: f64 = 5e-4;
+pub(super) const TIMING_MARGIN: f64 = 5e-4;
 /// Sampled paths a VM remembers (the oldest goes first).
 pub(super) const PATH_MEMO: usize = 32;
 /// A sampled path's key: the bits of the start joints, the start and goal poses (rotation,
@@ -115,7 +116,9 @@ pub(super) type PathMemo = Memo<PATH_KEY, PathSamples>;
 /// against time; top speed `vs`, jerk ramp `ramp` s) against every axis's speed and
 /// acceleration; if an axis would exceed one, the faster of the same profile at a lower
 /// acceleration and the path's time-optimal timing within the axis limits and the
-/// profile's own speed and acceleration.
+/// profile's own speed and acceleration. With jerk limits (`ramp` > 0) and `jerk_timed`
+/// (not a motion given a `duration`, which keeps its S-curve stretched), the path's
+/// jerk-limited timing where it is faster than the S-curves (`smooth`).
 pub(super) fn sample_path(
     model: &RobotModel,
     tool: &Iso,
@@ -123,6 +126,7 @@ pub(super) fn sample_path(
     branch: Option<u8>,
     (profile, vs, ramp, whole): (&Profile, f64, f64, f64),
     zone: Option<f64>,
+    jerk_timed: bool,
 ) -> Result<PathSamples, PlanError> {
     let n = model.dof();
     let pose = |s: f64| cartesian_at(path, start, goal, s);
@@ -146,6 +150,31 @@ pub(super) fn sample_path(
         Path::Arc { sweep, .. } if whole.is_finite() => *sweep,
         _ => 0.0,
     };
+    // With jerk limits: the path timed within every axis's jerk (the fastest found),
+    // unless an S-curve below is faster (a short line whose ramps the steps cannot
+    // resolve).
+    let path_limits = PathLimits {
+        speed: vs,
+        accel: profile.a,
+        normal,
+        whole,
+        along: None,
+    };
+    let smooth = if ramp > 0.0 && jerk_timed {
+        smooth_timing(&joints, (&speed, &accel, &jerk), &path_limits, &joints_at)
+    } else {
+        None
+    };
+    let smooth_lasts = smooth.as_ref().map_or(f64::INFINITY, |(_, t)| t.duration());
+    let smooth_samples = |(timed, timing): (JointPath, Timing)| {
+        let derivatives = knot_derivatives(&timed);
+        let (worst_axis, nearest) = fastest_axis(&derivatives, &timing, &speed[..n]);
+        let unslowed = (nearest >= SPEED_BINDS && timing.duration() > profile.t_total)
+            .then_some(profile.t_total)
+            .filter(|t| t.is_finite());
+        let end = timed.q[SEGMENTS];
+        timed_samples(&timed, timing, (unslowed, worst_axis), end, None)
+    };
     if bounded && within_whole(profile, normal, whole) {
         let check = check_profile(
             &joints,
@@ -156,7 +185,10 @@ pub(super) fn sample_path(
             &joints_at,
         )?;
         if check.fits {
-            return Ok(profile_samples(&joints, profile, &check, None, end));
+            return Ok(match smooth {
+                Some(found) if smooth_lasts < profile.t_total => smooth_samples(found),
+                _ => profile_samples(&joints, profile, &check, None, end),
+            });
         }
     }
     // The same trapezoid (S-curve) at the highest lower acceleration that keeps every
@@ -181,6 +213,11 @@ pub(super) fn sample_path(
     // between 1/64 of the programmed one and all of it; a slower speed than programmed
     // is a `slowdown` (against the programmed profile).
     if ramp > 0.0 {
+        if let Some(found) = smooth
+            && smooth_lasts < lower.as_ref().map_or(f64::INFINITY, |(p, _)| p.t_total)
+        {
+            return Ok(smooth_samples(found));
+        }
         let mut at = |f: f64| {
             lower_profile(
                 &joints,
@@ -235,13 +272,6 @@ pub(super) fn sample_path(
             return Ok(profile_samples(&joints, lower, check, Some(*lower), end));
         }
     }
-    let path_limits = PathLimits {
-        speed: vs,
-        accel: profile.a,
-        normal,
-        whole,
-        along: None,
-    };
     let (timing, look_ahead) = time_path(
         &mut joints,
         &mut derivatives,
@@ -292,10 +322,27 @@ pub(super) fn sample_path(
             .map(|t| t.duration())
             .filter(|would| timing.duration() > would * (1.0 + 1e-9))
     };
+    Ok(timed_samples(
+        &joints,
+        timing,
+        (unslowed, worst_axis),
+        end,
+        look_ahead,
+    ))
+}
+
+/// The samples of a path that follows `timing`.
+fn timed_samples(
+    joints: &JointPath,
+    timing: Timing,
+    (unslowed, worst_axis): (Option<f64>, usize),
+    end: [f64; MAX_AXES],
+    look_ahead: Option<f64>,
+) -> PathSamples {
     // (A timed path never flies with corner ramps: its cruise bound is its bound.)
-    let rates = timed_rates(&joints, &timing);
-    Ok(PathSamples {
-        seeds: seeds_of(&joints),
+    let rates = timed_rates(joints, &timing);
+    PathSamples {
+        seeds: seeds_of(joints),
         rates,
         cruise_rates: rates,
         timing: Some(timing),
@@ -304,7 +351,7 @@ pub(super) fn sample_path(
         worst_axis,
         end,
         look_ahead,
-    })
+    }
 }
 
 /// The joints at path fraction `s` of the TCP poses `pose`, seeded from `prev`: on the
@@ -409,6 +456,27 @@ pub(super) struct PathLimits<'a> {
     pub(super) along: Option<&'a AlongKnots<'a>>,
 }
 
+impl PathLimits<'_> {
+    /// The timing's limits: these and the axes' `speed` and `accel`, and the path's own
+    /// limits knot by knot `along`.
+    pub(super) fn with_axes<'a>(
+        &self,
+        speed: &'a [f64],
+        accel: &'a [f64],
+        along: Option<&'a KnotLimits>,
+    ) -> Limits<'a> {
+        Limits {
+            axis_speed: speed,
+            axis_accel: accel,
+            path_speed: self.speed,
+            path_accel: self.accel,
+            path_normal: self.normal,
+            path_whole: self.whole,
+            along,
+        }
+    }
+}
+
 /// Why [`time_path`] found no timing.
 #[derive(Debug)]
 pub(super) enum Untimed {
@@ -456,15 +524,7 @@ pub(super) fn time_path(
     // The timing keeps a margin below the limits the checks measure against.
     let speed_timed = speed.map(|v| v * (1.0 - TIMING_MARGIN));
     let accel_timed = accel.map(|a| a * (1.0 - TIMING_MARGIN));
-    let limits = Limits {
-        axis_speed: &speed_timed[..n],
-        axis_accel: &accel_timed[..n],
-        path_speed: path.speed,
-        path_accel: path.accel,
-        path_normal: path.normal,
-        path_whole: path.whole,
-        along: along.as_ref(),
-    };
+    let limits = path.with_axes(&speed_timed[..n], &accel_timed[..n], along.as_ref());
     let optimal = |joints: &JointPath| {
         Timing::from_speed(joints, &limits, x0).map_err(|e| match e {
             TimingError::Stuck { knot, axis } | TimingError::NotFinite { knot, axis } => {
@@ -573,7 +633,7 @@ const LOOK_AHEAD_SHARE: f64 = 0.95;
 
 /// No axis turns more than [`MAX_KNOT_TURN`] between two knots (else the arm changes
 /// configuration there).
-fn check_turns(joints: &JointPath) -> Result<(), PlanError> {
+pub(super) fn check_turns(joints: &JointPath) -> Result<(), PlanError> {
     for k in 1..KNOTS {
         for i in 0..joints.axes {
             let turn = (joints.q[k][i] - joints.q[k - 1][i]).abs();
@@ -1089,12 +1149,12 @@ fn state_at_distance(p: &Profile, d: f64) -> (f64, f64) {
     (p.speed_at(t), p.accel_at(t))
 }
 
-/// Per axis, a bound on its speed along a sampled path under `timing` (ṡ² is linear in s
-/// within a step: ṡ is largest at one of its ends).
+/// Per axis, a bound on its speed along a sampled path under `timing` (its largest path
+/// speed on each step: `Timing::step_top_speed`).
 pub(super) fn timed_rates(joints: &JointPath, timing: &Timing) -> [f64; MAX_AXES] {
     let mut step_speed = [0.0f64; SEGMENTS];
     for (k, v) in step_speed.iter_mut().enumerate() {
-        *v = timing.speed_at_knot(k).max(timing.speed_at_knot(k + 1));
+        *v = timing.step_top_speed(k);
     }
     rate_bounds(joints, &step_speed)
 }

@@ -625,6 +625,7 @@ fn plan_cartesian(
             branch,
             (&profile, vs, ramp, as_),
             zone_share,
+            duration_ns.is_none(),
         )?;
         let lasts = sampled_seconds(&s.timing, &s.executed, &profile);
         Ok((s, profile, lasts * NS))

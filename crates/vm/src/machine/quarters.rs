@@ -48,6 +48,20 @@ impl Inner {
         Ok(())
     }
 
+    /// Step `k`'s knots and quarter points in order (its start, the three points, its
+    /// end), if the step is solved.
+    pub(super) fn points(&self, joints: &JointPath, k: usize) -> Option<[[f64; MAX_AXES]; 5]> {
+        self.filled[k].then(|| {
+            [
+                joints.q[k],
+                self.q[k][0],
+                self.q[k][1],
+                self.q[k][2],
+                joints.q[k + 1],
+            ]
+        })
+    }
+
     /// The largest |q‴| of axis `i` within step `k` by third differences of its knots and
     /// quarter points (a quarter step apart: sharper than the knots' differences), if the
     /// step is solved.

@@ -150,6 +150,20 @@ impl Trajectory {
             Trajectory::Cartesian { .. } => {}
         }
     }
+
+    /// Every time (s from its start) the motion's path jerk may jump: its profiles' phase
+    /// ends ([`Trajectory::phase_ends`]) and a smooth timing's knots (its jerk `c_k·ṡ`
+    /// changes with each step's `c_k`).
+    pub(super) fn jerk_breaks(&self, mut visit: impl FnMut(f64)) {
+        self.phase_ends(&mut visit);
+        if let Trajectory::Cartesian {
+            timing: Some(t), ..
+        } = self
+            && t.is_smooth()
+        {
+            (1..SEGMENTS).for_each(|k| visit(t.time_at_knot(k)));
+        }
+    }
 }
 
 impl Trajectory {

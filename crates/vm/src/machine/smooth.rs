@@ -1,0 +1,139 @@
+//! A Cartesian path timed within its axes' jerk limits ([`smooth_timing`]): the path
+//! sampled again on knots finer towards its ends (where its jerk ramps from and to rest
+//! lie), its jerk-limited timing (`vworks_model::timing::Timing::jerk_limited`), and that
+//! timing checked between the knots: every axis's speed and acceleration at the steps'
+//! quarter points (`quarters::Inner`), its jerk there with the steps' sharpest `q‴`. Where
+//! a check finds an axis over (by the path's curvature within a step), the whole timing
+//! runs slower by just enough.
+
+use vworks_model::timing::{JointPath, KNOTS, SEGMENTS, Timing};
+
+use super::path::{PathLimits, TIMING_MARGIN, check_turns, knot_derivatives};
+use super::plan::PlanError;
+use super::quarters::{Inner, Kink};
+use crate::MAX_AXES;
+
+/// How much finer the steps are at the path's ends than at its middle: knots at
+/// `g − E·sin(2πg)/2π` of the equal ones `g`, `E` this (steps `1 − E` of the mean at the ends).
+const END_GRADING: f64 = 0.5;
+
+/// The path `joints` (sampled on equal knots by `joints_at`) timed within every axis's
+/// speed, acceleration and jerk (`limits`: per axis) and its own speed and acceleration
+/// (`path`; `along` is not used): the path as sampled for it and the timing, or `None`
+/// where no jerk-limited timing is found (the caller keeps its S-curve): also where a knot
+/// or quarter point of its own fails (the path was checked on its equal knots; a point
+/// between them that is out of reach is not this timing's to report).
+pub(super) fn smooth_timing(
+    joints: &JointPath,
+    (speed, accel, jerk): (&[f64; MAX_AXES], &[f64; MAX_AXES], &[f64; MAX_AXES]),
+    path: &PathLimits<'_>,
+    joints_at: &impl Fn(f64, &[f64; MAX_AXES]) -> Result<[f64; MAX_AXES], PlanError>,
+) -> Option<(JointPath, Timing)> {
+    let n = joints.axes;
+    let mut timed = joints.clone();
+    // Graded near a singularity (`JointPath::grade`), else finer towards the ends.
+    let knots = joints.grade().unwrap_or_else(|| {
+        let mut s = [0.0; KNOTS];
+        let tau = 2.0 * std::f64::consts::PI;
+        for (k, v) in s.iter_mut().enumerate() {
+            let g = k as f64 / SEGMENTS as f64;
+            *v = g - END_GRADING * (tau * g).sin() / tau;
+        }
+        s[SEGMENTS] = 1.0;
+        s
+    });
+    timed.set_knots(&knots);
+    for (k, s) in knots.iter().enumerate().skip(1) {
+        let prev = timed.q[k - 1];
+        timed.q[k] = joints_at(*s, &prev).ok()?;
+    }
+    check_turns(&timed).ok()?;
+    let derivatives = knot_derivatives(&timed);
+    let margin = 1.0 - TIMING_MARGIN;
+    let (speed_timed, accel_timed, jerk_timed) = (
+        speed.map(|v| v * margin),
+        accel.map(|a| a * margin),
+        jerk.map(|j| j * margin),
+    );
+    let limits = path.with_axes(&speed_timed[..n], &accel_timed[..n], None);
+    let timing = Timing::jerk_limited(&timed, &limits, &jerk_timed[..n]).ok()?;
+    // Between the knots: the quarter points of every step.
+    let mut inner = Inner::new();
+    inner.fill(&timed, &[true; SEGMENTS], joints_at).ok()?;
+    let mut ratios = [0.0f64; SEGMENTS];
+    let state = |_: usize, s: f64| {
+        let (x, u, _) = timing.state_at_place(s);
+        (x, u)
+    };
+    let (rv, ra) = inner.ratios(
+        &timed,
+        (&speed[..n], &accel[..n]),
+        state,
+        &[Kink::None; SEGMENTS],
+        &mut ratios,
+    );
+    let rj = jerk_ratio(&timed, &derivatives, &inner, &timing, &jerk[..n]);
+    let over = rv.max(ra.sqrt()).max(rj.cbrt());
+    let timing = if over > 1.0 {
+        timing.slower(over)
+    } else {
+        timing
+    };
+    Some((timed, timing))
+}
+
+/// The largest ratio of an axis's jerk to its limit at the knots and quarter points of
+/// every step under `timing`: `q′·s⃛ + 3q″·ṡ·s̈ + q‴·ṡ³` there, slopes and curvatures by
+/// differences over the quarter grid (at a knot, the knot's own), `q‴` from the step's two
+/// third differences (at 1.5 and 2.5 quarters: linear between and beyond them) and half
+/// their difference added as `|·|·ṡ³` (how much `q‴` may change across the step beyond
+/// that line).
+fn jerk_ratio(
+    joints: &JointPath,
+    derivatives: &super::path::KnotDerivatives,
+    inner: &Inner,
+    timing: &Timing,
+    jerk: &[f64],
+) -> f64 {
+    let mut worst = 0.0f64;
+    for k in 0..SEGMENTS {
+        let h = 0.25 * joints.step(k);
+        let Some(points) = inner.points(joints, k) else {
+            continue;
+        };
+        for (i, j) in jerk.iter().enumerate() {
+            if !j.is_finite() {
+                continue;
+            }
+            let q = points.map(|p| p[i]);
+            let third =
+                |a: usize| (q[a + 3] - 3.0 * q[a + 2] + 3.0 * q[a + 1] - q[a]) / (h * h * h);
+            let (t0, t1) = (third(0), third(1));
+            for p in 0..=4 {
+                let s = joints.knot(k) + p as f64 * h;
+                // (Just inside the step at its knots: the step's own jerk.)
+                let at = match p {
+                    0 => s + 1e-9 * h,
+                    4 => joints.knot(k + 1) - 1e-9 * h,
+                    _ => s,
+                };
+                let (x, u, sddd) = timing.state_at_place(at);
+                let (d1, d2) = match p {
+                    0 => derivatives[k][i],
+                    4 => derivatives[k + 1][i],
+                    _ => (
+                        (q[p + 1] - q[p - 1]) / (2.0 * h),
+                        (q[p + 1] - 2.0 * q[p] + q[p - 1]) / (h * h),
+                    ),
+                };
+                let d3 = t0 + (t1 - t0) * (p as f64 - 1.5);
+                let sd = x.max(0.0).sqrt();
+                let cube = sd * sd * sd;
+                let load = (d1 * sddd + 3.0 * d2 * sd * u + d3 * cube).abs()
+                    + 0.5 * (t1 - t0).abs() * cube;
+                worst = worst.max(load / j);
+            }
+        }
+    }
+    worst
+}
