@@ -19,10 +19,14 @@
 //! constraints using sequential convex programming", IEEE T-RO 2013). Every other limit is
 //! linear in `(x_k, u_k)`, at the knots and halfway along each step (where `x` and `u` are
 //! linear in the unknowns too). The objective is the largest `Σ x_k` (as bench/jerk.py's
-//! oracle: without jerk limits this is the time-optimal timing exactly). The programs are
-//! solved by Clarabel (an interior-point solver; pure Rust, deterministic); the first
-//! tangents are at the timing without jerk limits ([`Timing::optimal`]), and the rounds
-//! stop when `Σ x` grows by less than [`SETTLED`] of itself.
+//! oracle: without jerk limits this is the time-optimal timing exactly; with them it is a
+//! close proxy for the least time). The programs are solved by [`super::lp`], an
+//! interior-point solver for programs banded along a path (deterministic; tested against
+//! Clarabel). The first tangents are at the timing without jerk limits
+//! ([`Timing::optimal`]), capped near the ends by what a constant jerk from rest can
+//! reach, and the rounds stop when `Σ x` grows by less than [`SETTLED`] of itself, or a
+//! program finds no solution (the best so far is kept; none at all: an error, and the
+//! caller keeps its S-curve).
 //!
 //! The jerk is kept at the knots (with the step's `c` on either side) and the speeds and
 //! accelerations at the knots and halfway: between, the path's curvature moves them a
@@ -45,9 +49,11 @@ const SERIES_TERMS: usize = 11;
 struct Rows {
     eq: SparseRows,
     ineq: SparseRows,
-    /// Column scales: `x` and `u` are solved for in units of their largest value without
+    /// Column scales: each `x_k` is solved for in units of its first guess (from the
+    /// largest without jerk limits, near the ends far less), each `u_k` in units of the
+    /// largest `s̈` without jerk limits.
     /// jerk limits.
-    scale: [f64; 2],
+    scale: Vec<f64>,
 }
 
 /// No column: `x` and `u` at the ends, which are 0 (rest).
@@ -56,7 +62,7 @@ const NONE: usize = usize::MAX;
 const UNKNOWNS: usize = 2 * (KNOTS - 2);
 
 impl Rows {
-    fn new(scale: [f64; 2]) -> Rows {
+    fn new(scale: Vec<f64>) -> Rows {
         Rows {
             eq: SparseRows::new(),
             ineq: SparseRows::new(),
@@ -72,12 +78,16 @@ impl Rows {
         terms
             .iter()
             .filter(|(v, _)| *v != NONE)
-            .map(|&(v, a)| (v, a * self.scale[v % 2]))
+            .map(|&(v, a)| (v, a * self.scale[v]))
     }
 
     /// One row `Σ coef·var ≤ rhs` over `(var, coef)`, scaled to a right-hand side of 1
     /// where it is positive.
     fn push(&mut self, terms: &[(usize, f64)], rhs: f64) {
+        // (No limit: no row.)
+        if rhs.is_infinite() {
+            return;
+        }
         let norm = if rhs > 0.0 {
             rhs
         } else {
@@ -126,8 +136,9 @@ fn ui(k: usize) -> usize {
 
 /// The band order of the programs' Newton systems: per knot `x_k`, `u_k`, then the
 /// equality of the step after it (the first step's before knot 1): `x_k` at `3k − 2`,
-/// `u_k` at `3k − 1`, step `j`'s equality at `3j`. A row couples knots at most two apart
-/// (a jerk row: `u` of the knots either side of its own), six places.
+/// `u_k` at `3k − 1`, step `j`'s equality at `3j`. The widest row spans four places: a
+/// jerk row at knot `k` with the step after it (`x_k`, `u_k`, `u_{k+1}`) and a step's
+/// middle (`x` and `u` of both its knots).
 fn band_places() -> Vec<usize> {
     let mut place = vec![0; UNKNOWNS + SEGMENTS];
     for k in 1..SEGMENTS {
@@ -141,7 +152,7 @@ fn band_places() -> Vec<usize> {
 }
 
 /// The half-band of the programs' Newton systems ([`band_places`]).
-const BAND: usize = 7;
+const BAND: usize = 4;
 
 /// Step `j`'s `c` (`s⃛ = c·ṡ`) as terms in the `u`: from rest at a constant jerk on the
 /// first step (`u₁/(3Δ)`), to rest on the last (`−u/(3Δ)`), `(u_{j+1} − u_j)/Δ` between.
@@ -383,10 +394,30 @@ impl Timing {
         if !(x_scale > 0.0 && u_scale > 0.0 && x_scale.is_finite() && u_scale.is_finite()) {
             return Err(TimingError::Stuck { knot: 0, axis: 0 });
         }
-        let mut fixed = Rows::new([x_scale, u_scale]);
+        // The first tangents: at the timing without jerk limits, but near the ends no
+        // faster than the largest constant jerk the axes allow there reaches from rest
+        // (s = J·t³/6 and ṡ = J·t²/2: ṡ² = 6^{4/3}/4·J^{2/3}·s^{4/3} at s from rest).
+        let mut guess = unjerked.x;
+        for (k, g) in guess.iter_mut().enumerate() {
+            let path_jerk = (0..path.axes)
+                .filter(|i| axis_jerk[*i].is_finite())
+                .map(|i| axis_jerk[i] / slopes.after[k][i].0.abs())
+                .fold(f64::INFINITY, f64::min);
+            let from_rest = path.knot(k).min(1.0 - path.knot(k));
+            if path_jerk.is_finite() {
+                let reach = 6f64.powf(4.0 / 3.0) / 4.0
+                    * path_jerk.powf(2.0 / 3.0)
+                    * from_rest.powf(4.0 / 3.0);
+                *g = g.min(reach);
+            }
+        }
+        let mut scale = vec![u_scale; UNKNOWNS];
+        for k in 1..SEGMENTS {
+            scale[xi(k)] = guess[k].max(1e-9 * x_scale);
+        }
+        let mut fixed = Rows::new(scale);
         fixed_rows(path, &slopes, limits, &mut fixed);
         let place = band_places();
-        let mut guess = unjerked.x;
         let mut best: Option<([f64; KNOTS], [f64; KNOTS], f64)> = None;
         for _ in 0..MAX_ROUNDS {
             let mut rows = fixed.clone();
@@ -405,7 +436,7 @@ impl Timing {
                 break;
             }
             for (g, x) in guess.iter_mut().zip(&x) {
-                *g = x.max(1e-12 * x_scale);
+                *g = x.max(1e-9 * x_scale);
             }
         }
         let (x, u, _) = best.ok_or(TimingError::Stuck { knot: 0, axis: 0 })?;
@@ -512,8 +543,8 @@ impl Timing {
     pub(super) fn smooth_at(&self, k: usize, tau: f64) -> PathState {
         let n = SEGMENTS;
         let d = self.s[k + 1] - self.s[k];
-        let span = self.t[k + 1] - self.t[k];
-        let tau = tau.clamp(0.0, span);
+        let span = (self.t[k + 1] - self.t[k]).max(0.0);
+        let tau = tau.max(0.0).min(span);
         if k == 0 || k == n - 1 {
             let v = self.x[if k == 0 { 1 } else { k }].sqrt();
             let jerk = 2.0 * v / (span * span);
@@ -547,8 +578,8 @@ impl Timing {
     pub(super) fn smooth_time_in(&self, k: usize, ds: f64) -> f64 {
         let n = SEGMENTS;
         let d = self.s[k + 1] - self.s[k];
-        let span = self.t[k + 1] - self.t[k];
-        let ds = ds.clamp(0.0, d);
+        let span = (self.t[k + 1] - self.t[k]).max(0.0);
+        let ds = ds.max(0.0).min(d);
         if k == 0 || k == n - 1 {
             let v = self.x[if k == 0 { 1 } else { k }].sqrt();
             let jerk = 2.0 * v / (span * span);
@@ -561,44 +592,67 @@ impl Timing {
         let (b, c) = self.curve[k];
         let v = self.x[k].sqrt();
         let there = (self.x[k] + 2.0 * b * ds + c * ds * ds).max(0.0).sqrt();
-        let mut tau = if v + there > 0.0 {
-            (2.0 * ds / (v + there)).min(span)
+        let guess = if v + there > 0.0 {
+            2.0 * ds / (v + there)
         } else {
             0.0
         };
-        for _ in 0..NEWTON_ROUNDS {
-            let (sigma, speed) = advance(v, b, c, tau);
-            if speed <= 0.0 {
-                break;
-            }
-            let next = (tau - (sigma - ds) / speed).clamp(0.0, span);
-            let settled = (next - tau).abs() <= 1e-15 * span;
-            tau = next;
-            if settled {
-                break;
-            }
-        }
-        tau
+        time_to(v, b, c, ds, guess, Some(span.max(0.0)))
+            .unwrap_or(guess)
+            .max(0.0)
+            .min(span.max(0.0))
     }
 }
 
-/// Newton steps at most for a time within a step.
-const NEWTON_ROUNDS: usize = 50;
+/// Newton (or bisection) steps at most for a time within a step.
+const NEWTON_ROUNDS: usize = 100;
 
 /// How long a step of length `d` takes from speed `v0` (to `v1`, its speed at the end)
-/// with `σ̈ = b + c·σ`: Newton's method on `σ(t) = d` from the time at constant `s̈`.
+/// with `σ̈ = b + c·σ` ([`time_to`] from the time at constant `s̈`).
 fn step_duration(v0: f64, v1: f64, b: f64, c: f64, d: f64) -> Option<f64> {
-    let mut tau = 2.0 * d / (v0 + v1);
+    time_to(v0, b, c, d, 2.0 * d / (v0 + v1), None)
+}
+
+/// The time `τ` at which `σ(τ) = target` (`σ` from 0 at speed `v`, `σ̈ = b + c·σ`, its
+/// speed positive up to there), from the guess `guess`, within `[0, span]` if given:
+/// Newton's method kept inside a bracket that bisection narrows where a Newton step would
+/// leave it (`σ` grows exponentially where `c` is large: plain Newton overshoots).
+fn time_to(v: f64, b: f64, c: f64, target: f64, guess: f64, span: Option<f64>) -> Option<f64> {
+    if target <= 0.0 {
+        return Some(0.0);
+    }
+    // A bracket [lo, hi] with σ(lo) ≤ target ≤ σ(hi).
+    let (mut lo, mut hi) = (0.0f64, span.unwrap_or(guess.max(f64::MIN_POSITIVE)));
+    if span.is_none() {
+        let mut grown = 0;
+        while advance(v, b, c, hi).0 < target {
+            lo = hi;
+            hi *= 2.0;
+            grown += 1;
+            if grown > 200 || !hi.is_finite() {
+                return None;
+            }
+        }
+    }
+    let mut tau = guess.clamp(lo, hi);
     for _ in 0..NEWTON_ROUNDS {
-        let (sigma, speed) = advance(v0, b, c, tau);
-        if speed.is_nan() || speed <= 0.0 {
+        let (sigma, speed) = advance(v, b, c, tau);
+        if !sigma.is_finite() || !speed.is_finite() {
             return None;
         }
-        let next = tau - (sigma - d) / speed;
-        if !(next > 0.0 && next.is_finite()) {
-            return None;
+        if sigma < target {
+            lo = tau;
+        } else {
+            hi = tau;
         }
-        let settled = (next - tau).abs() <= 1e-15 * tau;
+        let newton = tau - (sigma - target) / speed;
+        let next = if speed > 0.0 && newton > lo && newton < hi {
+            newton
+        } else {
+            0.5 * (lo + hi)
+        };
+        let settled =
+            (next - tau).abs() <= 1e-15 * next.max(f64::MIN_POSITIVE) || hi - lo <= 1e-15 * hi;
         tau = next;
         if settled {
             break;
@@ -655,8 +709,8 @@ fn solve(rows: &Rows, place: &[usize]) -> Option<([f64; KNOTS], [f64; KNOTS])> {
     let mut x = [0.0; KNOTS];
     let mut u = [0.0; KNOTS];
     for k in 1..SEGMENTS {
-        x[k] = z[xi(k)] * rows.scale[0];
-        u[k] = z[ui(k)] * rows.scale[1];
+        x[k] = z[xi(k)] * rows.scale[xi(k)];
+        u[k] = z[ui(k)] * rows.scale[ui(k)];
     }
     Some((x, u))
 }
@@ -716,7 +770,6 @@ mod tests {
         let (v, a, j) = ([2.0], [4.0], [40.0]);
         let t = Timing::jerk_limited(&p, &limits(&v, &a), &j).unwrap();
         let d = t.duration();
-        eprintln!("duration {d}");
         assert!((1.6..1.6 * 1.01).contains(&d), "{d}");
         let w = sampled(&t, q, 1, [&v, &a, &j]);
         assert!(
@@ -763,7 +816,11 @@ mod tests {
         let mut slopes = KnotSlopes::new();
         checked_slopes(&p, &lim, &mut slopes).unwrap();
         let d3 = third_slopes(&p, &slopes);
-        let mut rows = Rows::new([20.0, 50.0]);
+        let mut rows = Rows::new(
+            (0..UNKNOWNS)
+                .map(|v| if v % 2 == 0 { 20.0 } else { 50.0 })
+                .collect(),
+        );
         fixed_rows(&p, &slopes, &lim, &mut rows);
         jerk_rows(&p, &slopes, &d3, &j, &unjerked.x, &mut rows);
         let (ours, _) = solve(&rows, &band_places()).unwrap();
@@ -797,7 +854,7 @@ mod tests {
         solver.solve();
         assert_eq!(solver.solution.status, SolverStatus::Solved);
         let theirs_total: f64 = (1..SEGMENTS)
-            .map(|k| solver.solution.x[xi(k)] * rows.scale[0])
+            .map(|k| solver.solution.x[xi(k)] * rows.scale[xi(k)])
             .sum();
         assert!(
             (ours_total - theirs_total).abs() <= 1e-7 * theirs_total,
@@ -805,12 +862,12 @@ mod tests {
         );
         let mut z = vec![0.0; UNKNOWNS];
         for k in 1..SEGMENTS {
-            z[xi(k)] = ours[k] / rows.scale[0];
+            z[xi(k)] = ours[k] / rows.scale[xi(k)];
         }
         // (u from the solution again: the rows are in the scaled unknowns.)
         let (_, u) = solve(&rows, &band_places()).unwrap();
         for k in 1..SEGMENTS {
-            z[ui(k)] = u[k] / rows.scale[1];
+            z[ui(k)] = u[k] / rows.scale[ui(k)];
         }
         for r in 0..rows.ineq.len() {
             assert!(rows.ineq.dot(r, &z) <= rows.ineq.rhs[r] + 1e-8, "row {r}");

@@ -18,8 +18,10 @@
 //! - a forward pass from rest takes the largest `u` that stays within them.
 //!
 //! The result is exact arithmetic on the samples: no iteration, no tolerance, the same
-//! bits for the same inputs. Nothing allocates: a [`Timing`] is three arrays of [`KNOTS`]
-//! numbers (the path speed squared, the time and the place of each knot).
+//! bits for the same inputs. Nothing allocates: a [`Timing`] is arrays of [`KNOTS`]
+//! numbers (the path speed squared, the time and the place of each knot, each step's
+//! curve). With jerk limits, [`Timing::jerk_limited`] (`jerk`, which allocates its
+//! linear programs) gives a smooth timing.
 
 use crate::ik::MAX_AXES;
 
@@ -831,9 +833,13 @@ impl Timing {
     }
 
     /// The same timing `factor` (≥ 1) times slower: every speed divided by it, every
-    /// acceleration by its square.
+    /// acceleration by its square (a factor that is not a positive finite number: the
+    /// same timing).
     pub fn slower(&self, factor: f64) -> Timing {
         let mut out = self.clone();
+        if !(factor.is_finite() && factor > 0.0) {
+            return out;
+        }
         for x in &mut out.x {
             *x /= factor * factor;
         }
@@ -848,7 +854,9 @@ impl Timing {
     }
 
     /// `ṡ²` at knot `k` and the path acceleration `s̈` over step `k` (from knot `k` to
-    /// `k + 1`): the timing's state anywhere on the step is `x_k + 2·s̈·(s − s_k)`.
+    /// `k + 1`): the timing's state anywhere on the step is `x_k + 2·s̈·(s − s_k)`. For a
+    /// smooth timing, whose `s̈` changes along the step, the step's mean `s̈` (the same
+    /// `x` at both its knots; [`Timing::state_at_place`] gives the state anywhere).
     pub fn step_state(&self, k: usize) -> (f64, f64) {
         let k = k.min(SEGMENTS - 1);
         let delta = self.s[k + 1] - self.s[k];

@@ -182,7 +182,7 @@ impl Inner {
 
 /// The larger of a ratio so far and a new one, where a ratio that is not a number (joints
 /// of NaN: never a limit kept) counts as infinitely over (`f64::max` would drop it).
-fn worse(so_far: f64, ratio: f64) -> f64 {
+pub(super) fn worse(so_far: f64, ratio: f64) -> f64 {
     if ratio.is_nan() {
         f64::INFINITY
     } else {

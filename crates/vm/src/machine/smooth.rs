@@ -10,7 +10,7 @@ use vworks_model::timing::{JointPath, KNOTS, SEGMENTS, Timing};
 
 use super::path::{PathLimits, TIMING_MARGIN, check_turns, knot_derivatives};
 use super::plan::PlanError;
-use super::quarters::{Inner, Kink};
+use super::quarters::{Inner, Kink, worse};
 use crate::MAX_AXES;
 
 /// How much finer the steps are at the path's ends than at its middle: knots at
@@ -74,6 +74,10 @@ pub(super) fn smooth_timing(
     );
     let rj = jerk_ratio(&timed, &derivatives, &inner, &timing, &jerk[..n]);
     let over = rv.max(ra.sqrt()).max(rj.cbrt());
+    // (A ratio that is not a number counts as infinitely over: no timing.)
+    if !over.is_finite() {
+        return None;
+    }
     let timing = if over > 1.0 {
         timing.slower(over)
     } else {
@@ -131,7 +135,7 @@ fn jerk_ratio(
                 let cube = sd * sd * sd;
                 let load = (d1 * sddd + 3.0 * d2 * sd * u + d3 * cube).abs()
                     + 0.5 * (t1 - t0).abs() * cube;
-                worst = worst.max(load / j);
+                worst = worse(worst, load / j);
             }
         }
     }

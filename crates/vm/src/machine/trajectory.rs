@@ -34,7 +34,8 @@ pub(super) enum Trajectory {
     },
     /// Cartesian: the TCP along `path`, orientation by slerp; joints by IK. The path
     /// fraction follows `profile`, or `timing` where the profile would take an axis past
-    /// a limit (the time-optimal timing within them).
+    /// a limit (the time-optimal timing within them) or, with jerk limits, where the
+    /// jerk-limited timing is faster than the profile.
     Cartesian {
         path: Path,
         from: Iso,
