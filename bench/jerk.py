@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""How close are vworks's jerk-limited straight lines to the fastest timing of the same path
-within the same axis speeds, accelerations and jerks? toppra has no jerk limits, so this
+"""How close are vworks's jerk-limited straight lines and arcs to the fastest timing of the
+same path within the same axis speeds, accelerations and jerks? toppra has no jerk limits, so this
 script carries its own oracle, checked against Ruckig (PyPI `ruckig`), which is exact for
 one axis.
 
@@ -29,13 +29,16 @@ time-optimal duration at 200 steps and 0.07 % at 800, from below
 (`tests/python/test_jerk_oracle.py`).
 
 **The comparison** (`main`): the random straight lines of bench/fidelity.py (seed 1) on the
-IRB 120, with every axis's jerk limit set in the workcell so that it ramps to its full
-acceleration in `--ramp` seconds (j = a / ramp); vworks's joint path is recorded at 1 ms,
-splined by TCP arc length (cubic), and timed by the oracle on 300 steps (and 40 more
-knots, geometrically closer, near each end, where a slow line's jerk ramps lie) within the same
-limits (each axis's speed and acceleration less 0.05 %, as vworks keeps them).
+IRB 120 (or, `--kind arc`, its arcs through their via points), with every axis's jerk
+limit set in the workcell so that it ramps to its full acceleration in `--ramp` seconds
+(j = a / ramp); vworks's joint path is recorded at 1 ms, splined by TCP arc length
+(cubic), and timed by the oracle on 300 steps (and 40 more knots, geometrically closer,
+near each end, where a slow line's jerk ramps lie) within the same limits (each axis's
+speed and acceleration less 0.05 %, as vworks keeps them); on an arc the TCP's whole
+acceleration, along it and towards the centre, within the model's TCP acceleration (the
+recorded path's p′ and p″ by the same spline, inside a 64-sided polygon around the disk).
 
-    .venv/bin/python bench/jerk.py [--cases 40] [--ramp 0.02] [--steps 300]
+    .venv/bin/python bench/jerk.py [--cases 40] [--ramp 0.02] [--steps 300] [--kind line|arc]
 
 Needs scipy and, for the check of the oracle, ruckig.
 """
@@ -62,10 +65,14 @@ def step_times(s, x):
     return 2.0 * np.diff(s) / np.maximum(v[:-1] + v[1:], 1e-300)
 
 
-def jerk_time(s, dq, ddq, vlim, alim, jlim, speed=math.inf, accel=math.inf):
+def jerk_time(s, dq, ddq, vlim, alim, jlim, speed=math.inf, accel=math.inf, tcp=None):
     """The fastest timing of the path q(s) found (see the module's doc): (duration (s), x, u,
     duration without the jerk limits). `s`: the N + 1 knots; `dq`, `ddq`: q′ and q″ there,
-    (N + 1, axes); limits per axis (`jlim` inf: none). None if a program has no solution."""
+    (N + 1, axes); limits per axis (`jlim` inf: none). `tcp`: for an arc, (p′, p″, e1, e2):
+    the TCP's position's derivatives by s at the knots ((N + 1, 3) each) and two unit
+    vectors spanning its plane; its whole acceleration p′·u + p″·ṡ² then stays within
+    `accel` at both ends of each step (inside a 64-sided polygon around that disk, at most
+    0.12 % outside it), not only |u|. None if a program has no solution."""
     from scipy.optimize import linprog
     from scipy.sparse import coo_matrix
 
@@ -88,7 +95,7 @@ def jerk_time(s, dq, ddq, vlim, alim, jlim, speed=math.inf, accel=math.inf):
     with np.errstate(divide="ignore"):
         xmax = np.min(np.where(dq != 0.0, (np.asarray(vlim) / dq) ** 2, np.inf), axis=1)
     xmax = np.minimum(xmax, speed ** 2)
-    ubound = accel if math.isfinite(accel) else None
+    ubound = accel if math.isfinite(accel) and tcp is None else None
     bounds = ([(0.0, float(m) if math.isfinite(m) else None) for m in xmax]
               + [(-ubound if ubound else None, ubound)] * n_steps)
     # accelerations at both ends of each step: ±(q′ u_k + q″ x) ≤ a
@@ -103,6 +110,20 @@ def jerk_time(s, dq, ddq, vlim, alim, jlim, speed=math.inf, accel=math.inf):
                 cols += [nx + idx, knot]
                 vals += [sign * dq[knot, i], sign * ddq[knot, i]]
                 rhs.append(np.full(n_steps, alim[i]))
+                r += n_steps
+    # an arc: the TCP's whole acceleration, faces f·(p′ u_k + p″ x) ≤ accel
+    if tcp is not None and math.isfinite(accel):
+        p1, p2, e1, e2 = tcp
+        phi = np.arange(64) * 2.0 * np.pi / 64
+        faces = np.outer(np.cos(phi), e1) + np.outer(np.sin(phi), e2)
+        for end in (0, 1):
+            idx = np.arange(n_steps)
+            knot = idx + end
+            for f in faces:
+                rows += [r + idx, r + idx]
+                cols += [nx + idx, knot]
+                vals += [p1[knot] @ f, p2[knot] @ f]
+                rhs.append(np.full(n_steps, accel))
                 r += n_steps
     accel_rows = (np.concatenate(rows), np.concatenate(cols), np.concatenate(vals), np.concatenate(rhs), r)
     # jerk: ±(acc of step k − acc of step k−1) ≤ j τ_k, k = 0..N (steps −1 and N at rest)
@@ -171,6 +192,12 @@ def jerk_time(s, dq, ddq, vlim, alim, jlim, speed=math.inf, accel=math.inf):
 
 def line_case(vworks, folder, case, ramp, steps, seed=1):
     """Case `case` of bench/fidelity.py's lines on the IRB 120 with jerk limits: a dict."""
+    return path_case(vworks, folder, case, ramp, steps, seed, "line")
+
+
+def path_case(vworks, folder, case, ramp, steps, seed=1, kind="line"):
+    """Case `case` of bench/fidelity.py's lines (`kind` "line", a move_l) or arcs ("arc", a
+    move_c through its via point) on the IRB 120 with jerk limits: a dict."""
     sys.path.insert(0, str(ROOT / "bench"))
     import fidelity
     from scipy.interpolate import CubicSpline
@@ -179,7 +206,9 @@ def line_case(vworks, folder, case, ramp, steps, seed=1):
     limits = fidelity.urdf_limits(model)
     jerks = limits[:, 3] / ramp
     q0, offset, speed = fidelity.draw_case(model, seed, 0, case, limits)
-    cell = fidelity.write_cell(folder, model, q0, offset, speed)
+    via = fidelity.draw_via(seed, 0, case, offset) if kind == "arc" else None
+    command = "move_c" if kind == "arc" else "move_l"
+    cell = fidelity.write_cell(folder, model, q0, offset, speed, via)
     cell.write_text(cell.read_text()
                     + "jerk = [" + ", ".join(f'"{math.degrees(j):.9f}deg/s3"' for j in jerks) + "]\n")
     row = {"case": case, "length_mm": float(np.linalg.norm(offset) * 1000.0), "speed_mps": speed}
@@ -193,10 +222,10 @@ def line_case(vworks, folder, case, ramp, steps, seed=1):
         row["skipped"] = fidelity.skip_reason(result)
         return row
     events = list(result.events)
-    start = next(i for i, e in enumerate(events) if e.kind == "motion_start" and e.data["command"] == "move_l")
+    start = next(i for i, e in enumerate(events) if e.kind == "motion_start" and e.data["command"] == command)
     t0, t1 = events[start].time_ns, next(e for e in events[start:] if e.kind == "motion_end").time_ns
     _, q, p = fidelity.record(loaded, t0, t1)
-    s, qk, _ = fidelity.path_samples(q, p)
+    s, qk, pk = fidelity.path_samples(q, p)
     spline = CubicSpline(s, qk)
     # Uniform, and denser near both ends, where a slow line's jerk ramps are short.
     length = s[-1] - s[0]
@@ -204,10 +233,16 @@ def line_case(vworks, folder, case, ramp, steps, seed=1):
     grid = np.unique(np.concatenate([np.linspace(s[0], s[-1], steps + 1), s[0] + ends, s[-1] - ends]))
     grid = grid[np.concatenate([[True], np.diff(grid) > 1e-12 * length])]  # (no step of no length)
     tcp_speed, tcp_accel = fidelity.urdf_tcp(model)
+    tcp = None
+    if via is not None:
+        centre, normal, _ = fidelity.circle(p[0], p[0] + via, p[0] + offset)  # the programmed circle
+        e1 = (p[0] - centre) / np.linalg.norm(p[0] - centre)
+        at = CubicSpline(s, pk)
+        tcp = (at(grid, 1), at(grid, 2), e1, np.cross(normal, e1))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         got = jerk_time(grid, spline(grid, 1), spline(grid, 2), limits[:, 2] * LIMIT_SHARE,
-                        limits[:, 3] * LIMIT_SHARE, jerks, min(speed, tcp_speed), tcp_accel)
+                        limits[:, 3] * LIMIT_SHARE, jerks, min(speed, tcp_speed), tcp_accel, tcp)
     if got is None:
         row["skipped"] = "the oracle found no timing"
         return row
@@ -222,22 +257,24 @@ def main():
     parser.add_argument("--cases", type=int, default=40)
     parser.add_argument("--ramp", type=float, default=0.02, help="each axis reaches its acceleration in this time (s)")
     parser.add_argument("--steps", type=int, default=300)
+    parser.add_argument("--kind", choices=["line", "arc"], default="line",
+                        help="straight lines (move_l) or circular arcs (move_c)")
     args = parser.parse_args()
     import vworks
 
     ratios, skipped = [], 0
     with tempfile.TemporaryDirectory() as tmp:
         for case in range(args.cases):
-            row = line_case(vworks, Path(tmp), case, args.ramp, args.steps)
+            row = path_case(vworks, Path(tmp), case, args.ramp, args.steps, kind=args.kind)
             if "skipped" in row:
                 skipped += 1
                 continue
             ratios.append(row["ratio"])
-            print(f"line {case:3d}: {row['length_mm']:5.0f} mm at {row['speed_mps']:g} m/s: vworks "
+            print(f"{args.kind} {case:3d}: {row['length_mm']:5.0f} mm at {row['speed_mps']:g} m/s: vworks "
                   f"{row['vworks_s']:.4f} s, oracle {row['oracle_s']:.4f} s ({row['ratio']:.4f}), "
                   f"without jerk limits {row['without_jerk_s']:.4f} s", flush=True)
     if ratios:
-        print(f"\n{len(ratios)} lines run, {skipped} skipped; vworks / oracle: median "
+        print(f"\n{len(ratios)} {args.kind}s run, {skipped} skipped; vworks / oracle: median "
               f"{np.median(ratios):.4f}, worst {max(ratios):.4f}, best {min(ratios):.4f}")
 
 

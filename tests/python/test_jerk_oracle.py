@@ -62,3 +62,17 @@ def test_jerk_limited_lines_are_within_1_percent_of_the_oracle_never_faster(case
     # S-curve slowed as a whole where an axis binds.
     assert row["ratio"] <= 1.01, row
     assert row["oracle_s"] >= row["without_jerk_s"], row
+
+
+@pytest.mark.oracle
+@pytest.mark.parametrize("case", [2, 6])
+def test_jerk_limited_arcs_are_within_1_percent_of_the_oracle_never_faster(case):
+    """Arcs (move_c): the oracle keeps the TCP's whole acceleration, along the arc and
+    towards its centre, as vworks does (docs/engine.md)."""
+    pytest.importorskip("scipy")
+    import vworks
+
+    with tempfile.TemporaryDirectory() as tmp:
+        row = jerk.path_case(vworks, Path(tmp), case, 0.02, 300, kind="arc")
+    assert "skipped" not in row, row
+    assert 0.998 <= row["ratio"] <= 1.01, row

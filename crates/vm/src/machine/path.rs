@@ -160,7 +160,7 @@ pub(super) fn sample_path(
         whole,
         along: None,
     };
-    let smooth = if ramp > 0.0 && jerk_timed {
+    let mut smooth = if ramp > 0.0 && jerk_timed {
         smooth_timing(&joints, (&speed, &accel, &jerk), &path_limits, &joints_at)
     } else {
         None
@@ -190,6 +190,11 @@ pub(super) fn sample_path(
                 _ => profile_samples(&joints, profile, &check, None, end),
             });
         }
+    }
+    // (No S-curve slower than the programmed one can beat a jerk-limited timing that is
+    // not: the searches below are for none.)
+    if let Some(found) = smooth.take_if(|_| smooth_lasts <= profile.t_total) {
+        return Ok(smooth_samples(found));
     }
     // The same trapezoid (S-curve) at the highest lower acceleration that keeps every
     // axis within its limits: where an axis binds only in the ramps (a short ramp at a

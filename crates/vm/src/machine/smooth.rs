@@ -2,9 +2,10 @@
 //! sampled again on knots finer towards its ends (where its jerk ramps from and to rest
 //! lie), its jerk-limited timing (`vworks_model::timing::Timing::jerk_limited`), and that
 //! timing checked between the knots: every axis's speed and acceleration at the steps'
-//! quarter points (`quarters::Inner`), its jerk there with the steps' sharpest `q‴`. Where
-//! a check finds an axis over (by the path's curvature within a step), the whole timing
-//! runs slower by just enough.
+//! quarter points (`quarters::Inner`), its jerk there with `q‴` from the steps' third
+//! differences. Where a speed or an acceleration is over (by the path's curvature within a
+//! step) those steps get less room and the path is timed again, once; what is still over
+//! makes the whole timing run slower by just enough.
 
 use vworks_model::timing::{JointPath, KNOTS, SEGMENTS, Timing};
 
@@ -16,6 +17,11 @@ use crate::MAX_AXES;
 /// How much finer the steps are at the path's ends than at its middle: knots at
 /// `g − E·sin(2πg)/2π` of the equal ones `g`, `E` this (steps `1 − E` of the mean at the ends).
 const END_GRADING: f64 = 0.5;
+
+/// How far over a speed or an acceleration between the knots must be for its steps to
+/// be given less room and the path timed again (below, the whole timing slows by as
+/// much, at most 0.1 %).
+const RETIME_FROM: f64 = 1.001;
 
 /// The path `joints` (sampled on equal knots by `joints_at`) timed within every axis's
 /// speed, acceleration and jerk (`limits`: per axis) and its own speed and acceleration
@@ -56,34 +62,46 @@ pub(super) fn smooth_timing(
         jerk.map(|j| j * margin),
     );
     let limits = path.with_axes(&speed_timed[..n], &accel_timed[..n], None);
-    let timing = Timing::jerk_limited(&timed, &limits, &jerk_timed[..n]).ok()?;
     // Between the knots: the quarter points of every step.
     let mut inner = Inner::new();
     inner.fill(&timed, &[true; SEGMENTS], joints_at).ok()?;
     let mut ratios = [0.0f64; SEGMENTS];
-    let state = |_: usize, s: f64| {
-        let (x, u, _) = timing.state_at_place(s);
-        (x, u)
-    };
-    let (rv, ra) = inner.ratios(
-        &timed,
-        (&speed[..n], &accel[..n]),
-        state,
-        &[Kink::None; SEGMENTS],
-        &mut ratios,
-    );
-    let rj = jerk_ratio(&timed, &derivatives, &inner, &timing, &jerk[..n]);
-    let over = rv.max(ra.sqrt()).max(rj.cbrt());
-    // (A ratio that is not a number counts as infinitely over: no timing.)
-    if !over.is_finite() {
-        return None;
+    // Where an axis's speed or acceleration goes over between the knots, its steps get
+    // less room and the path is timed again (once); what is still over, the jerk's too,
+    // slows the whole timing.
+    for round in 0..2 {
+        let timing = Timing::jerk_limited(&timed, &limits, &jerk_timed[..n]).ok()?;
+        let state = |_: usize, s: f64| {
+            let (x, u, _) = timing.state_at_place(s);
+            (x, u)
+        };
+        let (rv, ra) = inner.ratios(
+            &timed,
+            (&speed[..n], &accel[..n]),
+            state,
+            &[Kink::None; SEGMENTS],
+            &mut ratios,
+        );
+        let rj = jerk_ratio(&timed, &derivatives, &inner, &timing, &jerk[..n]);
+        let over = rv.max(ra.sqrt()).max(rj.cbrt());
+        // (A ratio that is not a number counts as infinitely over: no timing.)
+        if !over.is_finite() {
+            return None;
+        }
+        if over <= 1.0 {
+            return Some((timed, timing));
+        }
+        // (Over by less than RETIME_FROM: not worth the programs again.)
+        if round == 1 || rv.max(ra) <= RETIME_FROM {
+            return Some((timed, timing.slower(over)));
+        }
+        for (room, r) in timed.room.iter_mut().zip(&ratios) {
+            if *r > margin {
+                *room *= margin / r;
+            }
+        }
     }
-    let timing = if over > 1.0 {
-        timing.slower(over)
-    } else {
-        timing
-    };
-    Some((timed, timing))
+    None
 }
 
 /// The largest ratio of an axis's jerk to its limit at the knots and quarter points of
