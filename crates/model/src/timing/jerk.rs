@@ -52,7 +52,6 @@ struct Rows {
     /// Column scales: each `x_k` is solved for in units of its first guess (from the
     /// largest without jerk limits, near the ends far less), each `u_k` in units of the
     /// largest `s̈` without jerk limits.
-    /// jerk limits.
     scale: Vec<f64>,
 }
 
@@ -504,14 +503,12 @@ impl Timing {
         if !self.smooth {
             return (self.x[k] + 2.0 * b * sigma, b, 0.0);
         }
-        let n = SEGMENTS;
-        if k == 0 || k == n - 1 {
+        if k == 0 || k == SEGMENTS - 1 {
             // From or to rest at a constant jerk: x ∝ t⁴, s̈ ∝ t, t ∝ (the distance
             // from rest)^⅓.
             let (end, from_rest) = if k == 0 { (1, sigma) } else { (k, d - sigma) };
             let x_end = self.x[end];
-            let span = self.t[k + 1] - self.t[k];
-            let jerk = 2.0 * x_end.sqrt() / (span * span);
+            let (_, _, jerk) = self.end_step(k);
             let share = (from_rest / d).clamp(0.0, 1.0);
             let accel = 2.0 * x_end / (3.0 * d) * share.cbrt();
             let x = x_end * share * share.cbrt();
@@ -539,15 +536,22 @@ impl Timing {
         top.sqrt()
     }
 
-    /// The state `tau` seconds into step `k` of a smooth timing.
-    pub(super) fn smooth_at(&self, k: usize, tau: f64) -> PathState {
-        let n = SEGMENTS;
+    /// An end step of a smooth timing (the first or the last, from or to rest at a
+    /// constant jerk): its length in `s`, its duration `T` and its path jerk `J` (from
+    /// rest `ṡ = J·t²/2` and `s = J·t³/6`, so `T = 3Δ/√x` and `J = 2√x/T²`, `x` at its
+    /// other knot).
+    fn end_step(&self, k: usize) -> (f64, f64, f64) {
         let d = self.s[k + 1] - self.s[k];
         let span = (self.t[k + 1] - self.t[k]).max(0.0);
+        let v = self.x[if k == 0 { 1 } else { k }].sqrt();
+        (d, span, 2.0 * v / (span * span))
+    }
+
+    /// The state `tau` seconds into step `k` of a smooth timing.
+    pub(super) fn smooth_at(&self, k: usize, tau: f64) -> PathState {
+        let (d, span, jerk) = self.end_step(k);
         let tau = tau.max(0.0).min(span);
-        if k == 0 || k == n - 1 {
-            let v = self.x[if k == 0 { 1 } else { k }].sqrt();
-            let jerk = 2.0 * v / (span * span);
+        if k == 0 || k == SEGMENTS - 1 {
             let (sigma, speed, accel) = if k == 0 {
                 (
                     jerk * tau * tau * tau / 6.0,
@@ -576,13 +580,9 @@ impl Timing {
 
     /// The time from knot `k` of a smooth timing to `ds` further along step `k`.
     pub(super) fn smooth_time_in(&self, k: usize, ds: f64) -> f64 {
-        let n = SEGMENTS;
-        let d = self.s[k + 1] - self.s[k];
-        let span = (self.t[k + 1] - self.t[k]).max(0.0);
+        let (d, span, jerk) = self.end_step(k);
         let ds = ds.max(0.0).min(d);
-        if k == 0 || k == n - 1 {
-            let v = self.x[if k == 0 { 1 } else { k }].sqrt();
-            let jerk = 2.0 * v / (span * span);
+        if k == 0 || k == SEGMENTS - 1 {
             return if k == 0 {
                 (6.0 * ds / jerk).cbrt().min(span)
             } else {
@@ -597,10 +597,10 @@ impl Timing {
         } else {
             0.0
         };
-        time_to(v, b, c, ds, guess, Some(span.max(0.0)))
+        time_to(v, b, c, ds, guess, Some(span))
             .unwrap_or(guess)
             .max(0.0)
-            .min(span.max(0.0))
+            .min(span)
     }
 }
 
@@ -778,12 +778,17 @@ mod tests {
         );
     }
 
+    /// A curved path of two axes, and their speeds, accelerations and jerks.
+    fn curved(s: f64, i: usize) -> f64 {
+        if i == 0 { (3.0 * s).sin() } else { s * s }
+    }
+    const CURVED_LIMITS: ([f64; 2], [f64; 2], [f64; 2]) = ([1.0, 0.8], [3.0, 2.0], [30.0, 25.0]);
+
     /// The timing is continuous: the time of a place and the place at that time agree.
     #[test]
     fn time_and_place_agree() {
-        let q = |s: f64, i: usize| if i == 0 { (3.0 * s).sin() } else { s * s };
-        let p = path(2, q);
-        let (v, a, j) = ([1.0, 0.8], [3.0, 2.0], [30.0, 25.0]);
+        let (q, p) = (curved, path(2, curved));
+        let (v, a, j) = CURVED_LIMITS;
         let t = Timing::jerk_limited(&p, &limits(&v, &a), &j).unwrap();
         for k in 1..1000 {
             let s = k as f64 / 1000.0;
@@ -808,9 +813,8 @@ mod tests {
             DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus,
             ZeroConeT,
         };
-        let q = |s: f64, i: usize| if i == 0 { (3.0 * s).sin() } else { s * s };
-        let p = path(2, q);
-        let (v, a, j) = ([1.0, 0.8], [3.0, 2.0], [30.0, 25.0]);
+        let p = path(2, curved);
+        let (v, a, j) = CURVED_LIMITS;
         let lim = limits(&v, &a);
         let unjerked = Timing::optimal(&p, &lim).unwrap();
         let mut slopes = KnotSlopes::new();
@@ -823,7 +827,7 @@ mod tests {
         );
         fixed_rows(&p, &slopes, &lim, &mut rows);
         jerk_rows(&p, &slopes, &d3, &j, &unjerked.x, &mut rows);
-        let (ours, _) = solve(&rows, &band_places()).unwrap();
+        let (ours, ours_u) = solve(&rows, &band_places()).unwrap();
         let ours_total: f64 = ours.iter().sum();
         // Clarabel: the equalities, then the rows.
         let (mut ri, mut ci, mut vi, mut b) = (vec![], vec![], vec![], vec![]);
@@ -864,10 +868,8 @@ mod tests {
         for k in 1..SEGMENTS {
             z[xi(k)] = ours[k] / rows.scale[xi(k)];
         }
-        // (u from the solution again: the rows are in the scaled unknowns.)
-        let (_, u) = solve(&rows, &band_places()).unwrap();
         for k in 1..SEGMENTS {
-            z[ui(k)] = u[k] / rows.scale[ui(k)];
+            z[ui(k)] = ours_u[k] / rows.scale[ui(k)];
         }
         for r in 0..rows.ineq.len() {
             assert!(rows.ineq.dot(r, &z) <= rows.ineq.rhs[r] + 1e-8, "row {r}");

@@ -175,6 +175,11 @@ pub(super) fn sample_path(
         let end = timed.q[SEGMENTS];
         timed_samples(&timed, timing, (unslowed, worst_axis), end, None)
     };
+    // (No S-curve, the programmed one nor slower ones, can beat a jerk-limited timing
+    // faster than the programmed one: the checks and searches below are for none.)
+    if let Some(found) = smooth.take_if(|_| smooth_lasts < profile.t_total) {
+        return Ok(smooth_samples(found));
+    }
     if bounded && within_whole(profile, normal, whole) {
         let check = check_profile(
             &joints,
@@ -185,16 +190,8 @@ pub(super) fn sample_path(
             &joints_at,
         )?;
         if check.fits {
-            return Ok(match smooth {
-                Some(found) if smooth_lasts < profile.t_total => smooth_samples(found),
-                _ => profile_samples(&joints, profile, &check, None, end),
-            });
+            return Ok(profile_samples(&joints, profile, &check, None, end));
         }
-    }
-    // (No S-curve slower than the programmed one can beat a jerk-limited timing that is
-    // not: the searches below are for none.)
-    if let Some(found) = smooth.take_if(|_| smooth_lasts <= profile.t_total) {
-        return Ok(smooth_samples(found));
     }
     // The same trapezoid (S-curve) at the highest lower acceleration that keeps every
     // axis within its limits: where an axis binds only in the ramps (a short ramp at a

@@ -66,17 +66,8 @@ impl Inner {
     /// quarter points (a quarter step apart: sharper than the knots' differences), if the
     /// step is solved.
     pub(super) fn third_slope(&self, joints: &JointPath, k: usize, i: usize) -> Option<f64> {
-        if !self.filled[k] {
-            return None;
-        }
         let h = 0.25 * joints.step(k);
-        let q = [
-            joints.q[k][i],
-            self.q[k][0][i],
-            self.q[k][1][i],
-            self.q[k][2][i],
-            joints.q[k + 1][i],
-        ];
+        let q = self.points(joints, k)?.map(|p| p[i]);
         let third = |j: usize| (q[j + 3] - 3.0 * q[j + 2] + 3.0 * q[j + 1] - q[j]).abs();
         Some(third(0).max(third(1)) / (h * h * h))
     }
