@@ -140,3 +140,74 @@ proptest! {
         jerks_within(&src, ramp, true)?;
     }
 }
+
+/// When `src` ends, and the blend radius each `motion_start` carries.
+fn end_and_blends(src: &str, ramp: f64) -> (i64, Vec<Option<f64>>) {
+    let (mut v, _) = vm(src, ramp);
+    let (mut end, mut blends) = (0, Vec::new());
+    while let Next::Event(e) = v.next_event() {
+        match e.kind {
+            EventKind::Error { .. } => panic!("a runtime error\n{src}"),
+            EventKind::MotionStart { blend_m, .. } => blends.push(blend_m),
+            _ => {}
+        }
+        end = e.time;
+        v.perform();
+    }
+    (end, blends)
+}
+
+/// Lines from HOME by `(dx, dy)` mm each at `v` mm/s, the first ones with `zone`, the last
+/// to a stop.
+fn lines(legs: &[(i32, i32)], v: u32, zone: &str) -> String {
+    let mut src = format!("proc main() {{\n    move_j {HOME};\n    var p = current_pose();\n");
+    let (mut x, mut y) = (0, 0);
+    for (k, (dx, dy)) in legs.iter().enumerate() {
+        (x, y) = (x + dx, y + dy);
+        let z = if k + 1 == legs.len() {
+            "zone fine"
+        } else {
+            zone
+        };
+        src += &format!("    move_l offset(p, {x}mm, {y}mm, 0mm) speed {v}mm/s {z};\n");
+    }
+    src + "}\n"
+}
+
+/// Straight on, a corner timed as one path is the line itself (docs/engine.md, "Corners
+/// timed as one path"): two collinear 100 mm lines with `zone 10mm` on an arm with jerk
+/// limits take the robot over at the first one's look-ahead point (`blend=10mm`) and end
+/// when one 200 mm line does, within 0.5 % (each is timed on its own knots).
+#[test]
+fn a_straight_on_corner_with_jerk_limits_lasts_as_long_as_one_line() {
+    for ((dx, dy, v), ramp) in [
+        ((100, 0, 500), 0.02),
+        ((0, 100, 300), 0.05),
+        ((60, 80, 800), 0.05),
+    ] {
+        let (zoned, blends) = end_and_blends(&lines(&[(dx, dy), (dx, dy)], v, "zone 10mm"), ramp);
+        let (one, _) = end_and_blends(&lines(&[(2 * dx, 2 * dy)], v, "zone fine"), ramp);
+        assert_eq!(blends.last(), Some(&Some(0.01)), "({dx}, {dy}) at {v} mm/s");
+        let ratio = zoned as f64 / one as f64;
+        assert!(
+            (0.995..=1.005).contains(&ratio),
+            "({dx}, {dy}) at {v} mm/s: {zoned} vs {one}"
+        );
+    }
+}
+
+/// Two right-angle corners between 100 mm lines at 500 mm/s with `zone 10mm`, the axes
+/// ramping in 50 ms: both are timed as one path (`blend=10mm`), the program ends more than
+/// 5 % sooner than with `fine` points (758 ms against 829 ms measured), and every axis keeps
+/// its jerk at 1 kHz through both corners.
+#[test]
+fn right_angle_corners_with_jerk_limits_are_timed_as_one_path() {
+    let legs = [(100, 0), (0, 100), (-100, 0)];
+    let zoned = lines(&legs, 500, "zone 10mm");
+    let (end, blends) = end_and_blends(&zoned, 0.05);
+    let (fine, _) = end_and_blends(&lines(&legs, 500, "zone fine"), 0.05);
+    assert_eq!(blends[2..], [Some(0.01), Some(0.01)], "{blends:?}");
+    assert!((end as f64) < 0.95 * fine as f64, "{end} vs {fine}");
+    let r = jerk_ratios(&zoned, 0.05).unwrap();
+    assert!(r.iter().all(|r| *r <= 1.0 + JERK_TOLERANCE), "{r:?}");
+}

@@ -35,6 +35,7 @@
 use super::lp::{self, Program, SparseRows};
 use super::{JointPath, KNOTS, KnotSlopes, Limits, NORMAL_FACES, PathState, SEGMENTS, Timing};
 use super::{TimingError, checked_slopes};
+use crate::ik::MAX_AXES;
 
 /// Rounds of linear programs at most.
 const MAX_ROUNDS: usize = 12;
@@ -53,20 +54,32 @@ struct Rows {
     /// largest without jerk limits, near the ends far less), each `u_k` in units of the
     /// largest `s̈` without jerk limits.
     scale: Vec<f64>,
+    /// `x` and `u` at the first knot (given: 0 from rest, else the robot's state).
+    start: (f64, f64),
 }
 
-/// No column: `x` and `u` at the ends, which are 0 (rest).
+/// No column: `x` and `u` at the last knot, which are 0 (rest).
 const NONE: usize = usize::MAX;
+/// No column: `x` at the first knot, given ([`Rows::start`]).
+const X_START: usize = usize::MAX - 1;
+/// No column: `u` at the first knot, given.
+const U_START: usize = usize::MAX - 2;
 /// Unknowns: `x_k` and `u_k` for the knots between the ends.
 const UNKNOWNS: usize = 2 * (KNOTS - 2);
 
 impl Rows {
-    fn new(scale: Vec<f64>) -> Rows {
+    fn new(scale: Vec<f64>, start: (f64, f64)) -> Rows {
         Rows {
             eq: SparseRows::new(),
             ineq: SparseRows::new(),
             scale,
+            start,
         }
+    }
+
+    /// Whether the timing starts moving (not from rest).
+    fn moving(&self) -> bool {
+        self.start.0 > 0.0
     }
 
     /// `terms` in the scaled unknowns, the ends' left out.
@@ -76,17 +89,31 @@ impl Rows {
     ) -> impl Iterator<Item = (usize, f64)> + 'a {
         terms
             .iter()
-            .filter(|(v, _)| *v != NONE)
+            .filter(|(v, _)| *v < self.scale.len())
             .map(|&(v, a)| (v, a * self.scale[v]))
     }
 
+    /// What `terms` add up to at the ends, where `x` and `u` are given.
+    fn given(&self, terms: &[(usize, f64)]) -> f64 {
+        terms
+            .iter()
+            .map(|&(v, a)| match v {
+                X_START => a * self.start.0,
+                U_START => a * self.start.1,
+                _ => 0.0,
+            })
+            .sum()
+    }
+
     /// One row `Σ coef·var ≤ rhs` over `(var, coef)`, scaled to a right-hand side of 1
-    /// where it is positive.
+    /// where it is positive. (A row of the given start alone is no row: the start is
+    /// the robot's.)
     fn push(&mut self, terms: &[(usize, f64)], rhs: f64) {
         // (No limit: no row.)
-        if rhs.is_infinite() {
+        if rhs.is_infinite() || self.scaled_terms(terms).next().is_none() {
             return;
         }
+        let rhs = rhs - self.given(terms);
         let norm = if rhs > 0.0 {
             rhs
         } else {
@@ -110,23 +137,28 @@ impl Rows {
             .map(|(_, a)| a.abs())
             .fold(0.0, f64::max)
             .max(f64::MIN_POSITIVE);
+        let rhs = -self.given(terms) / norm;
         self.eq
-            .push(entries.into_iter().map(|(v, a)| (v, a / norm)), 0.0);
+            .push(entries.into_iter().map(|(v, a)| (v, a / norm)), rhs);
     }
 }
 
-/// `x_k`'s column ([`NONE`] at the ends).
+/// `x_k`'s column ([`X_START`] and [`NONE`] at the ends).
 fn xi(k: usize) -> usize {
-    if k == 0 || k >= SEGMENTS {
+    if k == 0 {
+        X_START
+    } else if k >= SEGMENTS {
         NONE
     } else {
         2 * (k - 1)
     }
 }
 
-/// `u_k`'s column ([`NONE`] at the ends).
+/// `u_k`'s column ([`U_START`] and [`NONE`] at the ends).
 fn ui(k: usize) -> usize {
-    if k == 0 || k >= SEGMENTS {
+    if k == 0 {
+        U_START
+    } else if k >= SEGMENTS {
         NONE
     } else {
         2 * (k - 1) + 1
@@ -154,9 +186,10 @@ fn band_places() -> Vec<usize> {
 const BAND: usize = 4;
 
 /// Step `j`'s `c` (`s⃛ = c·ṡ`) as terms in the `u`: from rest at a constant jerk on the
-/// first step (`u₁/(3Δ)`), to rest on the last (`−u/(3Δ)`), `(u_{j+1} − u_j)/Δ` between.
-fn step_c(j: usize, delta: f64) -> [(usize, f64); 2] {
-    if j == 0 {
+/// first step (`u₁/(3Δ)`; unless `moving`), to rest on the last (`−u/(3Δ)`),
+/// `(u_{j+1} − u_j)/Δ` between.
+fn step_c(j: usize, delta: f64, moving: bool) -> [(usize, f64); 2] {
+    if j == 0 && !moving {
         [(ui(1), 1.0 / (3.0 * delta)), (ui(0), 0.0)]
     } else if j == SEGMENTS - 1 {
         [(ui(j), -1.0 / (3.0 * delta)), (ui(j + 1), 0.0)]
@@ -168,11 +201,12 @@ fn step_c(j: usize, delta: f64) -> [(usize, f64); 2] {
 /// A column and its coefficient in a row.
 type Term = (usize, f64);
 
-/// Step `j`'s state halfway as terms: `(x, u)` there.
-fn step_middle(j: usize, delta: f64) -> ([Term; 4], [Term; 2]) {
+/// Step `j`'s state halfway as terms: `(x, u)` there (the first step from rest unless
+/// `moving`).
+fn step_middle(j: usize, delta: f64, moving: bool) -> ([Term; 4], [Term; 2]) {
     // (From and to rest at a constant jerk: x ∝ t⁴ and u ∝ t, t ∝ σ^⅓.)
     let (x_end, u_end) = (0.5f64.powf(4.0 / 3.0), 0.5f64.cbrt());
-    if j == 0 {
+    if j == 0 && !moving {
         (
             [(xi(1), x_end), (xi(0), 0.0), (ui(0), 0.0), (ui(1), 0.0)],
             [(ui(1), u_end), (ui(0), 0.0)],
@@ -205,27 +239,45 @@ fn scaled(out: &mut Vec<(usize, f64)>, a: f64, terms: &[(usize, f64)]) {
     out.extend(terms.iter().map(|&(v, c)| (v, a * c)));
 }
 
-/// Each step's `q‴` per axis (differences of `q″` across it).
-fn third_slopes(path: &JointPath, slopes: &KnotSlopes) -> Vec<[f64; crate::ik::MAX_AXES]> {
+/// Each step's `q‴` per axis at its start and its end: the differences of `q″` across it
+/// (the same at both), or `given` (a caller's finer estimate, as from points between the
+/// knots: where `q‴` jumps at a knot — a curve whose curvature begins there — differences
+/// of the knots' `q″` smear the jump over the steps on both sides).
+fn third_slopes(
+    path: &JointPath,
+    slopes: &KnotSlopes,
+    given: Option<&[StepThirds]>,
+) -> Vec<StepThirds> {
     (0..SEGMENTS)
         .map(|j| {
-            let mut d3 = [0.0; crate::ik::MAX_AXES];
+            if let Some(d3) = given.and_then(|g| g.get(j)) {
+                return *d3;
+            }
+            let mut d3 = [(0.0, 0.0); MAX_AXES];
             for (i, d) in d3.iter_mut().enumerate().take(path.axes) {
-                *d = (slopes.before[j + 1][i].1 - slopes.after[j][i].1) / path.step(j);
+                let v = (slopes.before[j + 1][i].1 - slopes.after[j][i].1) / path.step(j);
+                *d = (v, v);
             }
             d3
         })
         .collect()
 }
 
-/// The rows every round shares: rest at both ends, the steps' consistency, and every
-/// speed and acceleration at the knots and halfway.
+/// A step's `q‴` per axis at its start and at its end ([`Timing::jerk_limited_from`]).
+pub type StepThirds = [(f64, f64); MAX_AXES];
+
+/// The rows every round shares: the start given or from rest, rest at the end, the
+/// steps' consistency, and every speed and acceleration at the knots and halfway.
 fn fixed_rows(path: &JointPath, slopes: &KnotSlopes, lim: &Limits<'_>, rows: &mut Rows) {
     let n = SEGMENTS;
-    // Equalities, one per step in order: from rest at a constant jerk; x_{k+1} − x_k =
-    // Δ(u_k + u_{k+1}); to rest at a constant jerk. (At the ends x = u = 0: no unknowns.)
-    rows.push_eq(&[(xi(1), 1.0), (ui(1), -1.5 * path.step(0))]);
-    for k in 1..n - 1 {
+    let moving = rows.moving();
+    // Equalities, one per step in order: from rest at a constant jerk (or from the given
+    // start as any step); x_{k+1} − x_k = Δ(u_k + u_{k+1}); to rest at a constant jerk.
+    // (At the ends x and u are given: no unknowns.)
+    if !moving {
+        rows.push_eq(&[(xi(1), 1.0), (ui(1), -1.5 * path.step(0))]);
+    }
+    for k in usize::from(!moving)..n - 1 {
         let d = path.step(k);
         rows.push_eq(&[
             (xi(k + 1), 1.0),
@@ -236,16 +288,20 @@ fn fixed_rows(path: &JointPath, slopes: &KnotSlopes, lim: &Limits<'_>, rows: &mu
     }
     rows.push_eq(&[(xi(n - 1), 1.0), (ui(n - 1), 1.5 * path.step(n - 1))]);
     let curved = lim.path_whole.is_finite() && lim.path_normal > 0.0;
-    let face = lim.path_whole * (std::f64::consts::PI / (2.0 * NORMAL_FACES as f64)).cos();
     let mut terms: Vec<(usize, f64)> = Vec::with_capacity(8);
     // The limits at a point whose (x, u) are `x` and `u` (terms), slopes `d` per axis,
-    // room `room`.
+    // room `room`, and the path's own limits there if they change along it (`x_max`,
+    // tangent, normal, whole: [`crate::timing::KnotLimits`]).
     let mut point = |rows: &mut Rows,
                      x: &[(usize, f64)],
                      u: &[(usize, f64)],
                      d: &dyn Fn(usize) -> (f64, f64),
-                     room: f64| {
+                     room: f64,
+                     along: Option<[f64; 4]>| {
         let mut x_max = lim.path_speed * lim.path_speed;
+        if let Some([most, ..]) = along {
+            x_max = x_max.min(most);
+        }
         for i in 0..path.axes {
             let (d1, d2) = d(i);
             let amax = lim.axis_accel[i] * room;
@@ -273,51 +329,76 @@ fn fixed_rows(path: &JointPath, slopes: &KnotSlopes, lim: &Limits<'_>, rows: &mu
                 rows.push(&terms, lim.path_accel);
             }
         }
-        if curved {
+        // The TCP's acceleration along the path (u + tangent·x) and across it (normal·x)
+        // inside the polygon in the half disk of `whole` (as `Timing::optimal`'s).
+        let polygon = match along {
+            Some([_, tg, nm, whole]) => Some((tg, nm, whole)).filter(|_| whole.is_finite()),
+            None => curved.then_some((0.0, lim.path_normal, lim.path_whole)),
+        };
+        if let Some((tg, nm, whole)) = polygon {
+            let face = whole * (std::f64::consts::PI / (2.0 * NORMAL_FACES as f64)).cos();
             for j in 0..NORMAL_FACES {
                 let alpha = (j as f64 + 0.5) * std::f64::consts::PI / NORMAL_FACES as f64;
                 let (sin, cos) = alpha.sin_cos();
                 terms.clear();
                 scaled(&mut terms, cos, u);
-                scaled(&mut terms, sin * lim.path_normal, x);
+                scaled(&mut terms, cos * tg + sin * nm, x);
                 rows.push(&terms, face);
             }
         }
+    };
+    // The path's own limits at knot `k`, and halfway along step `j` (the tighter speed
+    // and whole acceleration, the mean curvature).
+    let at_knot = |k: usize| {
+        lim.along
+            .map(|al| [al.x_max[k], al.tangent[k], al.normal[k], al.whole[k]])
+    };
+    let halfway = |j: usize| {
+        lim.along.map(|al| {
+            [
+                al.x_max[j].min(al.x_max[j + 1]),
+                0.5 * (al.tangent[j] + al.tangent[j + 1]),
+                0.5 * (al.normal[j] + al.normal[j + 1]),
+                al.whole[j].min(al.whole[j + 1]),
+            ]
+        })
     };
     for k in 1..n {
         let (x, u) = ([(xi(k), 1.0)], [(ui(k), 1.0)]);
         let before = |i: usize| slopes.before[k][i];
         let after = |i: usize| slopes.after[k][i];
-        point(rows, &x, &u, &before, path.room[k - 1]);
+        point(rows, &x, &u, &before, path.room[k - 1], at_knot(k));
         let same = (0..path.axes).all(|i| slopes.before[k][i] == slopes.after[k][i]);
         if !same || path.room[k] != path.room[k - 1] {
-            point(rows, &x, &u, &after, path.room[k]);
+            point(rows, &x, &u, &after, path.room[k], at_knot(k));
         }
     }
     for j in 0..n {
         let delta = path.step(j);
-        let (x, u) = step_middle(j, delta);
+        let (x, u) = step_middle(j, delta, moving);
         let middle = |i: usize| {
             (
                 (path.q[j + 1][i] - path.q[j][i]) / delta,
                 0.5 * (slopes.after[j][i].1 + slopes.before[j + 1][i].1),
             )
         };
-        point(rows, &x, &u, &middle, path.room[j]);
+        point(rows, &x, &u, &middle, path.room[j], halfway(j));
     }
 }
 
-/// The jerk rows at the tangents at `guess` (`x̂` per knot): every axis with a jerk limit,
-/// at every knot, with the step's `c` on either side.
+/// The jerk rows at the tangents at `guess` (`x̂` per knot; at a given start, its `x`: the
+/// row is exact there): every axis with a jerk limit, at every knot, with the step's `c`
+/// on either side.
 fn jerk_rows(
     path: &JointPath,
     slopes: &KnotSlopes,
-    d3: &[[f64; crate::ik::MAX_AXES]],
+    d3: &[StepThirds],
     jerk: &[f64],
     guess: &[f64; KNOTS],
     rows: &mut Rows,
 ) {
     let n = SEGMENTS;
+    let moving = rows.moving();
     let mut terms: Vec<(usize, f64)> = Vec::with_capacity(8);
     for (i, &j) in jerk.iter().enumerate().take(path.axes) {
         if !j.is_finite() {
@@ -326,8 +407,10 @@ fn jerk_rows(
         // |g| ≤ j/√x at knot k, by its tangent at x̂: g·sign + j/(2x̂^{3/2})·x ≤ 3j/(2√x̂).
         for k in 0..=n {
             // (At the ends ṡ = 0: the jerk is q′·s⃛ of the end step, s⃛ = c·ṡ of its
-            // other knot.)
-            let (at, steps): (usize, &[usize]) = if k == 0 {
+            // other knot. A given start is a knot as any other, its step after it.)
+            let (at, steps): (usize, &[usize]) = if k == 0 && moving {
+                (0, &[0])
+            } else if k == 0 {
                 (1, &[0])
             } else if k == n {
                 (n - 1, &[n - 1])
@@ -346,13 +429,16 @@ fn jerk_rows(
                 } else {
                     slopes.after[k][i]
                 };
-                let c = step_c(step, path.step(step));
+                let c = step_c(step, path.step(step), moving);
                 for sign in [1.0, -1.0] {
                     terms.clear();
                     scaled(&mut terms, sign * d1, &c);
-                    if k != 0 && k != n {
+                    if (k != 0 || moving) && k != n {
                         terms.push((ui(k), sign * 3.0 * d2));
-                        terms.push((xi(k), sign * d3[step][i]));
+                        // (The step's q‴ at this knot: its end's if it ends here.)
+                        let (d3_start, d3_end) = d3[step][i];
+                        let d3 = if step < k { d3_end } else { d3_start };
+                        terms.push((xi(k), sign * d3));
                     }
                     terms.push((xi(at), slope));
                     rows.push(&terms, rhs);
@@ -365,15 +451,39 @@ fn jerk_rows(
 impl Timing {
     /// The fastest timing found of `path` from rest to rest within `limits` and every
     /// axis's jerk `axis_jerk` (`f64::INFINITY`: none): a smooth timing (see the module's
-    /// doc). `limits.along` is not supported (an error). Where the programs find no
-    /// timing, [`TimingError::Stuck`] (a path that can move has one: rest is inside every
-    /// program's rows).
+    /// doc). Where the programs find no timing, [`TimingError::Stuck`] (a path that can
+    /// move has one: rest is inside every program's rows).
     pub fn jerk_limited(
         path: &JointPath,
         limits: &Limits<'_>,
         axis_jerk: &[f64],
     ) -> Result<Timing, TimingError> {
-        if limits.along.is_some() || axis_jerk.len() < path.axes {
+        Timing::jerk_limited_from(path, limits, axis_jerk, (0.0, 0.0), None)
+    }
+
+    /// [`Timing::jerk_limited`] from a robot already moving: `ṡ²` and `s̈` at the path's
+    /// start are `start` (a corner taking over from the motion before; `(0, 0)`: from
+    /// rest), its first step a step as any other. Where no timing within the limits
+    /// continues from there (it is too fast to brake in time, or its acceleration cannot
+    /// turn soon enough), [`TimingError::Stuck`] or [`TimingError::TooFast`]. `third`:
+    /// each step's `q‴` per axis at its start and end where the caller knows it better
+    /// than differences of the knots' `q″` (one per step; `None`: those differences).
+    pub fn jerk_limited_from(
+        path: &JointPath,
+        limits: &Limits<'_>,
+        axis_jerk: &[f64],
+        start: (f64, f64),
+        third: Option<&[StepThirds]>,
+    ) -> Result<Timing, TimingError> {
+        let (x0, u0) = start;
+        if !(x0.is_finite() && x0 >= 0.0) {
+            return Err(TimingError::BadLimit(x0));
+        }
+        if !u0.is_finite() || (x0 == 0.0 && u0 != 0.0) {
+            return Err(TimingError::BadLimit(u0));
+        }
+        let moving = x0 > 0.0;
+        if axis_jerk.len() < path.axes {
             return Err(TimingError::BadLimit(f64::NAN));
         }
         if let Some(j) = axis_jerk[..path.axes]
@@ -382,10 +492,10 @@ impl Timing {
         {
             return Err(TimingError::BadLimit(*j));
         }
-        let unjerked = Timing::optimal(path, limits)?;
+        let unjerked = Timing::from_speed(path, limits, x0)?;
         let mut slopes = KnotSlopes::new();
         checked_slopes(path, limits, &mut slopes)?;
-        let d3 = third_slopes(path, &slopes);
+        let d3 = third_slopes(path, &slopes, third);
         let x_scale = unjerked.x.iter().fold(0.0f64, |m, x| m.max(*x));
         let u_scale = (0..SEGMENTS)
             .map(|k| unjerked.step_state(k).1.abs())
@@ -393,16 +503,22 @@ impl Timing {
         if !(x_scale > 0.0 && u_scale > 0.0 && x_scale.is_finite() && u_scale.is_finite()) {
             return Err(TimingError::Stuck { knot: 0, axis: 0 });
         }
-        // The first tangents: at the timing without jerk limits, but near the ends no
-        // faster than the largest constant jerk the axes allow there reaches from rest
-        // (s = J·t³/6 and ṡ = J·t²/2: ṡ² = 6^{4/3}/4·J^{2/3}·s^{4/3} at s from rest).
+        // The first tangents: at the timing without jerk limits, but near the ends (the
+        // last, and the first from rest) no faster than the largest constant jerk the
+        // axes allow there reaches from rest (s = J·t³/6 and ṡ = J·t²/2: ṡ² =
+        // 6^{4/3}/4·J^{2/3}·s^{4/3} at s from rest). At a given start, its own `x`.
         let mut guess = unjerked.x;
         for (k, g) in guess.iter_mut().enumerate() {
             let path_jerk = (0..path.axes)
                 .filter(|i| axis_jerk[*i].is_finite())
                 .map(|i| axis_jerk[i] / slopes.after[k][i].0.abs())
                 .fold(f64::INFINITY, f64::min);
-            let from_rest = path.knot(k).min(1.0 - path.knot(k));
+            let to_rest = 1.0 - path.knot(k);
+            let from_rest = if moving {
+                to_rest
+            } else {
+                path.knot(k).min(to_rest)
+            };
             if path_jerk.is_finite() {
                 let reach = 6f64.powf(4.0 / 3.0) / 4.0
                     * path_jerk.powf(2.0 / 3.0)
@@ -414,16 +530,18 @@ impl Timing {
         for k in 1..SEGMENTS {
             scale[xi(k)] = guess[k].max(1e-9 * x_scale);
         }
-        let mut fixed = Rows::new(scale);
+        guess[0] = x0;
+        let mut fixed = Rows::new(scale, start);
         fixed_rows(path, &slopes, limits, &mut fixed);
         let place = band_places();
         let mut best: Option<([f64; KNOTS], [f64; KNOTS], f64)> = None;
         for _ in 0..MAX_ROUNDS {
             let mut rows = fixed.clone();
             jerk_rows(path, &slopes, &d3, axis_jerk, &guess, &mut rows);
-            let Some((x, u)) = solve(&rows, &place) else {
+            let Some((mut x, mut u)) = solve(&rows, &place) else {
                 break;
             };
+            (x[0], u[0]) = start;
             let total: f64 = x.iter().sum();
             let settled = best
                 .as_ref()
@@ -442,7 +560,8 @@ impl Timing {
         Timing::smooth_from(path, &x, &u)
     }
 
-    /// The smooth timing with `ṡ²` and `s̈` at the knots `x` and `u` (both 0 at the ends).
+    /// The smooth timing with `ṡ²` and `s̈` at the knots `x` and `u` (both 0 at the end,
+    /// and at the start unless `x₀ > 0`).
     fn smooth_from(
         path: &JointPath,
         x: &[f64; KNOTS],
@@ -459,9 +578,10 @@ impl Timing {
             curve: [(0.0, 0.0); SEGMENTS],
             smooth: true,
         };
-        out.x[0] = 0.0;
+        out.x[0] = x[0].max(0.0);
         out.x[n] = 0.0;
-        for k in 1..n - 1 {
+        let first = usize::from(!out.moving());
+        for k in first..n - 1 {
             let d = path.step(k);
             let c = (u[k + 1] - u[k]) / d;
             let b = 0.5 * ((x[k + 1] - x[k]) / d - c * d);
@@ -475,7 +595,7 @@ impl Timing {
         let mut t = 0.0;
         for k in 0..n {
             let d = path.step(k);
-            let dt = if k == 0 {
+            let dt = if k == 0 && first == 1 {
                 3.0 * d / x[1].sqrt()
             } else if k == n - 1 {
                 3.0 * d / x[k].sqrt()
@@ -503,7 +623,7 @@ impl Timing {
         if !self.smooth {
             return (self.x[k] + 2.0 * b * sigma, b, 0.0);
         }
-        if k == 0 || k == SEGMENTS - 1 {
+        if self.rest_step(k) {
             // From or to rest at a constant jerk: x ∝ t⁴, s̈ ∝ t, t ∝ (the distance
             // from rest)^⅓.
             let (end, from_rest) = if k == 0 { (1, sigma) } else { (k, d - sigma) };
@@ -527,13 +647,24 @@ impl Timing {
         let k = k.min(SEGMENTS - 1);
         let mut top = self.x[k].max(self.x[k + 1]);
         let (b, c) = self.curve[k];
-        if self.smooth && c < 0.0 && k > 0 && k < SEGMENTS - 1 {
+        if self.smooth && c < 0.0 && !self.rest_step(k) {
             let sigma = -b / c;
             if sigma > 0.0 && sigma < self.s[k + 1] - self.s[k] {
                 top = top.max(self.x[k] + b * sigma);
             }
         }
         top.sqrt()
+    }
+
+    /// Whether the timing starts moving ([`Timing::jerk_limited_from`]).
+    pub fn moving(&self) -> bool {
+        self.x[0] > 0.0
+    }
+
+    /// Whether step `k` of a smooth timing is from or to rest at a constant jerk (the
+    /// last, and the first unless it starts moving).
+    pub(super) fn rest_step(&self, k: usize) -> bool {
+        (k == 0 && !self.moving()) || k == SEGMENTS - 1
     }
 
     /// An end step of a smooth timing (the first or the last, from or to rest at a
@@ -551,7 +682,7 @@ impl Timing {
     pub(super) fn smooth_at(&self, k: usize, tau: f64) -> PathState {
         let (d, span, jerk) = self.end_step(k);
         let tau = tau.max(0.0).min(span);
-        if k == 0 || k == SEGMENTS - 1 {
+        if self.rest_step(k) {
             let (sigma, speed, accel) = if k == 0 {
                 (
                     jerk * tau * tau * tau / 6.0,
@@ -582,7 +713,7 @@ impl Timing {
     pub(super) fn smooth_time_in(&self, k: usize, ds: f64) -> f64 {
         let (d, span, jerk) = self.end_step(k);
         let ds = ds.max(0.0).min(d);
-        if k == 0 || k == SEGMENTS - 1 {
+        if self.rest_step(k) {
             return if k == 0 {
                 (6.0 * ds / jerk).cbrt().min(span)
             } else {
@@ -744,7 +875,9 @@ mod tests {
             (0..axes).map(|i| q(s, i)).collect::<Vec<_>>()
         };
         let mut worst = [0.0f64; 3];
-        for k in -2..steps as isize {
+        // (From rest, the differences begin before the start; from a robot moving, there.)
+        let first = if t.moving() { 0 } else { -2 };
+        for k in first..steps as isize {
             let p: Vec<Vec<f64>> = (0..4).map(|j| at(k + j)).collect();
             for i in 0..axes {
                 let v = (p[1][i] - p[0][i]) / dt;
@@ -776,6 +909,38 @@ mod tests {
             w[0] <= 1.0 + 1e-5 && w[1] <= 1.0 + 1e-5 && w[2] <= 1.01,
             "{w:?}"
         );
+    }
+
+    /// The same axis taken over while moving. Cruising at 2 rad/s (`ṡ² = 1` of `q = 2s`,
+    /// `s̈ = 0`): it brakes over its last 0.6 rad in 0.6 s and cruises 1.4 rad in 0.7 s,
+    /// 1.3 s. At 1 rad/s and 4 rad/s² (`ṡ² = 0.25`, `s̈ = 2`): it keeps 4 rad/s² to
+    /// 1.8 rad/s (0.2 s, 0.28 rad), eases to 2 rad/s in 0.1 s (1.8·0.1 + 4·0.1²/2 −
+    /// 40·0.1³/6 = 0.19333 rad), brakes over 0.6 rad in 0.6 s and cruises the
+    /// 0.92667 rad left in 0.46333 s: 1.36333 s. Both within 1 % and no faster, their
+    /// limits kept sampled at 1 kHz from the start.
+    #[test]
+    fn one_axis_taken_over_while_moving() {
+        let q = |s: f64, _: usize| 2.0 * s;
+        let p = path(1, q);
+        let (v, a, j) = ([2.0], [4.0], [40.0]);
+        for (start, by_hand) in [((1.0, 0.0), 1.3), ((0.25, 2.0), 1.363_333)] {
+            let t = Timing::jerk_limited_from(&p, &limits(&v, &a), &j, start, None).unwrap();
+            let d = t.duration();
+            assert!(
+                (by_hand * (1.0 - 1e-6)..by_hand * 1.01).contains(&d),
+                "{start:?}: {d}"
+            );
+            let at0 = t.at(0.0);
+            assert!((at0.speed * at0.speed - start.0).abs() < 1e-12, "{at0:?}");
+            assert!((at0.accel - start.1).abs() < 1e-9, "{at0:?}");
+            let w = sampled(&t, q, 1, [&v, &a, &j]);
+            assert!(
+                w[0] <= 1.0 + 1e-5 && w[1] <= 1.0 + 1e-5 && w[2] <= 1.01,
+                "{start:?}: {w:?}"
+            );
+        }
+        // Too fast to brake in 2 rad (1 rad/s more than the limit): no timing.
+        assert!(Timing::jerk_limited_from(&p, &limits(&v, &a), &j, (2.25, 0.0), None).is_err());
     }
 
     /// A curved path of two axes, and their speeds, accelerations and jerks.
@@ -819,11 +984,12 @@ mod tests {
         let unjerked = Timing::optimal(&p, &lim).unwrap();
         let mut slopes = KnotSlopes::new();
         checked_slopes(&p, &lim, &mut slopes).unwrap();
-        let d3 = third_slopes(&p, &slopes);
+        let d3 = third_slopes(&p, &slopes, None);
         let mut rows = Rows::new(
             (0..UNKNOWNS)
                 .map(|v| if v % 2 == 0 { 20.0 } else { 50.0 })
                 .collect(),
+            (0.0, 0.0),
         );
         fixed_rows(&p, &slopes, &lim, &mut rows);
         jerk_rows(&p, &slopes, &d3, &j, &unjerked.x, &mut rows);

@@ -876,7 +876,7 @@ impl Timing {
         }
         // (A step whose s̈ falls through 0 peaks inside it.)
         let mut top = knots;
-        for k in 1..SEGMENTS - 1 {
+        for k in (0..SEGMENTS).filter(|k| !self.rest_step(*k)) {
             let (b, c) = self.curve[k];
             let sigma = if c < 0.0 { -b / c } else { -1.0 };
             if sigma > 0.0 && sigma < self.s[k + 1] - self.s[k] {
@@ -908,6 +908,9 @@ impl Timing {
     /// Where the path is at `time` seconds from its start (its start before, its end
     /// after).
     pub fn at(&self, time: f64) -> PathState {
+        if self.smooth && self.moving() && time <= 0.0 {
+            return self.smooth_at(0, 0.0);
+        }
         if time.is_nan() || time <= 0.0 {
             return PathState {
                 s: 0.0,
@@ -966,6 +969,7 @@ impl Timing {
 }
 
 mod jerk;
+pub use jerk::StepThirds;
 mod lp;
 #[cfg(test)]
 mod tests;

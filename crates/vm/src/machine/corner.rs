@@ -19,6 +19,13 @@
 //! across the path, knot by knot) and each motion's own path speed (its orientation speed
 //! on its own pieces; in the curve the two rotations compose).
 //!
+//! For an arm with jerk limits the progressions are `h(u) = 2u³ − u⁴` and its mirror
+//! ([`run_out`]): the same shares of `s`, and no second derivative at the joins, so the
+//! curvature and every axis's acceleration are continuous there; the path is timed within
+//! every axis's jerk from the robot's path speed *and acceleration* as it takes over
+//! (`smooth::time_smooth`, `Timing::jerk_limited_from`), its steps' `q‴` from their
+//! quarter points (it jumps where the curve begins).
+//!
 //! With an orientation zone wider than the curve (RAPID's `pzone_ori`, [`Turn`]), the
 //! tool turns over that wider stretch, centred on the curve, with progressions of the same
 //! form of its own; the position's curve is unchanged (docs/engine.md, "Orientation
@@ -26,15 +33,17 @@
 
 use vworks_model::RobotModel;
 use vworks_model::math::{Iso, V3, add, axpy, dot, mat_mul, norm, sub, transpose};
-use vworks_model::timing::{JointPath, KNOTS, KnotLimits, SEGMENTS};
+use vworks_model::timing::{JointPath, KNOTS, KnotLimits, SEGMENTS, Timing};
 
 use super::blend::{Fading, turn_angle};
+use super::jerks::axis_jerks;
 use super::path::{
     Memo, PathLimits, Untimed, axis_limits, knot_derivatives, knot_joints, sample_knots, seeds_of,
     timed_rates,
 };
 use super::plan::{Trajectory, to_ns};
 use super::quarters::Inner;
+use super::smooth::{smooth_look_ahead, time_smooth};
 use crate::MAX_AXES;
 use crate::motion::{NS, Path, cartesian_at, slerp};
 use std::convert::Infallible;
@@ -58,6 +67,9 @@ pub(super) struct TimedCorner {
     pub(super) s_out: f64,
     /// Where the tool turns over a wider stretch than the curve (an orientation zone).
     pub(super) turn: Option<Turn>,
+    /// Whether the progressions keep the curve's curvature continuous (an arm with jerk
+    /// limits: [`run_out`]).
+    pub(super) smooth: bool,
 }
 
 /// Where the tool turns from the first motion's orientation to the second's over more
@@ -125,8 +137,8 @@ impl TimedCorner {
         let sigma = self.s_out - self.s_in;
         let u = ((s - self.s_in) / sigma).clamp(0.0, 1.0);
         let (r1, r2) = (1.0 - self.f_in, self.f_out);
-        let (g1, g1d, g1dd) = run_out(u);
-        let (g2, g2d, g2dd) = run_out(1.0 - u);
+        let (g1, g1d, g1dd) = run_out(u, self.smooth);
+        let (g2, g2d, g2dd) = run_out(1.0 - u, self.smooth);
         Progress {
             f1: self.f_in + r1 * g1,
             d1: r1 * g1d / sigma,
@@ -144,13 +156,14 @@ impl TimedCorner {
         let w = self.turn.as_ref().filter(|w| s > w.s_in && s < w.s_out)?;
         let width = w.s_out - w.s_in;
         let u = (s - w.s_in) / width;
-        let (g, gd, _) = run_out(u);
+        let (g, gd, _) = run_out(u, self.smooth);
+        let (g2, g2d, _) = run_out(1.0 - u, self.smooth);
         let (r1, r2) = (1.0 - w.f_in, w.f_out);
         Some([
             w.f_in + r1 * g,
             r1 * gd / width,
-            r2 * u * u,
-            2.0 * r2 * u / width,
+            r2 * (1.0 - g2),
+            r2 * g2d / width,
         ])
     }
 
@@ -206,8 +219,24 @@ impl TimedCorner {
         if f2 <= 0.0 {
             return self.s_in;
         }
-        // f2 = r₂·u².
-        self.s_in + (self.s_out - self.s_in) * (f2 / self.f_out).sqrt()
+        // f2 = r₂·(1 − g(1 − u)): u², or with smooth progressions 2u³ − u⁴, increasing
+        // (by bisection).
+        let share = f2 / self.f_out;
+        let u = if self.smooth {
+            let (mut lo, mut hi) = (0.0f64, 1.0f64);
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                if 1.0 - run_out(1.0 - mid, true).0 < share {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            hi
+        } else {
+            share.sqrt()
+        };
+        self.s_in + (self.s_out - self.s_in) * u
     }
 }
 
@@ -267,9 +296,24 @@ fn piece_knots(joins: [f64; 4]) -> ([f64; KNOTS], [usize; 4]) {
 
 /// The first path's progression through the curve, `g(u) = 2u − u² = 1 − (1 − u)²`, and
 /// its first and second derivatives: from 0 at slope 2 to 1 at slope 0 (the second runs
-/// in as `1 − g(1 − u) = u²`).
-fn run_out(u: f64) -> (f64, f64, f64) {
-    (2.0 * u - u * u, 2.0 - 2.0 * u, -2.0)
+/// in as `1 − g(1 − u) = u²`). With `smooth`, `g(u) = 1 − h(1 − u)` with `h(v) = 2v³ −
+/// v⁴`: the same slopes at both ends, and no second derivative there (`h(0) = h′(0) =
+/// h″(0) = 0`, `h(1) = 1`, `h′(1) = 2`, `h″(1) = 0`), so the curve's curvature begins at
+/// 0 and the axes' accelerations are continuous at the joins (an arm with jerk limits
+/// would jump there); its second runs in as `h(u)`. Both keep the curve within the zone:
+/// for two lines the TCP is within `r·(e₁ + e₂) ≤ r` of the point.
+fn run_out(u: f64, smooth: bool) -> (f64, f64, f64) {
+    if smooth {
+        let v = 1.0 - u;
+        let (v2, v3) = (v * v, v * v * v);
+        (
+            1.0 - (2.0 * v3 - v2 * v2),
+            6.0 * v2 - 4.0 * v3,
+            -(12.0 * v - 12.0 * v2),
+        )
+    } else {
+        (2.0 * u - u * u, 2.0 - 2.0 * u, -2.0)
+    }
 }
 
 /// The fewest steps of a corner's curve: it turns the TCP within the zone, often a small
@@ -345,9 +389,12 @@ pub(super) fn take_over(
         return None;
     };
     let (l1, l2) = (p1.length(), p2.length());
-    if l1 <= 1e-7 || l2 <= 1e-7 || prof1.t_jerk > 0.0 || prof2.t_jerk > 0.0 {
+    if l1 <= 1e-7 || l2 <= 1e-7 {
         return None;
     }
+    // An arm with jerk limits (its profiles ramp): the curve's curvature continuous, the
+    // timing within every axis's jerk from the robot's acceleration too.
+    let smooth = prof1.t_jerk > 0.0 || prof2.t_jerk > 0.0;
     let zone = f.motion.zone.min(0.5 * l2);
     // Within a micrometre before its zone (a look-ahead point is a knot, which may fall
     // just before it): from where the robot has reached it, the nanoseconds later that
@@ -417,6 +464,7 @@ pub(super) fn take_over(
         s_in,
         s_out: s_in + sigma,
         turn: None,
+        smooth,
     };
     // The orientation zone: the TCP covers 2r/σ of either path per unit of s on the
     // straight pieces, so a turn of radius ρ is ρσ/r wide in s, centred on the curve,
@@ -447,6 +495,7 @@ pub(super) fn take_over(
     }
     let q_now = first.joints_at(model, dt)?;
     let own_speed = first.own_speed_at(dt);
+    let own_accel = if smooth { first.own_accel_at(dt) } else { 0.0 };
     // The same corner from the same state (a program repeating its moves) is timed once.
     let mut key = [0u64; CORNER_KEY];
     let mid1 = p1.at(0.5);
@@ -471,6 +520,7 @@ pub(super) fn take_over(
             &prof2.t_jerk,
             &prof2.t_acc,
             &prof2.t_total,
+            &own_accel,
         ])
         .enumerate()
     {
@@ -483,7 +533,7 @@ pub(super) fn take_over(
                 model,
                 tool,
                 (corner, r, [*vs1, *as1, *ws1]),
-                (q_now, own_speed),
+                (q_now, own_speed, own_accel),
                 (next, next_zone),
             ))
         });
@@ -535,24 +585,23 @@ pub(super) type CornerMemo = Memo<CORNER_KEY, Option<Taken>>;
 /// Corners a VM remembers.
 pub(super) const CORNER_MEMO: usize = 16;
 /// A corner's key: joints now and at the end, 11 numbers, 5 poses, 2 midpoints, the next
-/// motion's profile, the branch.
-pub(super) const CORNER_KEY: usize = 2 * MAX_AXES + 11 + 5 * 12 + 6 + 7 + 1;
+/// motion's profile, the robot's acceleration on its own path, the branch.
+pub(super) const CORNER_KEY: usize = 2 * MAX_AXES + 11 + 5 * 12 + 6 + 7 + 1 + 1;
 
-/// The corner `corner` from the robot's joints and own-path speed `now` on the first
-/// path into `next`, timed (`take_over`'s work once the corner is known).
+/// The corner `corner` from the robot's joints and own-path speed and acceleration `now`
+/// on the first path into `next`, timed (`take_over`'s work once the corner is known):
+/// within every axis's jerk too for an arm with jerk limits (a smooth corner).
 fn time_corner(
     model: &RobotModel,
     tool: &Iso,
     (corner, r, [vs1, as1, ws1]): (TimedCorner, f64, [f64; 3]),
-    (q_now, own_speed): ([f64; MAX_AXES], f64),
+    (q_now, own_speed, own_accel): ([f64; MAX_AXES], f64, f64),
     (next, next_zone): (&Trajectory, Option<f64>),
 ) -> Option<Taken> {
     let Trajectory::Cartesian {
         path: p2,
         from: from2,
         to: to2,
-        profile: prof2,
-        end_joints,
         branch,
         path_limits: [vs2, as2, ws2],
         ..
@@ -572,7 +621,10 @@ fn time_corner(
     let (knots, breaks) = piece_knots([w_in, corner.s_in, corner.s_out, w_out]);
     let mut joints = JointPath::new(n);
     sample_knots(&mut joints, &q_now, Some(&knots), &joints_at).ok()?;
-    joints.set_breaks(breaks);
+    // (A smooth corner's curvature is continuous at its joins: its third derivative,
+    // which its jerk depends on, jumps there, and one-sided second differences there
+    // would lose it over the step after; central ones keep it.)
+    joints.set_breaks(if corner.smooth { [0; 4] } else { breaks });
     let mut derivatives = knot_derivatives(&joints);
     let mut inner = Inner::new();
     let limits = axis_limits(model);
@@ -651,6 +703,27 @@ fn time_corner(
     let stop_at = next_zone
         .filter(|z| *z > 0.0)
         .map(|z| corner.s_of_own(1.0 - z.min(0.5 * l2) / l2));
+    // With jerk limits: from the robot's speed and acceleration (in this path's fraction:
+    // the first path's is linear in it where the robot is), no faster start.
+    if corner.smooth {
+        let start = if x0 > 0.0 {
+            (x0, own_accel / rate_now)
+        } else {
+            (0.0, 0.0)
+        };
+        let jerk = axis_jerks(model);
+        let (timed, timing) = time_smooth(
+            joints,
+            (&limits.0, &limits.1, &jerk),
+            &path_limits,
+            &joints_at,
+            start,
+        )?;
+        let look_ahead = stop_at
+            .and_then(|s| smooth_look_ahead(&timing, s))
+            .map(|t| t.max(timing.time_at(corner.end())));
+        return taken((next, tool), &corner, (&timed, timing, look_ahead), r);
+    }
     let mut time = |x0: f64| {
         super::path::time_path(
             &mut joints,
@@ -677,7 +750,31 @@ fn time_corner(
     // have ended.)
     let curve_end = timing.time_at(corner.end());
     let look_ahead = look_ahead.map(|t| t.max(curve_end));
-    let rates = timed_rates(&joints, &timing);
+    taken((next, tool), &corner, (&joints, timing, look_ahead), r)
+}
+
+/// The corner `corner` into `next` (with `tool`) as taken: the path `joints` and its
+/// `timing`, its own look-ahead point.
+fn taken(
+    (next, tool): (&Trajectory, &Iso),
+    corner: &TimedCorner,
+    (joints, timing, look_ahead): (&JointPath, Timing, Option<f64>),
+    r: f64,
+) -> Option<Taken> {
+    let Trajectory::Cartesian {
+        path: p2,
+        from: from2,
+        to: to2,
+        profile: prof2,
+        end_joints,
+        branch,
+        path_limits: [vs2, as2, ws2],
+        ..
+    } = next
+    else {
+        return None;
+    };
+    let rates = timed_rates(joints, &timing);
     let point_ns = to_ns(timing.duration());
     Some(Taken {
         traj: Trajectory::Cartesian {
@@ -692,7 +789,7 @@ fn time_corner(
             branch: *branch,
             rates,
             cruise_rates: rates,
-            seeds: seeds_of(&joints),
+            seeds: seeds_of(joints),
             tool: *tool,
             corner: Some(corner.clone()),
             path_limits: [*vs2, *as2, *ws2],

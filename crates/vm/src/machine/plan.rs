@@ -18,6 +18,7 @@ use crate::types::{Dim, fmt_quantity};
 use vworks_model::timing::{SEGMENTS, Timing};
 
 use super::path::{PATH_KEY, PathMemo, PathSamples, SEEDS, sample_path};
+use super::smooth::profile_look_ahead;
 pub(super) use super::trajectory::Trajectory;
 
 /// How far (relative) an axis's speed found by sampling may exceed its limit and still
@@ -618,7 +619,7 @@ fn plan_cartesian(
     let sample_at = |v: f64, w: f64| -> Result<(PathSamples, Profile, f64), PlanError> {
         let (vs, as_, js) = limits(v, w);
         let profile = Profile::with_jerk(1.0, vs, as_, js);
-        let s = sample_path(
+        let mut s = sample_path(
             model,
             &tool,
             ends,
@@ -627,6 +628,10 @@ fn plan_cartesian(
             zone_share,
             duration_ns.is_none(),
         )?;
+        // (An S-curve looks ahead as a smooth timing does.)
+        if let (None, None, Some(z)) = (&s.timing, s.look_ahead, zone_share) {
+            s.look_ahead = profile_look_ahead(s.executed.as_ref().unwrap_or(&profile), z);
+        }
         let lasts = sampled_seconds(&s.timing, &s.executed, &profile);
         Ok((s, profile, lasts * NS))
     };

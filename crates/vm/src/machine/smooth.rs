@@ -5,7 +5,9 @@
 //! quarter points (`quarters::Inner`), its jerk there with `q‴` from the steps' third
 //! differences. Where a speed or an acceleration is over (by the path's curvature within a
 //! step) those steps get less room and the path is timed again, once; what is still over
-//! makes the whole timing run slower by just enough.
+//! makes the whole timing run slower by just enough. A corner's path, timed from the
+//! robot's state as it takes over ([`time_smooth`] from a start), cannot be slower as a
+//! whole: its steps get less room a few times, else it has no timing.
 
 use vworks_model::timing::{JointPath, KNOTS, SEGMENTS, Timing};
 
@@ -13,6 +15,7 @@ use super::path::{PathLimits, TIMING_MARGIN, check_turns, knot_derivatives};
 use super::plan::PlanError;
 use super::quarters::{Inner, Kink, worse};
 use crate::MAX_AXES;
+use crate::motion::Profile;
 
 /// How much finer the steps are at the path's ends than at its middle: knots at
 /// `g − E·sin(2πg)/2π` of the equal ones `g`, `E` this (steps `1 − E` of the mean at the ends).
@@ -23,19 +26,25 @@ const END_GRADING: f64 = 0.5;
 /// much, at most 0.1 %).
 const RETIME_FROM: f64 = 1.001;
 
+/// Every axis's speed, acceleration and jerk limits.
+pub(super) type AxisLimits<'a> = (
+    &'a [f64; MAX_AXES],
+    &'a [f64; MAX_AXES],
+    &'a [f64; MAX_AXES],
+);
+
 /// The path `joints` (sampled on equal knots by `joints_at`) timed within every axis's
 /// speed, acceleration and jerk (`limits`: per axis) and its own speed and acceleration
-/// (`path`; `along` is not used): the path as sampled for it and the timing, or `None`
-/// where no jerk-limited timing is found (the caller keeps its S-curve): also where a knot
-/// or quarter point of its own fails (the path was checked on its equal knots; a point
-/// between them that is out of reach is not this timing's to report).
+/// (`path`): the path as sampled for it and the timing, or `None` where no jerk-limited
+/// timing is found (the caller keeps its S-curve): also where a knot or quarter point of
+/// its own fails (the path was checked on its equal knots; a point between them that is
+/// out of reach is not this timing's to report).
 pub(super) fn smooth_timing(
     joints: &JointPath,
-    (speed, accel, jerk): (&[f64; MAX_AXES], &[f64; MAX_AXES], &[f64; MAX_AXES]),
+    limits: AxisLimits<'_>,
     path: &PathLimits<'_>,
     joints_at: &impl Fn(f64, &[f64; MAX_AXES]) -> Result<[f64; MAX_AXES], PlanError>,
 ) -> Option<(JointPath, Timing)> {
-    let n = joints.axes;
     let mut timed = joints.clone();
     // Graded near a singularity (`JointPath::grade`), else finer towards the ends.
     let knots = joints.grade().unwrap_or_else(|| {
@@ -54,23 +63,66 @@ pub(super) fn smooth_timing(
         timed.q[k] = joints_at(*s, &prev).ok()?;
     }
     check_turns(&timed).ok()?;
+    time_smooth(timed, limits, path, joints_at, (0.0, 0.0))
+}
+
+/// Rounds of less room for a timing that starts moving (it cannot be slower as a whole).
+const ROOM_ROUNDS_MOVING: usize = 3;
+
+/// The share of every axis's jerk a timing that starts moving is timed within at first.
+const MOVING_JERK_SHARE: f64 = 0.99;
+
+/// The path `timed` (sampled on its knots) timed within every axis's speed, acceleration
+/// and jerk and its own limits (`path`, also those along it) from `start` (`ṡ²`, `s̈`;
+/// `(0, 0)`: rest) to rest, checked between its knots ([`smooth_timing`]); `None` where
+/// none is found.
+pub(super) fn time_smooth(
+    mut timed: JointPath,
+    (speed, accel, jerk): AxisLimits<'_>,
+    path: &PathLimits<'_>,
+    joints_at: &impl Fn(f64, &[f64; MAX_AXES]) -> Result<[f64; MAX_AXES], PlanError>,
+    start: (f64, f64),
+) -> Option<(JointPath, Timing)> {
+    let n = timed.axes;
+    let moving = start.0 > 0.0;
     let derivatives = knot_derivatives(&timed);
     let margin = 1.0 - TIMING_MARGIN;
-    let (speed_timed, accel_timed, jerk_timed) = (
+    // (From a robot moving the jerks are timed a little lower still: the checks between
+    // the knots find a corner's jerks up to 0.7 % over its programs' rows, and a timing
+    // that starts moving can only be made again.)
+    let jerk_share = if moving {
+        margin * MOVING_JERK_SHARE
+    } else {
+        margin
+    };
+    let (speed_timed, accel_timed, mut jerk_timed) = (
         speed.map(|v| v * margin),
         accel.map(|a| a * margin),
-        jerk.map(|j| j * margin),
+        jerk.map(|j| j * jerk_share),
     );
-    let limits = path.with_axes(&speed_timed[..n], &accel_timed[..n], None);
+    let along = path.along.map(|f| f(timed.knots()));
     // Between the knots: the quarter points of every step.
     let mut inner = Inner::new();
     inner.fill(&timed, &[true; SEGMENTS], joints_at).ok()?;
+    // Each step's q‴ from its quarter points, for the programs' jerk rows as for the
+    // checks (knots' differences would smear a jump in it: where a corner's curve begins).
+    let mut thirds = vec![[(0.0, 0.0); MAX_AXES]; SEGMENTS];
+    for (k, d3) in thirds.iter_mut().enumerate() {
+        for (i, d) in d3.iter_mut().enumerate().take(n) {
+            let (t0, t1) = step_thirds(&timed, &derivatives, &inner, k, i);
+            *d = (t0 - 1.5 * (t1 - t0), t0 + 2.5 * (t1 - t0));
+        }
+    }
     let mut ratios = [0.0f64; SEGMENTS];
     // Where an axis's speed or acceleration goes over between the knots, its steps get
     // less room and the path is timed again (once); what is still over, the jerk's too,
     // slows the whole timing.
-    for round in 0..2 {
-        let timing = Timing::jerk_limited(&timed, &limits, &jerk_timed[..n]).ok()?;
+    let rounds = if moving { ROOM_ROUNDS_MOVING } else { 2 };
+    for round in 0..rounds {
+        let limits = path.with_axes(&speed_timed[..n], &accel_timed[..n], along.as_ref());
+        let timing =
+            Timing::jerk_limited_from(&timed, &limits, &jerk_timed[..n], start, Some(&thirds))
+                .ok()?;
         let state = |_: usize, s: f64| {
             let (x, u, _) = timing.state_at_place(s);
             (x, u)
@@ -91,8 +143,19 @@ pub(super) fn smooth_timing(
         if over <= 1.0 {
             return Some((timed, timing));
         }
-        // (Over by less than RETIME_FROM: not worth the programs again.)
-        if round == 1 || rv.max(ra) <= RETIME_FROM {
+        // (From a robot moving: less room for the steps over, and the jerks timed lower by
+        // as much as the checks find them over, a few times; else none. Over by less
+        // than RETIME_FROM: not worth the programs again.)
+        if moving {
+            if round + 1 == rounds {
+                return None;
+            }
+            if rj > 1.0 {
+                for j in &mut jerk_timed {
+                    *j *= margin / rj;
+                }
+            }
+        } else if round == 1 || rv.max(ra) <= RETIME_FROM {
             return Some((timed, timing.slower(over)));
         }
         for (room, r) in timed.room.iter_mut().zip(&ratios) {
@@ -102,6 +165,65 @@ pub(super) fn smooth_timing(
         }
     }
     None
+}
+
+/// A smooth timing's look-ahead point for a zone beginning at `stop_at` (`s`): when (s
+/// from its start) the next motion may take the robot over, early enough for it to stop
+/// before the zone as the timing itself stops at its end. The timing's last braking
+/// begins at the last knot where `s̈ ≥ 0`; moved back by the zone's length, the robot
+/// there has as long to brake before the zone as the timing had to its end (`None`
+/// where that is at its start).
+pub(super) fn smooth_look_ahead(timing: &Timing, stop_at: f64) -> Option<f64> {
+    let braking = (1..SEGMENTS)
+        .rev()
+        .find(|&k| timing.state_at_place(timing.knot(k)).1 >= 0.0)?;
+    let place = timing.knot(braking) - (1.0 - stop_at);
+    let k = (1..=braking).rev().find(|&k| timing.knot(k) <= place)?;
+    Some(timing.time_at_knot(k))
+}
+
+/// An S-curve's look-ahead point for a zone of `zone` (a share of its distance), as
+/// [`smooth_look_ahead`]'s: its braking begins `t_acc` before its end; moved back by the
+/// zone, the time it is there (by bisection; `None` where that is at its start, or for a
+/// trapezoid: an arm without jerk limits flies by with corner ramps).
+pub(super) fn profile_look_ahead(profile: &Profile, zone: f64) -> Option<f64> {
+    if profile.t_jerk <= 0.0 || profile.dist.is_nan() || profile.dist <= 0.0 {
+        return None;
+    }
+    let braking = (profile.t_total - profile.t_acc).max(0.0);
+    let place = profile.at(braking) - zone * profile.dist;
+    if place <= 0.0 {
+        return None;
+    }
+    let (mut lo, mut hi) = (0.0f64, braking);
+    for _ in 0..64 {
+        let mid = 0.5 * (lo + hi);
+        if profile.at(mid) < place {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(lo)
+}
+
+/// Axis `i`'s third differences in step `k` at its 1.5 and 2.5 quarters (from its knots
+/// and quarter points; without them, the knots' `q″` difference, both the same).
+fn step_thirds(
+    joints: &JointPath,
+    derivatives: &super::path::KnotDerivatives,
+    inner: &Inner,
+    k: usize,
+    i: usize,
+) -> (f64, f64) {
+    let h = 0.25 * joints.step(k);
+    let Some(points) = inner.points(joints, k) else {
+        let d3 = (derivatives[k + 1][i].1 - derivatives[k][i].1) / joints.step(k);
+        return (d3, d3);
+    };
+    let q = points.map(|p| p[i]);
+    let third = |a: usize| (q[a + 3] - 3.0 * q[a + 2] + 3.0 * q[a + 1] - q[a]) / (h * h * h);
+    (third(0), third(1))
 }
 
 /// The largest ratio of an axis's jerk to its limit at the knots and quarter points of
@@ -128,9 +250,7 @@ fn jerk_ratio(
                 continue;
             }
             let q = points.map(|p| p[i]);
-            let third =
-                |a: usize| (q[a + 3] - 3.0 * q[a + 2] + 3.0 * q[a + 1] - q[a]) / (h * h * h);
-            let (t0, t1) = (third(0), third(1));
+            let (t0, t1) = step_thirds(joints, derivatives, inner, k, i);
             for p in 0..=4 {
                 let s = joints.knot(k) + p as f64 * h;
                 // (Just inside the step at its knots: the step's own jerk.)

@@ -287,6 +287,33 @@ impl Trajectory {
         }
     }
 
+    /// The acceleration of a Cartesian motion's own path fraction `dt` seconds in (1/s²):
+    /// past a corner it took over (where its own fraction is linear in the path's), or
+    /// without one. (Ramps are not followed: 0; they fly by with ramps, not timed corners.)
+    pub(super) fn own_accel_at(&self, dt: f64) -> f64 {
+        let (rate, timing, profile) = match self {
+            Trajectory::Cartesian {
+                corner,
+                timing,
+                profile,
+                ramps: None,
+                ..
+            } => (
+                corner
+                    .as_ref()
+                    .map_or(1.0, |c| c.own_rate(self.fraction_at(dt))),
+                timing,
+                profile,
+            ),
+            _ => return 0.0,
+        };
+        match timing {
+            Some(t) => rate * t.at(dt).accel,
+            None if profile.dist > 0.0 => rate * profile.accel_at(dt) / profile.dist,
+            None => 0.0,
+        }
+    }
+
     /// The largest speed of a Cartesian motion's own path fraction (1/s): through a corner
     /// it took over, the largest at the timing's knots (its own fraction's rate is linear
     /// or constant between them).
