@@ -41,6 +41,10 @@ use crate::ik::MAX_AXES;
 const MAX_ROUNDS: usize = 12;
 /// The rounds stop when `Σ x` grows by less than this share of itself.
 const SETTLED: f64 = 1e-3;
+/// How close (relative) to its tangent's point every knot's `ṡ²` must be for the first
+/// program from a given guess to be kept as it is: the tangent `(3/2 − r/2)·√r` of the
+/// true bound at `r = x/x̂` is within 0.1 % of it for `r` within 5 % of 1.
+const CLOSE_TANGENT: f64 = 0.05;
 /// Terms of the series of a step's `σ(t)` where `|c|·t² ≤ 1` (the next is below 1e-19 of
 /// the first).
 const SERIES_TERMS: usize = 11;
@@ -266,6 +270,22 @@ fn third_slopes(
 /// A step's `q‴` per axis at its start and at its end ([`Timing::jerk_limited_from`]).
 pub type StepThirds = [(f64, f64); MAX_AXES];
 
+/// Where a jerk-limited timing starts, and what its caller knows of the path
+/// ([`Timing::jerk_limited_from`]; the default: from rest, knowing nothing more).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct JerkStart<'a> {
+    /// `ṡ²` and `s̈` at the path's start (`(0, 0)`: rest; a corner taking over from the
+    /// motion before: the robot's).
+    pub state: (f64, f64),
+    /// Each step's `q‴` per axis at its start and end where the caller knows it better
+    /// than differences of the knots' `q″` (one per step; `None`: those differences).
+    pub third: Option<&'a [StepThirds]>,
+    /// The first tangents' `ṡ²` per knot (all positive between the ends), where the
+    /// caller has a timing close to the one sought — the same path timed before within
+    /// other limits — in place of the timing without jerk limits: fewer programs.
+    pub guess: Option<&'a [f64; KNOTS]>,
+}
+
 /// The rows every round shares: the start given or from rest, rest at the end, the
 /// steps' consistency, and every speed and acceleration at the knots and halfway.
 fn fixed_rows(path: &JointPath, slopes: &KnotSlopes, lim: &Limits<'_>, rows: &mut Rows) {
@@ -465,23 +485,25 @@ impl Timing {
         limits: &Limits<'_>,
         axis_jerk: &[f64],
     ) -> Result<Timing, TimingError> {
-        Timing::jerk_limited_from(path, limits, axis_jerk, (0.0, 0.0), None)
+        Timing::jerk_limited_from(path, limits, axis_jerk, &JerkStart::default())
     }
 
-    /// [`Timing::jerk_limited`] from a robot already moving: `ṡ²` and `s̈` at the path's
-    /// start are `start` (a corner taking over from the motion before; `(0, 0)`: from
-    /// rest), its first step a step as any other. Where no timing within the limits
-    /// continues from there (it is too fast to brake in time, or its acceleration cannot
-    /// turn soon enough), [`TimingError::Stuck`] or [`TimingError::TooFast`]. `third`:
-    /// each step's `q‴` per axis at its start and end where the caller knows it better
-    /// than differences of the knots' `q″` (one per step; `None`: those differences).
+    /// [`Timing::jerk_limited`] from where `from` says (a robot already moving: its first
+    /// step a step as any other), with what it knows of the path. Where no timing within
+    /// the limits continues from a moving start (it is too fast to brake in time, or its
+    /// acceleration cannot turn soon enough), [`TimingError::Stuck`] or
+    /// [`TimingError::TooFast`].
     pub fn jerk_limited_from(
         path: &JointPath,
         limits: &Limits<'_>,
         axis_jerk: &[f64],
-        start: (f64, f64),
-        third: Option<&[StepThirds]>,
+        from: &JerkStart<'_>,
     ) -> Result<Timing, TimingError> {
+        let JerkStart {
+            state: start,
+            third,
+            guess: given_guess,
+        } = *from;
         let (x0, u0) = start;
         if !(x0.is_finite() && x0 >= 0.0) {
             return Err(TimingError::BadLimit(x0));
@@ -515,7 +537,14 @@ impl Timing {
         // axes allow there reaches from rest (s = J·t³/6 and ṡ = J·t²/2: ṡ² =
         // 6^{4/3}/4·J^{2/3}·s^{4/3} at s from rest). At a given start, its own `x`.
         let mut guess = unjerked.x;
-        for (k, g) in guess.iter_mut().enumerate() {
+        if let Some(given) = given_guess.filter(|g| g[1..SEGMENTS].iter().all(|x| *x > 0.0)) {
+            guess = *given;
+        }
+        for (k, g) in guess
+            .iter_mut()
+            .enumerate()
+            .filter(|_| given_guess.is_none())
+        {
             let path_jerk = (0..path.axes)
                 .filter(|i| axis_jerk[*i].is_finite())
                 .map(|i| axis_jerk[i] / slopes.after[k][i].0.abs())
@@ -542,7 +571,7 @@ impl Timing {
         fixed_rows(path, &slopes, limits, &mut fixed);
         let place = band_places();
         let mut best: Option<([f64; KNOTS], [f64; KNOTS], f64)> = None;
-        for _ in 0..MAX_ROUNDS {
+        for round in 0..MAX_ROUNDS {
             let mut rows = fixed.clone();
             jerk_rows(path, &slopes, &d3, axis_jerk, &guess, &mut rows);
             let Some((mut x, mut u)) = solve(&rows, &place) else {
@@ -550,9 +579,15 @@ impl Timing {
             };
             (x[0], u[0]) = start;
             let total: f64 = x.iter().sum();
+            // (Tangents at a given timing close to the one sought: settled at once where
+            // every knot's x is within CLOSE_TANGENT of its tangent's point — there each
+            // jerk row is within 0.1 % of the true bound.)
             let settled = best
                 .as_ref()
-                .is_some_and(|b| total <= b.2 * (1.0 + SETTLED));
+                .is_some_and(|b| total <= b.2 * (1.0 + SETTLED))
+                || (round == 0
+                    && given_guess.is_some()
+                    && (1..SEGMENTS).all(|k| (x[k] - guess[k]).abs() <= CLOSE_TANGENT * guess[k]));
             if best.as_ref().is_none_or(|b| total > b.2) {
                 best = Some((x, u, total));
             }
@@ -931,7 +966,11 @@ mod tests {
         let p = path(1, q);
         let (v, a, j) = ([2.0], [4.0], [40.0]);
         for (start, by_hand) in [((1.0, 0.0), 1.3), ((0.25, 2.0), 1.363_333)] {
-            let t = Timing::jerk_limited_from(&p, &limits(&v, &a), &j, start, None).unwrap();
+            let from = JerkStart {
+                state: start,
+                ..JerkStart::default()
+            };
+            let t = Timing::jerk_limited_from(&p, &limits(&v, &a), &j, &from).unwrap();
             let d = t.duration();
             assert!(
                 (by_hand * (1.0 - 1e-6)..by_hand * 1.01).contains(&d),
@@ -947,7 +986,11 @@ mod tests {
             );
         }
         // Too fast to brake in 2 rad (1 rad/s more than the limit): no timing.
-        assert!(Timing::jerk_limited_from(&p, &limits(&v, &a), &j, (2.25, 0.0), None).is_err());
+        let too_fast = JerkStart {
+            state: (2.25, 0.0),
+            ..JerkStart::default()
+        };
+        assert!(Timing::jerk_limited_from(&p, &limits(&v, &a), &j, &too_fast).is_err());
     }
 
     /// A curved path of two axes, and their speeds, accelerations and jerks.

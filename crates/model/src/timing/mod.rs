@@ -969,7 +969,7 @@ impl Timing {
 }
 
 mod jerk;
-pub use jerk::StepThirds;
+pub use jerk::{JerkStart, StepThirds};
 mod lp;
 #[cfg(test)]
 mod tests;

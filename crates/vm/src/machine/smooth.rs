@@ -9,7 +9,7 @@
 //! robot's state as it takes over ([`time_smooth`] from a start), cannot be slower as a
 //! whole: its steps get less room a few times, else it has no timing.
 
-use vworks_model::timing::{JointPath, KNOTS, SEGMENTS, Timing};
+use vworks_model::timing::{JerkStart, JointPath, KNOTS, SEGMENTS, Timing};
 
 use super::path::{PathLimits, TIMING_MARGIN, check_turns, knot_derivatives};
 use super::plan::PlanError;
@@ -118,11 +118,17 @@ pub(super) fn time_smooth(
     // less room and the path is timed again (once); what is still over, the jerk's too,
     // slows the whole timing.
     let rounds = if moving { ROOM_ROUNDS_MOVING } else { 2 };
+    let mut previous: Option<[f64; KNOTS]> = None;
     for round in 0..rounds {
         let limits = path.with_axes(&speed_timed[..n], &accel_timed[..n], along.as_ref());
-        let timing =
-            Timing::jerk_limited_from(&timed, &limits, &jerk_timed[..n], start, Some(&thirds))
-                .ok()?;
+        let from = JerkStart {
+            state: start,
+            third: Some(&thirds),
+            guess: previous.as_ref(),
+        };
+        let timing = Timing::jerk_limited_from(&timed, &limits, &jerk_timed[..n], &from).ok()?;
+        // (The next round, if any, starts its tangents at this timing: it is close.)
+        previous = Some(timing_knots(&timing));
         let state = |_: usize, s: f64| {
             let (x, u, _) = timing.state_at_place(s);
             (x, u)
@@ -278,4 +284,9 @@ fn jerk_ratio(
         }
     }
     worst
+}
+
+/// `ṡ²` at every knot of `timing`.
+fn timing_knots(timing: &Timing) -> [f64; KNOTS] {
+    std::array::from_fn(|k| timing.state_at_knot(k))
 }
