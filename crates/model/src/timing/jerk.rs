@@ -521,7 +521,15 @@ impl Timing {
         {
             return Err(TimingError::BadLimit(*j));
         }
-        let unjerked = Timing::from_speed(path, limits, x0)?;
+        // (A robot a little faster than the timing without jerk limits can start — its
+        // rows at the given start are not the programs' — has its first tangents at the
+        // fastest start that timing finds: the programs say whether it can go on.)
+        let unjerked = match Timing::from_speed(path, limits, x0) {
+            Err(TimingError::TooFast { largest }) if moving && largest > 0.0 => {
+                Timing::from_speed(path, limits, largest)?
+            }
+            found => found?,
+        };
         let mut slopes = KnotSlopes::new();
         checked_slopes(path, limits, &mut slopes)?;
         let d3 = third_slopes(path, &slopes, third);
