@@ -211,3 +211,30 @@ fn right_angle_corners_with_jerk_limits_are_timed_as_one_path() {
     let r = jerk_ratios(&zoned, 0.05).unwrap();
     assert!(r.iter().all(|r| *r <= 1.0 + JERK_TOLERANCE), "{r:?}");
 }
+
+/// A motion too short to cruise is taken over at its start (docs/engine.md, "Look-ahead"):
+/// two 30 mm lines at right angles at 1 m/s with `zone 10mm`, axes ramping in 50 ms, are
+/// timed as one path from rest — the second starts where the first does, `blend=10mm` —
+/// and end more than 10 % sooner than with a `fine` point (0.263 s against 0.302 s
+/// measured; taking over where the first was still accelerating found no timing, and the
+/// corner superposed ended at 0.279 s), every axis's jerk within 1 % at 1 kHz.
+#[test]
+fn a_motion_too_short_to_cruise_is_taken_over_at_its_start() {
+    let legs = [(30, 0), (0, 30)];
+    let zoned = lines(&legs, 1000, "zone 10mm");
+    let (end, blends) = end_and_blends(&zoned, 0.05);
+    let (fine, _) = end_and_blends(&lines(&legs, 1000, "zone fine"), 0.05);
+    assert_eq!(blends[1..], [None, Some(0.01)], "{blends:?}");
+    let (mut v, _) = vm(&zoned, 0.05);
+    let mut starts = Vec::new();
+    while let Next::Event(e) = v.next_event() {
+        if let EventKind::MotionStart { .. } = e.kind {
+            starts.push(e.time);
+        }
+        v.perform();
+    }
+    assert_eq!(starts[1], starts[2], "{starts:?}");
+    assert!((end as f64) < 0.9 * fine as f64, "{end} vs {fine}");
+    let r = jerk_ratios(&zoned, 0.05).unwrap();
+    assert!(r.iter().all(|r| *r <= 1.0 + JERK_TOLERANCE), "{r:?}");
+}

@@ -1,5 +1,6 @@
 //! Jerk-limited timing of a path ([`Timing::jerk_limited`]): the fastest timing found of
-//! `q(s)` from rest to rest within every axis's speed, acceleration *and jerk* and the
+//! `q(s)` from rest (or, [`Timing::jerk_limited_from`], from a robot already moving: a
+//! corner taking over) to rest within every axis's speed, acceleration *and jerk* and the
 //! path's own speed and acceleration, and what such a *smooth* timing is at any time.
 //!
 //! **The timing.** `s̈` is continuous: at each knot it is `u_k`, and on each step it is
@@ -110,11 +111,11 @@ impl Rows {
     }
 
     /// One row `Σ coef·var ≤ rhs` over `(var, coef)`, scaled to a right-hand side of 1
-    /// where it is positive. (A row of the given start alone is no row: the start is
-    /// the robot's.)
+    /// where it is positive.
     fn push(&mut self, terms: &[(usize, f64)], rhs: f64) {
-        // (No limit: no row.)
-        if rhs.is_infinite() || self.scaled_terms(terms).next().is_none() {
+        // (No limit: no row. A row of the given start alone — no unknown in it, or none
+        // with a coefficient — is the robot's state, not the program's to choose.)
+        if rhs.is_infinite() || self.scaled_terms(terms).all(|(_, a)| a == 0.0) {
             return;
         }
         let rhs = rhs - self.given(terms);

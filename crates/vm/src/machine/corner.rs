@@ -342,9 +342,10 @@ pub(super) struct Taken {
 /// The next Cartesian motion `next` (planned from the point as if from rest) taking the
 /// robot over at `time` from the rest of `f`, a Cartesian motion timed within its axes'
 /// limits (module docs); `next_zone` its own zone. `None` where this corner does not
-/// apply (a motion with a `duration`, jerk limits, corner ramps, a path of no length, the
+/// apply (a motion with a `duration`, corner ramps, a path of no length, the
 /// robot already inside the zone or still in a corner of its own) or has no timing that
-/// starts at the robot's speed and ends by `stop_end` (where stopping at the point would):
+/// starts at the robot's speed (and, with jerk limits, its acceleration) and ends by
+/// `stop_end` (where stopping at the point would):
 /// the caller superposes them instead. With `plain` false, only a corner that turns the
 /// tool over its orientation zone (where the caller has corner ramps to fall back on, as
 /// without an orientation zone). With the corner, the instant it takes over:

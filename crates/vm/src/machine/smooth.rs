@@ -164,7 +164,9 @@ pub(super) fn time_smooth(
         } else if round == 1 || rv.max(ra) <= RETIME_FROM {
             return Some((timed, timing.slower(over)));
         }
-        for (room, r) in timed.room.iter_mut().zip(&ratios) {
+        // (From a robot moving, the first step keeps its room: less would leave no start
+        // at the robot's speed.)
+        for (room, r) in timed.room.iter_mut().zip(&ratios).skip(usize::from(moving)) {
             if *r > margin {
                 *room *= margin / r;
             }
@@ -176,30 +178,43 @@ pub(super) fn time_smooth(
 /// A smooth timing's look-ahead point for a zone beginning at `stop_at` (`s`): when (s
 /// from its start) the next motion may take the robot over, early enough for it to stop
 /// before the zone as the timing itself stops at its end. The timing's last braking
-/// begins at the last knot where `s̈ ≥ 0`; moved back by the zone's length, the robot
-/// there has as long to brake before the zone as the timing had to its end (`None`
-/// where that is at its start).
+/// begins at the last knot where `s̈ ≥ 0`; moved back by the zone's length, a robot
+/// cruising there has as long to brake before the zone as the timing had to its end.
+/// Where the robot there is still accelerating (a motion too short to cruise: it would
+/// have to ease its acceleration first, and often could not turn into the curve in time)
+/// or that place is before the first knot, its start: the next motion takes it over from
+/// rest, the two timed as one path.
 pub(super) fn smooth_look_ahead(timing: &Timing, stop_at: f64) -> Option<f64> {
     let braking = (1..SEGMENTS)
         .rev()
         .find(|&k| timing.state_at_place(timing.knot(k)).1 >= 0.0)?;
     let place = timing.knot(braking) - (1.0 - stop_at);
-    let k = (1..=braking).rev().find(|&k| timing.knot(k) <= place)?;
-    Some(timing.time_at_knot(k))
+    let top_accel = (0..SEGMENTS)
+        .map(|k| timing.state_at_place(timing.knot(k)).1.abs())
+        .fold(0.0f64, f64::max);
+    let cruising = |k: usize| timing.state_at_place(timing.knot(k)).1 <= CRUISING * top_accel;
+    match (1..=braking).rev().find(|&k| timing.knot(k) <= place) {
+        Some(k) if cruising(k) => Some(timing.time_at_knot(k)),
+        _ => Some(0.0),
+    }
 }
+
+/// The share of its largest `s̈` below which a timing counts as cruising, not accelerating
+/// ([`smooth_look_ahead`]).
+const CRUISING: f64 = 0.01;
 
 /// An S-curve's look-ahead point for a zone of `zone` (a share of its distance), as
 /// [`smooth_look_ahead`]'s: its braking begins `t_acc` before its end; moved back by the
-/// zone, the time it is there (by bisection; `None` where that is at its start, or for a
-/// trapezoid: an arm without jerk limits flies by with corner ramps).
+/// zone, the time it is there (by bisection), if it cruises there; else its start. `None`
+/// for a trapezoid: an arm without jerk limits flies by with corner ramps.
 pub(super) fn profile_look_ahead(profile: &Profile, zone: f64) -> Option<f64> {
     if profile.t_jerk <= 0.0 || profile.dist.is_nan() || profile.dist <= 0.0 {
         return None;
     }
     let braking = (profile.t_total - profile.t_acc).max(0.0);
     let place = profile.at(braking) - zone * profile.dist;
-    if place <= 0.0 {
-        return None;
+    if place <= profile.at(profile.t_acc) {
+        return Some(0.0);
     }
     let (mut lo, mut hi) = (0.0f64, braking);
     for _ in 0..64 {

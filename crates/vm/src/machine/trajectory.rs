@@ -315,16 +315,17 @@ impl Trajectory {
     }
 
     /// The largest speed of a Cartesian motion's own path fraction (1/s): through a corner
-    /// it took over, the largest at the timing's knots (its own fraction's rate is linear
-    /// or constant between them).
+    /// it took over, at most the largest over the timing's steps of the path's top speed
+    /// on the step times its own fraction's larger rate at the step's ends (that rate is
+    /// constant or rises monotonically between knots: `u²` and `2u³ − u⁴` alike).
     pub(super) fn top_own_speed(&self) -> f64 {
         match self {
             Trajectory::Cartesian {
                 corner: Some(c),
                 timing: Some(t),
                 ..
-            } => (0..=SEGMENTS)
-                .map(|k| c.own_rate(t.knot(k)) * t.speed_at_knot(k))
+            } => (0..SEGMENTS)
+                .map(|k| c.own_rate(t.knot(k)).max(c.own_rate(t.knot(k + 1))) * t.step_top_speed(k))
                 .fold(0.0, f64::max),
             _ => self.top_path_speed(),
         }
