@@ -272,7 +272,7 @@ pub(crate) fn load_parsed(
                             let bytes = fs.read(Path::new(name)).map_err(|e| {
                                 cx.bad(&at, format!("cannot read `{name}`: {e}{}", read_hint(&e)))
                             })?;
-                            let src = vworks_wslc::source_text(bytes)
+                            let src = vworks_wslc::source_text_of(name, bytes)
                                 .map_err(|e| cx.bad(&at, format!("{name}: {e}")))?;
                             texts.push((name.clone(), src));
                         }

@@ -1,4 +1,4 @@
-//! The files named on the command line: reading one (size limit, UTF-8 or Latin-1, errors
+//! The files named on the command line: reading one (size limit, UTF-8, or Latin-1 for RAPID; errors
 //! that say what to do), and what each is — a program, a workcell, a sweep file — so a
 //! command given the wrong one says which to give.
 
@@ -15,7 +15,8 @@ pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, String> {
 
 pub(crate) fn read(path: &Path) -> Result<String, String> {
     let bytes = read_bytes(path)?;
-    vworks_wslc::source_text(bytes).map_err(|e| format!("{}: {e}", path.display()))
+    vworks_wslc::source_text_of(&path.to_string_lossy(), bytes)
+        .map_err(|e| format!("{}: {e}", path.display()))
 }
 
 /// "cannot read FILE: why; what to do" for a file named on the command line.

@@ -605,6 +605,47 @@ fn a_program_that_is_not_utf8_is_an_error_at_its_line() {
     assert!(err.contains("line 2, column 13: byte 0xE9"), "{err}");
 }
 
+/// RAPID modules as controllers and RobotStudio write them, in Latin-1 (issue 31): a file
+/// that is not UTF-8 is read as ISO-8859-1, each byte one character, so every position is
+/// the file's own. A module with an accented comment and string checks and runs (its
+/// `TPWrite` logs the "é"); an error after an "é" on its line is at the column that counts
+/// that byte as one character (column 31, by hand).
+#[test]
+fn a_rapid_module_in_latin1_is_read_as_latin1() {
+    let d = temp_dir("latin1-rapid");
+    let ok = d.join("r1.mod");
+    std::fs::write(
+        &ok,
+        b"MODULE r1\n    ! posici\xf3n de reposo\n    CONST string s := \"caf\xe9\";\n    PROC main()\n        TPWrite s;\n    ENDPROC\nENDMODULE\n",
+    )
+    .unwrap();
+    let out = vworks(&["check", ok.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    std::fs::write(
+        d.join("cell.toml"),
+        "[[robot]]\nname = \"r1\"\nmodel = \"turntable\"\nprogram = \"r1.mod\"\n",
+    )
+    .unwrap();
+    let out = vworks(&["run", d.join("cell.toml").to_str().unwrap(), "--trace"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stdout).contains("log \"café\""),
+        "{}",
+        text(&out.stdout)
+    );
+    let bad = d.join("bad.mod");
+    std::fs::write(
+        &bad,
+        b"MODULE bad\n    ! posici\xf3n\n    PROC main()\n        WaitTime 1;\n        TPWrite \"\xe9\"; WaitTime qq;\n    ENDPROC\nENDMODULE\n",
+    )
+    .unwrap();
+    let out = vworks(&["check", bad.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = text(&out.stderr);
+    assert!(err.contains("bad.mod:5:31"), "{err}");
+    assert!(err.contains("TPWrite \"é\"; WaitTime qq;"), "{err}");
+}
+
 /// `package://` meshes are found through ROS_PACKAGE_PATH (after the workcell's
 /// `package_path`), as a ROS-Industrial user expects.
 #[test]

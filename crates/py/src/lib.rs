@@ -64,7 +64,10 @@ fn load_cell(py: Python<'_>, path: PathBuf) -> PyResult<Cell> {
             for d in &diagnostics {
                 // Read as the loader read it: a regular file, within the size limit.
                 let bytes = vworks_cell::Disk.read(std::path::Path::new(&d.at.file));
-                if let Some(text) = bytes.ok().and_then(|b| String::from_utf8(b).ok()) {
+                let text = bytes
+                    .ok()
+                    .and_then(|b| vworks_wslc::source_text_of(&d.at.file, b).ok());
+                if let Some(text) = text {
                     sources.add(&d.at.file, &text);
                 }
             }

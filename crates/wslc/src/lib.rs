@@ -88,6 +88,24 @@ pub fn source_text(bytes: Vec<u8>) -> Result<String, NotUtf8> {
     })
 }
 
+/// A program file's text from its bytes, as its language's files are written: UTF-8
+/// (without a leading byte-order mark) for every language; a RAPID file that is not UTF-8
+/// is Latin-1 (ISO-8859-1: what controllers and RobotStudio write, accented comments and
+/// all), each byte one character, so every line and column is the file's own. A WSL file
+/// that is not UTF-8 is an error ([`source_text`]).
+pub fn source_text_in(language: Language, bytes: Vec<u8>) -> Result<String, NotUtf8> {
+    match (language, std::str::from_utf8(&bytes).is_ok()) {
+        (Language::Rapid, false) => Ok(bytes.iter().map(|b| char::from(*b)).collect()),
+        _ => source_text(bytes),
+    }
+}
+
+/// [`source_text_in`] the language of the file `path` names (by its extension: WSL for
+/// any other).
+pub fn source_text_of(path: &str, bytes: Vec<u8>) -> Result<String, NotUtf8> {
+    source_text_in(Language::of_path(path), bytes)
+}
+
 /// Compiles one module. `path` names the file in diagnostics and in the module.
 pub fn compile(path: &str, source: &str) -> Result<Compiled, CompileError> {
     compile_files(&[(path, source)])
@@ -126,5 +144,29 @@ pub fn compile_program(
     match language {
         Language::Wsl => compile_files(files),
         Language::Rapid => rapid::compile_files(files, io),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+
+    use super::*;
+
+    /// A RAPID file that is not UTF-8 is Latin-1, one character per byte (every byte
+    /// from 0x80 to 0xFF is the code point of the same number); UTF-8 stays UTF-8 (its
+    /// "é" is one character, not two); a WSL file that is not UTF-8 is the error it was.
+    #[test]
+    fn rapid_files_that_are_not_utf8_are_latin1() {
+        let latin1: Vec<u8> = b"! caf\xe9 \xff\x80".to_vec();
+        let text = source_text_of("a/M.MOD", latin1.clone()).unwrap();
+        assert_eq!(text, "! caf\u{e9} \u{ff}\u{80}");
+        assert_eq!(text.chars().count(), latin1.len());
+        assert_eq!(
+            source_text_of("m.mod", "! café".as_bytes().to_vec()).unwrap(),
+            "! café"
+        );
+        let err = source_text_of("p.wsl", latin1).unwrap_err();
+        assert_eq!((err.line, err.col, err.byte), (1, 6, 0xE9));
     }
 }
