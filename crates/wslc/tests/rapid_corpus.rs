@@ -21,11 +21,8 @@ fn run_corpus(dir: &Path) -> (Vec<String>, Vec<(String, Vec<String>)>) {
     for p in files {
         let name = p.file_name().unwrap().to_string_lossy().into_owned();
         let bytes = std::fs::read(&p).unwrap();
-        // Public modules come in Latin-1 too: read them as the controller would show them.
-        let text = match String::from_utf8(bytes) {
-            Ok(t) => t,
-            Err(e) => e.into_bytes().iter().map(|&b| b as char).collect(),
-        };
+        // Public modules come in Latin-1 too: read as vworks reads RAPID files.
+        let text = vworks_wslc::source_text_of(&name, bytes).unwrap();
         let result = std::panic::catch_unwind(|| compile_as(Language::Rapid, &name, &text));
         match result {
             Err(_) => panic!("{name}: the RAPID front-end panicked"),

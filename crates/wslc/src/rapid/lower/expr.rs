@@ -18,7 +18,9 @@ impl Tr<'_> {
             return self.aggregate(items, want, e.span);
         }
         let v = self.expr(e)?;
-        if v.ty == want || (v.ty == Ty::Intnum && want == Ty::Num) {
+        // (`intnum` is an alias of `num`, its properties and all: each is the other.)
+        let nums = [Ty::Num, Ty::Intnum];
+        if v.ty == want || (nums.contains(&v.ty) && nums.contains(&want)) {
             return Some(Val { ty: want, ..v });
         }
         // A pose-like value where another pose-like one is wanted: RAPID converts none of
@@ -172,9 +174,11 @@ impl Tr<'_> {
 
     /// The leaves of data `d` (element `index` of an array, 1-based).
     pub(crate) fn data_value(&mut self, d: &Data, index: Option<u32>, span: Span) -> Val {
+        // (An intnum's value is a num: the alias's properties are num's.)
+        let ty = if d.ty == Ty::Intnum { Ty::Num } else { d.ty };
         if let Some(parts) = &d.inline {
             return Val {
-                ty: d.ty,
+                ty,
                 parts: parts
                     .iter()
                     .map(|p| w::Expr {
@@ -186,7 +190,7 @@ impl Tr<'_> {
             };
         }
         Val {
-            ty: d.ty,
+            ty,
             parts: Tr::leaf_names(d, index)
                 .iter()
                 .map(|n| b::name(n, span))

@@ -374,7 +374,15 @@ impl Tr<'_> {
                     Err(())
                 }
                 None => {
-                    self.error(Code::E0080, "an array's size must be a constant", n.span);
+                    // (A name declared nowhere is unknown, as anywhere else.)
+                    match &n.kind {
+                        r::ExprKind::Name(name) if self.lookup(&name.key()).is_none() => {
+                            self.unknown_name(name);
+                        }
+                        _ => {
+                            self.error(Code::E0080, "an array's size must be a constant", n.span);
+                        }
+                    }
                     Err(())
                 }
             },
