@@ -619,6 +619,15 @@ impl Parser<'_, '_, Token> {
             self.skip_past_semi();
             return Ok(StmtKind::Unsupported("late binding (`%name%`)"));
         }
+        // A teach pendant's placeholder: `<SMT>` (a statement not yet written) has no `;`,
+        // so only it is skipped (and a `;` after it), never the statements after it.
+        if self.at_tok(&Tok::Lt) && self.peek(1).tok == Tok::Ident && self.peek(2).tok == Tok::Gt {
+            self.bump();
+            self.bump();
+            self.bump();
+            self.eat_tok(&Tok::Semi);
+            return Ok(StmtKind::Unsupported("a placeholder (`<SMT>`)"));
+        }
         if self.at_tok(&Tok::Lt) || self.at_tok(&Tok::Question) {
             self.skip_past_semi();
             return Ok(StmtKind::Unsupported("a placeholder (`<SMT>`)"));
