@@ -58,3 +58,37 @@ ENDMODULE
 ";
     assert_eq!(errors(src), [(Code::E0080, 3, 17)]);
 }
+
+/// Without the workcell's I/O (`vworks check m.mod`), a signal is any name an I/O
+/// instruction of the task gives as one: `IF di1 = 1` reads the signal that `WaitDI di1,
+/// 1` waits on (before, the read was an unknown name while the wait passed), wherever the
+/// two stand; a name no I/O instruction gives is still unknown.
+#[test]
+fn a_signal_read_in_an_expression_is_the_signal_an_instruction_names() {
+    let src = "MODULE m
+    PROC main()
+        IF di1 = 1 THEN
+            WaitTime 1;
+        ENDIF
+        WHILE DI2 = 0 AND di1 = 1 DO
+            WaitTime 0.1;
+        ENDWHILE
+        Other;
+    ENDPROC
+    PROC Other()
+        WaitDI di1, 1;
+        PulseDO \\PLength:=0.1, di2;
+    ENDPROC
+ENDMODULE
+";
+    assert_eq!(errors(src), []);
+    let src = "MODULE m
+    PROC main()
+        IF di7 = 1 THEN
+            WaitDI di1, 1;
+        ENDIF
+    ENDPROC
+ENDMODULE
+";
+    assert_eq!(errors(src), [(Code::E0010, 3, 12)]);
+}

@@ -23,18 +23,36 @@ use crate::rapid::SignalKind;
 use crate::rapid::syntax::{self as r, Arg};
 use crate::syntax::{self as w, Span};
 
+/// The I/O instructions whose first argument (not an option) is a signal's name.
+const SIGNAL_INSTRUCTIONS: &[&str] = &[
+    "setdo",
+    "set",
+    "reset",
+    "pulsedo",
+    "setgo",
+    "waitdi",
+    "waitdo",
+    "waitgi",
+    "waitgo",
+    "isignaldi",
+    "isignaldo",
+    "isignalgi",
+    "isignalgo",
+];
+
 impl Tr<'_> {
     /// Finds every `CONNECT` of the task (with the module it stands in, whose names it
     /// sees), and every order of an interrupt (`ISignalDI …`, `ITimer …`), so that
     /// `IDelete` knows which handlers it disables and `IWatch` how to order it again,
-    /// wherever they stand.
+    /// wherever they stand; and the names its I/O instructions give as signals.
     pub(crate) fn collect_connects(&mut self, modules: &[r::RapidModule]) {
         type Found = (
             Vec<(r::Name, r::Name, Span, usize)>,
             Vec<(String, r::Name, Vec<Arg>)>,
             Vec<String>,
+            Vec<String>,
         );
-        let mut found: Found = (Vec::new(), Vec::new(), Vec::new());
+        let mut found: Found = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         fn walk(ss: &[r::Stmt], module: usize, found: &mut Found) {
             for s in ss {
                 match &s.kind {
@@ -45,6 +63,16 @@ impl Tr<'_> {
                     }
                     r::StmtKind::Call { name, args } => {
                         let k = name.key();
+                        // (The signal an I/O instruction names: its first argument that is
+                        // not an option.)
+                        if SIGNAL_INSTRUCTIONS.contains(&k.as_str())
+                            && let Some(Arg::Pos(r::Expr {
+                                kind: r::ExprKind::Name(n),
+                                ..
+                            })) = args.iter().find(|a| matches!(a, Arg::Pos(_)))
+                        {
+                            found.3.push(n.key());
+                        }
                         if k == "gripload"
                             && let Some(Arg::Pos(r::Expr {
                                 kind: r::ExprKind::Name(n),
@@ -98,10 +126,13 @@ impl Tr<'_> {
                 }
             }
         }
-        let (connects, orders, mut parts) = found;
+        let (connects, orders, mut parts, mut signals) = found;
         parts.sort();
         parts.dedup();
         self.grip_parts = parts;
+        signals.sort();
+        signals.dedup();
+        self.named_signals = signals;
         for (intno, trap, span, mi) in connects {
             self.module = mi;
             let sig = match self.lookup(&trap.key()) {
@@ -235,8 +266,16 @@ impl Tr<'_> {
 
     /// A signal's bare name read as a value (a num), within a workcell.
     pub(crate) fn signal_value(&mut self, n: &r::Name) -> Option<Val> {
-        let io = self.io.as_ref()?;
-        io.iter().find(|s| s.name.eq_ignore_ascii_case(&n.text))?;
+        // (Without the workcell's I/O, a name the task's I/O instructions give as a
+        // signal: `check` of a lone module reads `IF di1 = 1` as `WaitDI di1, 1` sees it.)
+        match self.io.as_ref() {
+            Some(io) => {
+                io.iter().find(|s| s.name.eq_ignore_ascii_case(&n.text))?;
+            }
+            None => {
+                self.named_signals.binary_search(&n.key()).ok()?;
+            }
+        }
         let all = [
             SignalKind::Di,
             SignalKind::Do,

@@ -53,6 +53,7 @@ pub(crate) fn translate(
         ordered: BTreeSet::new(),
         orders: BTreeMap::new(),
         grip_parts: Vec::new(),
+        named_signals: Vec::new(),
     };
     t.collect(modules);
     t.collect_connects(modules);
@@ -181,6 +182,10 @@ pub(crate) struct Tr<'d> {
     pub(crate) ordered: BTreeSet<String>,
     /// The workcell parts the task's `GripLoad`s name (loaddata names, lower case), sorted.
     pub(crate) grip_parts: Vec<String>,
+    /// The names the task's I/O instructions give as their signal (`WaitDI di1, 1`), in
+    /// order (lower case): without the workcell's I/O (`io` is `None`), these alone are
+    /// signals where an expression reads a bare name.
+    pub(crate) named_signals: Vec<String>,
 }
 
 /// The WSL name of a RAPID name: lower case (RAPID is case-insensitive).
