@@ -8,7 +8,7 @@ use std::hint::black_box;
 use std::sync::Arc;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use vworks_model::builtin;
+use vworks_model::{RobotModel, builtin};
 use vworks_vm::machine::{EventKind, Next, Vm, VmConfig};
 
 const LOOPS: i64 = 1_000_000;
@@ -127,6 +127,18 @@ fn corner_sampling(c: &mut Criterion) {
     g.finish();
 }
 
+/// An IRB 120, with `ramp`, its axes' jerk limits ramping each acceleration up in `ramp` s.
+fn irb120_ramping(ramp: Option<f64>) -> Arc<RobotModel> {
+    let mut model = builtin::load("irb120").unwrap();
+    if let Some(ramp) = ramp {
+        for k in 0..model.dof() {
+            let j = model.axes[k];
+            model.joints[j].max_jerk = Some(model.joints[j].max_accel / ramp);
+        }
+    }
+    Arc::new(model)
+}
+
 /// Planning one `move_l` (sampling its path, checking and timing it): 300 mm past axis 1 of
 /// an IRB 120 at 2 m/s, an axis's speed binding; without jerk limits (TOPP-RA), and with
 /// axes ramping their accelerations in 20 ms (the jerk-limited timing's linear programs).
@@ -141,14 +153,7 @@ fn planning(c: &mut Criterion) {
     let mut g = c.benchmark_group("plan");
     g.sample_size(10);
     for (name, ramp) in [("move_l", None), ("move_l_jerk_limited", Some(0.02))] {
-        let mut model = builtin::load("irb120").unwrap();
-        if let Some(ramp) = ramp {
-            for k in 0..model.dof() {
-                let j = model.axes[k];
-                model.joints[j].max_jerk = Some(model.joints[j].max_accel / ramp);
-            }
-        }
-        let model = Arc::new(model);
+        let model = irb120_ramping(ramp);
         g.bench_function(name, |b| {
             b.iter(|| {
                 // (A new VM each time: its memo would remember the path.)
@@ -194,14 +199,7 @@ fn corner_planning(c: &mut Criterion) {
     let mut g = c.benchmark_group("plan");
     g.sample_size(10);
     for (name, ramp) in [("corner", None), ("corner_jerk_limited", Some(0.02))] {
-        let mut model = builtin::load("irb120").unwrap();
-        if let Some(ramp) = ramp {
-            for k in 0..model.dof() {
-                let j = model.axes[k];
-                model.joints[j].max_jerk = Some(model.joints[j].max_accel / ramp);
-            }
-        }
-        let model = Arc::new(model);
+        let model = irb120_ramping(ramp);
         g.bench_function(name, |b| {
             b.iter(|| {
                 let mut v = Vm::new(m.clone(), model.clone(), VmConfig::default(), entry);

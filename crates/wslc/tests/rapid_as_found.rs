@@ -17,8 +17,8 @@ fn errors(src: &str) -> Vec<(Code, u32, u32)> {
     }
 }
 
-/// "The data type intnum is an alias data type for num and thus inherits its
-/// properties" (RAPID reference, intnum): an intnum takes a num as its initial value or
+/// RAPID's intnum is an alias data type of num, with num's properties (ABB's technical
+/// reference manual, data type intnum): an intnum takes a num as its initial value or
 /// by assignment, and is a num in arithmetic.
 #[test]
 fn an_intnum_is_a_num() {
@@ -39,24 +39,20 @@ ENDMODULE
 /// at the name), as anywhere else; a size that is data, not a constant, is still E0080.
 #[test]
 fn an_array_size_naming_nothing_is_an_unknown_name() {
-    let src = "MODULE m
-    CONST num N := 3;
-    VAR num arr{M};
-    PROC main()
-        WaitTime 1;
-    ENDPROC
-ENDMODULE
-";
-    assert_eq!(errors(src), [(Code::E0010, 3, 17)]);
-    let src = "MODULE m
-    VAR num k := 3;
-    VAR num arr{k};
-    PROC main()
-        WaitTime 1;
-    ENDPROC
-ENDMODULE
-";
-    assert_eq!(errors(src), [(Code::E0080, 3, 17)]);
+    // (Line 3, column 17: the size's name after `    VAR num arr{`.)
+    let module = |decl: &str, size: &str| {
+        format!(
+            "MODULE m\n    {decl}\n    VAR num arr{{{size}}};\n    PROC main()\n        WaitTime 1;\n    ENDPROC\nENDMODULE\n"
+        )
+    };
+    assert_eq!(
+        errors(&module("CONST num N := 3;", "M")),
+        [(Code::E0010, 3, 17)]
+    );
+    assert_eq!(
+        errors(&module("VAR num k := 3;", "k")),
+        [(Code::E0080, 3, 17)]
+    );
 }
 
 /// Without the workcell's I/O (`vworks check m.mod`), a signal is any name an I/O

@@ -360,12 +360,8 @@ fn fixed_rows(path: &JointPath, slopes: &KnotSlopes, lim: &Limits<'_>, rows: &mu
             let face = whole * (std::f64::consts::PI / (2.0 * NORMAL_FACES as f64)).cos();
             // (Where the path does not curve, w = 0: the faces bound the acceleration along
             // it alone, and only the two most nearly along it bind.)
-            let faces: &mut dyn Iterator<Item = usize> = if nm == 0.0 {
-                &mut [0, NORMAL_FACES - 1].into_iter()
-            } else {
-                &mut (0..NORMAL_FACES)
-            };
-            for j in faces {
+            let binds = |j: &usize| nm != 0.0 || *j == 0 || *j == NORMAL_FACES - 1;
+            for j in (0..NORMAL_FACES).filter(binds) {
                 let alpha = (j as f64 + 0.5) * std::f64::consts::PI / NORMAL_FACES as f64;
                 let (sin, cos) = alpha.sin_cos();
                 terms.clear();

@@ -720,9 +720,7 @@ fn time_corner(
             &joints_at,
             start,
         )?;
-        let look_ahead = stop_at
-            .and_then(|s| smooth_look_ahead(&timing, s))
-            .map(|t| t.max(timing.time_at(corner.end())));
+        let look_ahead = stop_at.and_then(|s| smooth_look_ahead(&timing, s));
         return taken((next, tool), &corner, (&timed, timing, look_ahead), r);
     }
     let mut time = |x0: f64| {
@@ -747,15 +745,12 @@ fn time_corner(
         }
         Err(_) => return None,
     };
-    // (Its own motion_end, and so the next corner, never before its curve and its turn
-    // have ended.)
-    let curve_end = timing.time_at(corner.end());
-    let look_ahead = look_ahead.map(|t| t.max(curve_end));
     taken((next, tool), &corner, (&joints, timing, look_ahead), r)
 }
 
 /// The corner `corner` into `next` (with `tool`) as taken: the path `joints` and its
-/// `timing`, its own look-ahead point.
+/// `timing`, its own look-ahead point (never before its curve and its turn have ended:
+/// its own motion_end, and so the next corner, comes after them).
 fn taken(
     (next, tool): (&Trajectory, &Iso),
     corner: &TimedCorner,
@@ -775,6 +770,7 @@ fn taken(
     else {
         return None;
     };
+    let look_ahead = look_ahead.map(|t| t.max(timing.time_at(corner.end())));
     let rates = timed_rates(joints, &timing);
     let point_ns = to_ns(timing.duration());
     Some(Taken {

@@ -12,7 +12,7 @@ use vworks_model::timing::{JointPath, KNOTS, KnotLimits, Limits, SEGMENTS, Timin
 use super::jerks::{KnotJerks, NEAR_JERK, axis_jerk_load, axis_jerks};
 use super::plan::{JOINT_SPEED_TOLERANCE, PlanError, ik_tcp};
 use super::quarters::{Inner, Kink};
-use super::smooth::{smooth_look_ahead, smooth_timing};
+use super::smooth::smooth_timing;
 use crate::MAX_AXES;
 use crate::motion::{Path, Profile, cartesian_at};
 
@@ -173,9 +173,7 @@ pub(super) fn sample_path(
             .then_some(profile.t_total)
             .filter(|t| t.is_finite());
         let end = timed.q[SEGMENTS];
-        // (With a zone: where the next motion may take the robot over.)
-        let look_ahead = zone.and_then(|z| smooth_look_ahead(&timing, 1.0 - z));
-        timed_samples(&timed, timing, (unslowed, worst_axis), end, look_ahead)
+        timed_samples(&timed, timing, (unslowed, worst_axis), end, None)
     };
     // (No S-curve, the programmed one nor slower ones, can beat a jerk-limited timing
     // faster than the programmed one: the checks and searches below are for none.)

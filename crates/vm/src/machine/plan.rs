@@ -18,7 +18,7 @@ use crate::types::{Dim, fmt_quantity};
 use vworks_model::timing::{SEGMENTS, Timing};
 
 use super::path::{PATH_KEY, PathMemo, PathSamples, SEEDS, sample_path};
-use super::smooth::profile_look_ahead;
+use super::smooth::{profile_look_ahead, smooth_look_ahead};
 pub(super) use super::trajectory::Trajectory;
 
 /// How far (relative) an axis's speed found by sampling may exceed its limit and still
@@ -628,9 +628,15 @@ fn plan_cartesian(
             zone_share,
             duration_ns.is_none(),
         )?;
-        // (An S-curve looks ahead as a smooth timing does.)
-        if let (None, None, Some(z)) = (&s.timing, s.look_ahead, zone_share) {
-            s.look_ahead = profile_look_ahead(s.executed.as_ref().unwrap_or(&profile), z);
+        // (With a zone, a jerk-limited timing or an S-curve looks ahead from where its
+        // last braking, moved back by the zone, begins; a timing within the axes' limits
+        // has its own look-ahead point.)
+        if let (None, Some(z)) = (s.look_ahead, zone_share) {
+            s.look_ahead = match &s.timing {
+                Some(t) if t.is_smooth() => smooth_look_ahead(t, 1.0 - z),
+                Some(_) => None,
+                None => profile_look_ahead(s.executed.as_ref().unwrap_or(&profile), z),
+            };
         }
         let lasts = sampled_seconds(&s.timing, &s.executed, &profile);
         Ok((s, profile, lasts * NS))

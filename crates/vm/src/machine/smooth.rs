@@ -185,14 +185,12 @@ pub(super) fn time_smooth(
 /// or that place is before the first knot, its start: the next motion takes it over from
 /// rest, the two timed as one path.
 pub(super) fn smooth_look_ahead(timing: &Timing, stop_at: f64) -> Option<f64> {
-    let braking = (1..SEGMENTS)
-        .rev()
-        .find(|&k| timing.state_at_place(timing.knot(k)).1 >= 0.0)?;
+    // (s̈ at knot k: the step after it starts there.)
+    let accel = |k: usize| timing.state_at_place(timing.knot(k)).1;
+    let braking = (1..SEGMENTS).rev().find(|&k| accel(k) >= 0.0)?;
     let place = timing.knot(braking) - (1.0 - stop_at);
-    let top_accel = (0..SEGMENTS)
-        .map(|k| timing.state_at_place(timing.knot(k)).1.abs())
-        .fold(0.0f64, f64::max);
-    let cruising = |k: usize| timing.state_at_place(timing.knot(k)).1 <= CRUISING * top_accel;
+    let top_accel = (0..SEGMENTS).map(|k| accel(k).abs()).fold(0.0f64, f64::max);
+    let cruising = |k: usize| accel(k) <= CRUISING * top_accel;
     match (1..=braking).rev().find(|&k| timing.knot(k) <= place) {
         Some(k) if cruising(k) => Some(timing.time_at_knot(k)),
         _ => Some(0.0),
@@ -205,7 +203,7 @@ const CRUISING: f64 = 0.01;
 
 /// An S-curve's look-ahead point for a zone of `zone` (a share of its distance), as
 /// [`smooth_look_ahead`]'s: its braking begins `t_acc` before its end; moved back by the
-/// zone, the time it is there (by bisection), if it cruises there; else its start. `None`
+/// zone, the first time it is there, if it cruises there; else its start. `None`
 /// for a trapezoid: an arm without jerk limits flies by with corner ramps.
 pub(super) fn profile_look_ahead(profile: &Profile, zone: f64) -> Option<f64> {
     if profile.t_jerk <= 0.0 || profile.dist.is_nan() || profile.dist <= 0.0 {
@@ -216,16 +214,7 @@ pub(super) fn profile_look_ahead(profile: &Profile, zone: f64) -> Option<f64> {
     if place <= profile.at(profile.t_acc) {
         return Some(0.0);
     }
-    let (mut lo, mut hi) = (0.0f64, braking);
-    for _ in 0..64 {
-        let mid = 0.5 * (lo + hi);
-        if profile.at(mid) < place {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    Some(lo)
+    Some(profile.time_at(place))
 }
 
 /// Axis `i`'s third differences in step `k` at its 1.5 and 2.5 quarters (from its knots

@@ -287,30 +287,31 @@ impl Trajectory {
         }
     }
 
-    /// The acceleration of a Cartesian motion's own path fraction `dt` seconds in (1/s²):
-    /// past a corner it took over (where its own fraction is linear in the path's), or
-    /// without one. (Ramps are not followed: 0; they fly by with ramps, not timed corners.)
-    pub(super) fn own_accel_at(&self, dt: f64) -> f64 {
-        let (rate, timing, profile) = match self {
+    /// The path acceleration `d²s/dt²` (fractions of the path per second²) of a Cartesian
+    /// trajectory `dt` seconds in (0 for a joint one, and on corner ramps: timed corners,
+    /// which read it, never take over from them).
+    pub(super) fn path_accel_at(&self, dt: f64) -> f64 {
+        match self {
+            Trajectory::Cartesian { ramps: Some(_), .. } => 0.0,
             Trajectory::Cartesian {
-                corner,
-                timing,
-                profile,
-                ramps: None,
-                ..
-            } => (
-                corner
-                    .as_ref()
-                    .map_or(1.0, |c| c.own_rate(self.fraction_at(dt))),
-                timing,
-                profile,
-            ),
-            _ => return 0.0,
-        };
-        match timing {
-            Some(t) => rate * t.at(dt).accel,
-            None if profile.dist > 0.0 => rate * profile.accel_at(dt) / profile.dist,
-            None => 0.0,
+                timing: Some(t), ..
+            } => t.at(dt).accel,
+            Trajectory::Cartesian { profile, .. } if profile.dist > 0.0 => {
+                profile.accel_at(dt) / profile.dist
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// The acceleration of a Cartesian motion's own path fraction `dt` seconds in (1/s²),
+    /// as [`Trajectory::own_speed_at`]: past a corner it took over its own fraction is
+    /// linear in the path's.
+    pub(super) fn own_accel_at(&self, dt: f64) -> f64 {
+        match self {
+            Trajectory::Cartesian {
+                corner: Some(c), ..
+            } => c.own_rate(self.fraction_at(dt)) * self.path_accel_at(dt),
+            _ => self.path_accel_at(dt),
         }
     }
 
