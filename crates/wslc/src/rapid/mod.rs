@@ -13,6 +13,7 @@
 //! assert_eq!(out.module.globals.len(), 1);
 //! ```
 
+mod catalog;
 pub mod lexer;
 mod lower;
 pub mod parser;

@@ -8,6 +8,7 @@ use vworks_vm::Dim;
 use super::data::{Ty, build as b, quat_rpy};
 use super::{Data, Sym, Tr, Val};
 use crate::diag::Code;
+use crate::rapid::catalog::Kind;
 use crate::rapid::syntax::{self as r, Arg};
 use crate::syntax::{self as w, Span};
 
@@ -118,6 +119,9 @@ impl Tr<'_> {
     }
 
     pub(crate) fn unknown_name(&mut self, n: &r::Name) {
+        if self.not_run(n, &[Kind::Data]) {
+            return;
+        }
         let key = n.key();
         let names: Vec<String> = self
             .locals
@@ -748,6 +752,7 @@ impl Tr<'_> {
                 );
                 None
             }
+            None if self.not_run(f, &[Kind::Function]) => None,
             None => {
                 let elsewhere = self.local_elsewhere(&f.key());
                 let d = self.error(

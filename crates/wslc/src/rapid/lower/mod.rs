@@ -23,6 +23,7 @@ pub(crate) mod table;
 
 use std::collections::{BTreeMap, BTreeSet};
 
+use super::catalog::{self, Kind};
 use super::syntax::{self as r, Storage};
 use crate::diag::{Code, Diagnostic};
 use crate::syntax::{self as w, Span};
@@ -223,6 +224,20 @@ impl Tr<'_> {
         self.diags.push(d);
     }
 
+    /// E0300 for a RAPID built-in of `kinds` that vworks does not run, naming it and its
+    /// part of RobotWare (the catalogue, [`crate::rapid::catalog`]); false if `name` is
+    /// none.
+    pub(crate) fn not_run(&mut self, name: &r::Name, kinds: &[Kind]) -> bool {
+        let Some(entry) = catalog::find(&name.text, kinds) else {
+            return false;
+        };
+        let d = Diagnostic::error(Code::E0300, entry.message(), name.span)
+            .with_help(entry.group.help.to_string())
+            .with_note("docs/rapid.md lists what RAPID vworks runs, and under \"Not run\" what it does not");
+        self.diags.push(d);
+        true
+    }
+
     /// Module-level names first, so routines may be called before they are declared. A
     /// name is declared once in its module, and a task-wide name once in the task; a
     /// `LOCAL` name may repeat in other modules.
@@ -328,26 +343,7 @@ impl Tr<'_> {
         if let Some(t) = Ty::from_name(&n.text) {
             return Some(t);
         }
-        let known = [
-            "signaldi",
-            "signaldo",
-            "signalgi",
-            "signalgo",
-            "signalai",
-            "signalao",
-            "clock",
-            "errnum",
-            "triggdata",
-            "shapedata",
-            "wzstationary",
-        ];
-        if known.contains(&n.key().as_str()) {
-            self.unsupported(
-                &format!("the data type `{}`", n.text),
-                n.span,
-                "I/O signals, sync identifiers and task lists come with the I/O and MultiMove support; see docs/rapid.md",
-            );
-        } else {
+        if !self.not_run(n, &[Kind::DataType]) {
             // The types a declaration may name anywhere (not MultiMove's).
             let names: Vec<&str> = data::TYPES
                 .iter()

@@ -11,59 +11,9 @@ use super::expr::article;
 use super::table::Call;
 use super::{Data, Sym, Tr, block};
 use crate::diag::Code;
+use crate::rapid::catalog::Kind;
 use crate::rapid::syntax::{self as r, Arg, Storage};
 use crate::syntax::{self as w, Span};
-
-/// Instructions that exist in RAPID but that vworks does not run (and that the table,
-/// [`super::table::INSTRUCTIONS`], does not name).
-const UNSUPPORTED: &[&str] = &[
-    "syncmoveon",
-    "syncmoveoff",
-    "syncmoveundo",
-    "searchl",
-    "searchc",
-    "searchj",
-    "triggl",
-    "triggj",
-    "triggc",
-    "movelsync",
-    "movejsync",
-    "movecsync",
-    "movelddo",
-    "movejdo",
-    "movecdo",
-    "movelao",
-    "wzboxdef",
-    "wzcyldef",
-    "wzspherdef",
-    "wzlimsup",
-    "wzdosignal",
-    "wzenable",
-    "wzdisable",
-    "wzfree",
-    "accset",
-    "velset",
-    "pathaccLim",
-    "stoppmove",
-    "startmove",
-    "storepath",
-    "restopath",
-    "clearpath",
-    "open",
-    "close",
-    "write",
-    "readnum",
-    "clkstart",
-    "clkstop",
-    "clkreset",
-    "tpreadfk",
-    "tpreadnum",
-    "load",
-    "unload",
-    "erase",
-    "raisetouser",
-    "setao",
-];
 
 impl Tr<'_> {
     /// A statement list in a scope of its own.
@@ -567,14 +517,6 @@ impl Tr<'_> {
         if self.instruction(&key, name, args, span, out) {
             return;
         }
-        if UNSUPPORTED.contains(&key.as_str()) {
-            self.unsupported(
-                &format!("the instruction `{}`", name.text),
-                name.span,
-                "write the program without it",
-            );
-            return;
-        }
         let mut push = |kind| out.push(w::Stmt { kind, span });
         match self.lookup(&key) {
             Some(Sym::Routine(sig)) if sig.kind == r::RoutineKind::Proc => {
@@ -602,6 +544,7 @@ impl Tr<'_> {
                     name.span,
                 );
             }
+            _ if self.not_run(name, &[Kind::Instruction, Kind::Function]) => {}
             _ => {
                 let names: Vec<String> = self
                     .scope

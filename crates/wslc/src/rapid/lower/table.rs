@@ -532,20 +532,6 @@ pub(crate) const FUNCTIONS: &[Row<FuncLowering>] = &[
         FNotRun(NOT_HERE),
         "only inside TPWrite/ErrWrite texts",
     ),
-    row("Present", 0..=usize::MAX, &[], FNotRun(NOT_HERE), "E0300"),
-    row("StrLen", 0..=usize::MAX, &[], FNotRun(NOT_HERE), "E0300"),
-    row("StrPart", 0..=usize::MAX, &[], FNotRun(NOT_HERE), "E0300"),
-    row("Pow", 0..=usize::MAX, &[], FNotRun(NOT_HERE), "E0300"),
-    row("Exp", 0..=usize::MAX, &[], FNotRun(NOT_HERE), "E0300"),
-    row("ClkTime", 0..=usize::MAX, &[], FNotRun(NOT_HERE), "E0300"),
-    row(
-        "GetNextSym",
-        0..=usize::MAX,
-        &[],
-        FNotRun(NOT_HERE),
-        "E0300",
-    ),
-    row("ReadNum", 0..=usize::MAX, &[], FNotRun(NOT_HERE), "E0300"),
 ];
 
 /// The row named `key` (any case).
