@@ -785,6 +785,12 @@ impl Vm {
         let Some((end, at)) = self.arm.zoned_point_ahead(t) else {
             return t;
         };
+        // `delay 0s` says it: it waits for the robot and nothing else (RAPID's `WaitRob`).
+        let zero_delay =
+            ins == Some(Instr::Delay) && self.main.stack.last() == Some(&0f64.to_bits());
+        if zero_delay {
+            return end;
+        }
         // Warned at the stop point's time, where the trace shows the statement's event.
         self.warn_once(pc, end, WarningKind::StopPoint, |vm| {
             format!(

@@ -37,6 +37,9 @@ pub(crate) enum Ty {
     Conf,
     Extax,
     Intnum,
+    /// A stopwatch (`ClkStart`, `ClkRead`): when it last started, the time it ran before,
+    /// and whether it runs.
+    Clock,
     /// A MultiMove synchronisation point (`WaitSyncTask`).
     Syncident,
     /// A task name, in the task lists of `WaitSyncTask`.
@@ -64,6 +67,7 @@ pub(crate) const TYPES: &[(&str, Ty)] = &[
     ("confdata", Ty::Conf),
     ("extjoint", Ty::Extax),
     ("intnum", Ty::Intnum),
+    ("clock", Ty::Clock),
     ("syncident", Ty::Syncident),
     ("tasks", Ty::Tasks),
 ];
@@ -105,6 +109,11 @@ impl Ty {
                 (".zone_ori", Type::Num(Dim::ANGLE)),
             ],
             Ty::Tool => &[(".tframe", Type::Pose)],
+            Ty::Clock => &[
+                (".started", Type::Num(Dim::TIME)),
+                (".before", Type::Num(Dim::TIME)),
+                (".running", Type::Bool),
+            ],
             Ty::Wobj => &[(".uframe", Type::Pose), (".oframe", Type::Pose)],
             Ty::Str | Ty::Load | Ty::Conf | Ty::Extax | Ty::Syncident | Ty::Tasks => &[],
         }

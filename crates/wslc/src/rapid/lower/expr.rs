@@ -483,7 +483,7 @@ impl Tr<'_> {
             Ty::Load => 6,
             Ty::Extax => 6,
             Ty::Tasks => 1,
-            Ty::Num | Ty::Bool | Ty::Str | Ty::Intnum | Ty::Syncident => {
+            Ty::Num | Ty::Bool | Ty::Str | Ty::Intnum | Ty::Syncident | Ty::Clock => {
                 self.error(
                     Code::E0020,
                     format!("expected {}, found `[…]`", article(want)),
@@ -704,7 +704,7 @@ impl Tr<'_> {
                     text: name.text,
                 })
             }
-            Ty::Num | Ty::Bool | Ty::Str | Ty::Intnum | Ty::Syncident => None,
+            Ty::Num | Ty::Bool | Ty::Str | Ty::Intnum | Ty::Syncident | Ty::Clock => None,
         }
     }
 

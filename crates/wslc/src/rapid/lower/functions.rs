@@ -210,20 +210,52 @@ impl Tr<'_> {
         let (key, f, span) = (c.key, c.name, c.span);
         let p = &c.pos;
         let opts = &c.opts;
-        if let Some((_, n, _)) = opts.first() {
-            self.unsupported(
-                &format!("{}'s `\\Dec`", f.text),
-                n.span,
-                "scale the value by a power of ten",
-            );
-            return None;
-        }
+        // `\Dec:=n`: n decimals, by scaling by 10^n (a constant whole number 0 to 15).
+        let scale = match opts.first() {
+            None => None,
+            Some((_, n, e)) => match e.map(|e| (e, self.const_num(e))) {
+                Some((_, Some(d))) if (0.0..=15.0).contains(&d) && d.fract() == 0.0 => {
+                    Some(10f64.powi(d as i32))
+                }
+                Some((e, Some(_))) => {
+                    self.error(
+                        Code::E0025,
+                        format!(
+                            "{}'s `\\Dec` is a whole number of decimals, 0 to 15",
+                            f.text
+                        ),
+                        e.span,
+                    );
+                    return None;
+                }
+                _ => {
+                    self.unsupported(
+                        &format!("{}'s `\\Dec` of a value known only when running", f.text),
+                        n.span,
+                        "give the number of decimals as a constant",
+                    );
+                    return None;
+                }
+            },
+        };
         let x = self.nums(p)?.remove(0);
+        let x = match scale {
+            Some(k) => b::bin(w::BinOp::Mul, x, b::num(k, span)),
+            None => x,
+        };
+        let unscale = |e: w::Expr| match scale {
+            Some(k) => b::bin(w::BinOp::Div, e, b::num(k, span)),
+            None => e,
+        };
         if key == "trunc" {
-            return num(b::call("num", vec![b::call("int", vec![x], span)], span));
+            return num(unscale(b::call(
+                "num",
+                vec![b::call("int", vec![x], span)],
+                span,
+            )));
         }
         self.round_helper(span);
-        num(b::call("round'", vec![x], span))
+        num(unscale(b::call("round'", vec![x], span)))
     }
 
     /// `OrientZYX(z, y, x)`.

@@ -14,6 +14,7 @@
 //! Every WSL node gets the span of the RAPID construct it comes from, so the bytecode's
 //! line table, the event trace and runtime errors name RAPID lines.
 
+mod clocks;
 pub(crate) mod data;
 mod expr;
 mod functions;
@@ -874,6 +875,11 @@ pub(crate) fn block(stmts: Vec<w::Stmt>, span: Span) -> w::Block {
 }
 
 /// RAPID's predefined data: speeds, zones, `tool0`, `wobj0`, `load0`.
+/// RAPID's `pi`: the system module BASE declares `CONST num pi := 3.1415926;`, seven
+/// decimals, not the f64 nearest π (programs that print or compare it see these).
+#[allow(clippy::approx_constant)]
+const RAPID_PI: f64 = 3.1415926;
+
 fn predefined(key: &str) -> Option<Data> {
     let span = Span::default();
     let mut d = Data {
@@ -918,6 +924,12 @@ fn predefined(key: &str) -> Option<Data> {
             d.ty = Ty::Load;
             d.inline = Some(Vec::new());
         }
+        // The predefined nums: pi as RAPID defines it (to 7 decimals), a digital
+        // signal's levels, and the longest wait.
+        "pi" => d.inline = Some(vec![b::num(RAPID_PI, span)]),
+        "high" => d.inline = Some(vec![b::num(1.0, span)]),
+        "low" => d.inline = Some(vec![b::num(0.0, span)]),
+        "wait_max" => d.inline = Some(vec![b::num(8_388_608.0, span)]),
         _ => return None,
     }
     Some(d)

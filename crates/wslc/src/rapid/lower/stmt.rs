@@ -123,7 +123,7 @@ impl Tr<'_> {
 
     /// The data an assignment or `Incr` writes: a name, or an array element at a
     /// constant index.
-    fn place(&mut self, e: &r::Expr) -> Option<(Data, Option<u32>)> {
+    pub(crate) fn place(&mut self, e: &r::Expr) -> Option<(Data, Option<u32>)> {
         let (n, idx) = match &e.kind {
             r::ExprKind::Name(n) => (n, None),
             r::ExprKind::Index(x, idx) => match (&x.kind, idx.as_slice()) {
@@ -583,6 +583,21 @@ impl Tr<'_> {
             let kind = w::StmtKind::Delay(b::with_unit(t.leaf(), Dim::TIME));
             out.push(w::Stmt { kind, span: c.span });
         }
+    }
+
+    /// `WaitRob \InPos;`, `WaitRob \ZeroSpeed;`: the program waits until the robot stands
+    /// at its point (a zoned point before it becomes a stop point): `delay 0s`.
+    pub(crate) fn wait_rob(&mut self, c: &Call<'_>, out: &mut Vec<w::Stmt>) {
+        if c.opts.len() != 1 {
+            self.error(
+                Code::E0013,
+                "WaitRob takes one of `\\InPos` or `\\ZeroSpeed`",
+                c.span,
+            );
+            return;
+        }
+        let kind = w::StmtKind::Delay(b::quantity(0.0, Dim::TIME, c.span));
+        out.push(w::Stmt { kind, span: c.span });
     }
 
     /// `TPWrite text [\Num:=n] …;`

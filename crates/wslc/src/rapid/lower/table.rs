@@ -11,6 +11,7 @@
 
 use std::ops::RangeInclusive;
 
+use super::data::{Ty, build as b};
 use super::{Tr, Val};
 use crate::rapid::syntax::{self as r, Arg};
 use crate::syntax::{self as w, Span};
@@ -202,6 +203,34 @@ pub(crate) const INSTRUCTIONS: &[Row<InstrLowering>] = &[
         &[],
         I(|t, c, out| t.grip_load(c, out)),
         "grip the part the loaddata names; load0 releases it",
+    ),
+    row(
+        "WaitRob",
+        0..=0,
+        &["InPos", "ZeroSpeed"],
+        I(|t, c, out| t.wait_rob(c, out)),
+        "wait until the robot stands at its point",
+    ),
+    row(
+        "ClkReset",
+        1..=1,
+        &[],
+        I(|t, c, out| t.clock(c, out)),
+        "a clock to zero (a running clock runs on)",
+    ),
+    row(
+        "ClkStart",
+        1..=1,
+        &[],
+        I(|t, c, out| t.clock(c, out)),
+        "a clock runs from the simulated time now",
+    ),
+    row(
+        "ClkStop",
+        1..=1,
+        &[],
+        I(|t, c, out| t.clock(c, out)),
+        "a clock stops, keeping its time",
     ),
     row(
         "MoveL",
@@ -517,6 +546,25 @@ pub(crate) const FUNCTIONS: &[Row<FuncLowering>] = &[
         &[],
         F(|t, c| t.io_function(c)),
         "a digital input is 1",
+    ),
+    row(
+        "ClkRead",
+        1..=1,
+        &["HighRes"],
+        F(|t, c| t.clock_read(c)),
+        "a clock's time in seconds",
+    ),
+    row(
+        "RobOS",
+        0..=0,
+        &[],
+        F(|_, c| {
+            Some(Val::one(
+                Ty::Bool,
+                b::expr(w::ExprKind::Bool(false), c.span),
+            ))
+        }),
+        "FALSE: vworks is not a real controller (as on a virtual one)",
     ),
     row(
         "NumToStr",
