@@ -158,7 +158,7 @@ fn bad_inputs_are_errors_with_the_file_named() {
     assert!(text(&out.stderr).contains("missing.wsl"));
 
     let corrupt = d.join("corrupt.wslb");
-    std::fs::write(&corrupt, b"WSLB\x04\x00\x00\x00garbage").unwrap_or_else(|e| panic!("{e}"));
+    std::fs::write(&corrupt, b"WSLB\x05\x00\x00\x00garbage").unwrap_or_else(|e| panic!("{e}"));
     let out = vworks(&["disasm", corrupt.to_str().unwrap_or_default()]);
     assert_eq!(out.status.code(), Some(1));
     let err = text(&out.stderr);

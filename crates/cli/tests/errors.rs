@@ -11,7 +11,7 @@
 mod common;
 use std::path::Path;
 
-use common::{parse, run, test_every_case};
+use common::{mask_speed, parse, run, test_every_case};
 
 fn main() {
     test_every_case(
@@ -24,6 +24,7 @@ fn main() {
 fn every_bad_input_gets_an_answer_a_person_can_act_on(dir: &Path, name: &str) {
     let case = parse(&std::fs::read_to_string(dir.join(format!("{name}.case"))).unwrap());
     let (code, stdout, stderr) = run(name, &case);
+    let (stdout, stderr) = (mask_speed(&stdout), mask_speed(&stderr));
     let mut got = format!("exit {code}\n--- stderr\n{stderr}");
     if !stdout.is_empty() {
         got.push_str("--- stdout\n");

@@ -15,7 +15,7 @@
 mod common;
 use std::path::Path;
 
-use common::{parse, run, test_every_case};
+use common::{mask_speed, parse, run, test_every_case};
 
 fn main() {
     test_every_case(
@@ -23,24 +23,6 @@ fn main() {
         10,
         runs_give_the_times_and_outcomes_the_language_reference_promises,
     )
-}
-
-/// `1234x real time` → `Nx real time`: the only thing in an output that depends on the
-/// machine.
-fn mask_speed(text: &str) -> String {
-    text.lines()
-        .map(|line| match line.find("x real time") {
-            Some(end) => {
-                let start = line[..end]
-                    .rfind(|c: char| !c.is_ascii_digit())
-                    .map_or(0, |i| i + 1);
-                format!("{}N{}", &line[..start], &line[end..])
-            }
-            None => line.to_string(),
-        })
-        .collect::<Vec<_>>()
-        .join("\n")
-        + if text.ends_with('\n') { "\n" } else { "" }
 }
 
 fn runs_give_the_times_and_outcomes_the_language_reference_promises(dir: &Path, name: &str) {

@@ -10,6 +10,7 @@
 
 use crate::bytecode::{Cmp, Instr, Module, ProcInfo, SrcPos};
 use crate::math;
+use crate::texts::{self, Texts};
 
 /// One activation record.
 #[derive(Clone, Copy, Debug)]
@@ -150,6 +151,7 @@ impl Thread {
         m: &Module,
         r: &dyn Reader,
         vars: &mut [u64],
+        texts: &mut Texts,
         budget: &mut u64,
         max_depth: usize,
     ) -> Result<Stop, RuntimeError> {
@@ -338,6 +340,18 @@ impl Thread {
                         x.max(y)
                     } as u64);
                 }
+                Instr::TextCat
+                | Instr::CmpT(_)
+                | Instr::TextLen
+                | Instr::TextPart
+                | Instr::TextFind(_)
+                | Instr::TextMatch
+                | Instr::TextMemb
+                | Instr::TextMap
+                | Instr::NumToText
+                | Instr::ValText(_)
+                | Instr::TextIsNum
+                | Instr::TextNum => self.text(ins, m, texts).map_err(|e| err(pc, e))?,
                 Instr::MinF | Instr::MaxF | Instr::Atan2 => {
                     let y = f(self.pop());
                     let x = f(self.pop());
@@ -513,5 +527,70 @@ impl Thread {
             ));
         }
         Ok(i as usize)
+    }
+}
+
+impl Thread {
+    /// A text instruction ([`crate::texts`]): pops its operands, pushes its result.
+    fn text(&mut self, ins: Instr, m: &Module, texts: &mut Texts) -> Result<(), String> {
+        fn text_of<'a>(t: &'a Texts, m: &'a Module, h: u64) -> Result<&'a str, String> {
+            t.get(m, h)
+                .ok_or_else(|| format!("a text handle no text has ({h}): a corrupt module"))
+        }
+        let v = match ins {
+            Instr::TextCat => {
+                let (y, x) = (self.pop(), self.pop());
+                let s = format!("{}{}", text_of(texts, m, x)?, text_of(texts, m, y)?);
+                texts.make(m, s)?
+            }
+            Instr::CmpT(c) => {
+                let (y, x) = (self.pop(), self.pop());
+                let o = text_of(texts, m, x)?.cmp(text_of(texts, m, y)?);
+                u64::from(c.holds(o))
+            }
+            Instr::TextLen => b(text_of(texts, m, self.pop())?.chars().count() as f64),
+            Instr::TextPart => {
+                let (len, start, s) = (f(self.pop()), f(self.pop()), self.pop());
+                let part = texts::part(text_of(texts, m, s)?, start, len)?;
+                texts.make(m, part)?
+            }
+            Instr::TextFind(_) | Instr::TextMatch | Instr::TextMemb => {
+                let (set, at, s) = (self.pop(), f(self.pop()), self.pop());
+                let (s, set) = (text_of(texts, m, s)?, text_of(texts, m, set)?);
+                match ins {
+                    Instr::TextFind(not_in) => b(texts::find(s, at, set, not_in)?),
+                    Instr::TextMatch => b(texts::find_text(s, at, set)?),
+                    _ => u64::from(texts::member(s, at, set)?),
+                }
+            }
+            Instr::TextMap => {
+                let (to, from, s) = (self.pop(), self.pop(), self.pop());
+                let mapped = texts::map(
+                    text_of(texts, m, s)?,
+                    text_of(texts, m, from)?,
+                    text_of(texts, m, to)?,
+                );
+                texts.make(m, mapped)?
+            }
+            Instr::NumToText => {
+                let (dec, x) = (f(self.pop()), f(self.pop()));
+                texts.make(m, texts::num_to_str(x, dec)?)?
+            }
+            Instr::ValText(k) => {
+                let x = self.pop();
+                let s = match k {
+                    0 => (if x != 0 { "TRUE" } else { "FALSE" }).to_string(),
+                    _ => texts::num_value(f(x)),
+                };
+                texts.make(m, s)?
+            }
+            Instr::TextIsNum => {
+                u64::from(texts::parse_num(text_of(texts, m, self.pop())?).is_some())
+            }
+            Instr::TextNum => b(texts::parse_num(text_of(texts, m, self.pop())?).unwrap_or(0.0)),
+            _ => return Err(format!("`{}` is not a text instruction", ins.name())),
+        };
+        self.stack.push(v);
+        Ok(())
     }
 }

@@ -26,6 +26,7 @@ pub mod machine;
 pub mod math;
 pub mod motion;
 pub mod ramps;
+pub mod texts;
 pub mod types;
 
 pub use bytecode::{Instr, LoadError, Module};

@@ -204,13 +204,18 @@ pub enum Type {
     Joints,
     /// Position (m) and fixed-axis roll-pitch-yaw orientation (rad).
     Pose,
+    /// A text (RAPID's `string`; WSL writes text only in `log` and `fail`): one slot, a
+    /// handle of the robot's texts ([`crate::texts::Texts`]): 0 is the empty text, `k + 1`
+    /// the module's string `k`, and the handles after those the texts the run made. A text
+    /// is its robot's own: it is never a global, and never crosses to another robot.
+    Text,
 }
 
 impl Type {
     /// How many 64-bit slots a value of this type takes on the stack or in a frame.
     pub fn width(self) -> u8 {
         match self {
-            Type::Bool | Type::Int | Type::Num(_) => 1,
+            Type::Bool | Type::Int | Type::Num(_) | Type::Text => 1,
             Type::Pose => POSE_WIDTH,
             Type::Joints => MAX_AXES as u8,
         }
@@ -235,6 +240,7 @@ impl Type {
             Type::Num(d) => format!("num({})", d.formula()),
             Type::Joints => "joints".into(),
             Type::Pose => "pose".into(),
+            Type::Text => "text".into(),
         }
     }
 }
@@ -258,6 +264,8 @@ pub enum ConstValue {
     Joints(Vec<f64>),
     /// A pose: x, y, z (m), rx, ry, rz (rad).
     Pose([f64; 6]),
+    /// A text: the index of the module's string (its slot is the handle `index + 1`).
+    Text(u32),
 }
 
 impl ConstValue {
@@ -269,6 +277,7 @@ impl ConstValue {
             Type::Num(_) => ConstValue::Num(0.0),
             Type::Joints => ConstValue::Joints(Vec::new()),
             Type::Pose => ConstValue::Pose([0.0; 6]),
+            Type::Text => ConstValue::Text(u32::MAX),
         }
     }
 
@@ -278,7 +287,8 @@ impl ConstValue {
             (ConstValue::Bool(_), Type::Bool)
             | (ConstValue::Int(_), Type::Int)
             | (ConstValue::Num(_), Type::Num(_))
-            | (ConstValue::Pose(_), Type::Pose) => true,
+            | (ConstValue::Pose(_), Type::Pose)
+            | (ConstValue::Text(_), Type::Text) => true,
             (ConstValue::Joints(v), Type::Joints) => v.len() <= MAX_AXES,
             _ => false,
         }
@@ -287,7 +297,7 @@ impl ConstValue {
     /// True when every number in the value is finite (no NaN or infinity).
     pub fn is_finite(&self) -> bool {
         match self {
-            ConstValue::Bool(_) | ConstValue::Int(_) => true,
+            ConstValue::Bool(_) | ConstValue::Int(_) | ConstValue::Text(_) => true,
             ConstValue::Num(x) => x.is_finite(),
             ConstValue::Joints(v) => v.iter().all(|x| x.is_finite()),
             ConstValue::Pose(p) => p.iter().all(|x| x.is_finite()),
@@ -312,6 +322,9 @@ impl ConstValue {
                     *s = x.to_bits();
                 }
             }
+            // The empty text (the zero value) is handle 0.
+            ConstValue::Text(u32::MAX) => out[0] = 0,
+            ConstValue::Text(k) => out[0] = u64::from(*k) + 1,
         }
     }
 
@@ -334,6 +347,8 @@ impl ConstValue {
                     .collect();
                 format!("pose({})", parts.join(", "))
             }
+            (ConstValue::Text(u32::MAX), _) => "\"\"".into(),
+            (ConstValue::Text(k), _) => format!("text#{k}"),
         }
     }
 }

@@ -118,7 +118,10 @@ pub fn compile(path: &str, source: &str) -> Result<Compiled, CompileError> {
 pub fn compile_files(files: &[(&str, &str)]) -> Result<Compiled, CompileError> {
     let program = ProgramText::new(files);
     let mut diags = Vec::new();
-    let mut ast = syntax::SourceModule { items: Vec::new() };
+    let mut ast = syntax::SourceModule {
+        items: Vec::new(),
+        texts: false,
+    };
     for (_, file) in program.parse_each(&mut diags, lexer::lex, parser::parse) {
         ast.items.extend(file.items);
     }

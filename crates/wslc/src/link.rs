@@ -136,6 +136,7 @@ fn describe(t: Type) -> String {
         Type::Num(d) => d.described(),
         Type::Joints => "joints".into(),
         Type::Pose => "a pose".into(),
+        Type::Text => "a text".into(),
     }
 }
 

@@ -231,7 +231,10 @@ impl Parser<'_, '_, Token> {
                 }
             }
         }
-        SourceModule { items }
+        SourceModule {
+            items,
+            texts: false,
+        }
     }
 
     fn item(&mut self) -> PResult<Item> {

@@ -54,6 +54,10 @@ pub struct Ident {
 pub struct SourceModule {
     /// Declarations in order.
     pub items: Vec<Item>,
+    /// Text values are allowed: the type `text`, and text literals in expressions. True
+    /// for a translation from RAPID, whose strings are values; WSL writes text only in
+    /// `log` and `fail` (E0034), so its parser leaves this false.
+    pub texts: bool,
 }
 
 /// A module-level declaration.

@@ -19,7 +19,7 @@ use crate::types::{ConstValue, Dim, MAX_AXES, Type};
 /// The first four bytes of every `.wslb` file.
 pub const MAGIC: [u8; 4] = *b"WSLB";
 /// The format version this build writes and reads.
-pub const FORMAT_VERSION: u16 = 4;
+pub const FORMAT_VERSION: u16 = 5;
 
 const SECTIONS: [&[u8; 4]; 15] = [
     b"SRC_", b"STRS", b"CNST", b"GLOB", b"VARS", b"PROC", b"CODE", b"COND", b"WHEN", b"RMTE",
@@ -69,6 +69,7 @@ impl Writer {
             }
             Type::Joints => self.u8(3),
             Type::Pose => self.u8(4),
+            Type::Text => self.u8(5),
         }
     }
     fn value(&mut self, v: &ConstValue) {
@@ -93,6 +94,10 @@ impl Writer {
             ConstValue::Pose(p) => {
                 self.u8(4);
                 p.iter().for_each(|x| self.f64(*x));
+            }
+            ConstValue::Text(k) => {
+                self.u8(5);
+                self.u32(*k);
             }
         }
     }
@@ -635,6 +640,7 @@ impl<'a> Reader<'a> {
             }
             3 => Type::Joints,
             4 => Type::Pose,
+            5 => Type::Text,
             b => return Err(self.error(format!("unknown type tag {b}"))),
         })
     }
@@ -668,6 +674,7 @@ impl<'a> Reader<'a> {
                 }
                 ConstValue::Pose(p)
             }
+            5 => ConstValue::Text(self.u32()?),
             b => return Err(self.error(format!("unknown constant tag {b}"))),
         })
     }

@@ -319,6 +319,39 @@ instruction_set! {
     0x50 Cos;
     /// `atan2(y, x)`.
     0x51 Atan2;
+    /// Pops text b and text a; pushes a followed by b (RAPID's `+` on strings; a text holds
+    /// at most 80 characters: more is a run-time error).
+    0x90 TextCat;
+    /// Compares two texts character by character, pushes a bool.
+    0x91 CmpT(c: Cmp);
+    /// Pops a text; pushes its length in characters (a num): `StrLen`.
+    0x92 TextLen;
+    /// Pops a length, a start position (nums) and a text; pushes that part: `StrPart`
+    /// (out of the text is a run-time error).
+    0x93 TextPart;
+    /// Pops a set (text), a start position and a text; pushes the position of the first
+    /// character from the start that is in the set (not in it, if `not_in`), or the length
+    /// + 1: `StrFind`.
+    0x94 TextFind(not_in: bool);
+    /// Pops a pattern (text), a start position and a text; pushes the position of the
+    /// pattern from the start, or the length + 1: `StrMatch`.
+    0x95 TextMatch;
+    /// Pops a set (text), a position and a text; pushes whether that character is in the
+    /// set: `StrMemb`.
+    0x96 TextMemb;
+    /// Pops a to-map, a from-map and a text (texts); pushes the text with each character
+    /// of the from-map replaced by the one at its place in the to-map: `StrMap`.
+    0x97 TextMap;
+    /// Pops a number of decimals and a num; pushes the num rounded to them, as text:
+    /// `NumToStr`.
+    0x98 NumToText;
+    /// Pops a value of kind `k` (0: a bool, 1: a num); pushes it as RAPID's `ValToStr`
+    /// writes it (`TRUE`; at most 6 significant digits).
+    0x99 ValText(k: u8);
+    /// Pops a text; pushes whether it writes a number: `StrToVal`'s result.
+    0x9a TextIsNum;
+    /// Pops a text; pushes the number it writes, or 0: `StrToVal`'s value.
+    0x9b TextNum;
     /// Pops `n` nums, pushes a joints value (zero-padded to MAX_AXES slots).
     0x58 MakeJoints(n: u8);
     /// Pops an index and a joints value, pushes that axis's value.
@@ -441,6 +474,13 @@ impl Instr {
             Instr::IntToNumBelow => eff(2, 2),
             Instr::NegI | Instr::NegF | Instr::IntToNum | Instr::NumToInt | Instr::Not => eff(1, 1),
             Instr::AbsI | Instr::AbsF | Instr::Sqrt | Instr::Sin | Instr::Cos => eff(1, 1),
+            Instr::TextCat | Instr::CmpT(_) | Instr::NumToText => eff(2, 1),
+            Instr::TextLen | Instr::ValText(_) | Instr::TextIsNum | Instr::TextNum => eff(1, 1),
+            Instr::TextPart
+            | Instr::TextFind(_)
+            | Instr::TextMatch
+            | Instr::TextMemb
+            | Instr::TextMap => eff(3, 1),
             Instr::MakeJoints(n) => eff(u32::from(n), J),
             Instr::JointsGet => eff(J + 1, 1),
             Instr::PoseGet(_) => eff(P, 1),

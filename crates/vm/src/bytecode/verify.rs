@@ -57,6 +57,9 @@ pub enum VerifyError {
         /// The variable's index.
         index: usize,
     },
+    /// A remote call site passes a text, which is its robot's own.
+    #[error("a remote call site passes a text, which cannot cross to another robot")]
+    RemoteText,
     /// A module variable's initial value is not a finite value of its type.
     #[error("module variable {index} has an initial value of another type")]
     VariableInit {
@@ -332,6 +335,11 @@ impl Module {
             if !c.value.fits(c.ty) || !c.value.is_finite() {
                 return Err(E::Constant { index, ty: c.ty });
             }
+            if let ConstValue::Text(k) = c.value
+                && k != u32::MAX
+            {
+                s(k, StringUser::Constant(index))?;
+            }
         }
         for (index, g) in self.globals.iter().enumerate() {
             s(g.name, StringUser::Global(index))?;
@@ -346,6 +354,11 @@ impl Module {
             }
             if !v.init.fits(v.ty) || !v.init.is_finite() {
                 return Err(E::VariableInit { index });
+            }
+            if let ConstValue::Text(k) = v.init
+                && k != u32::MAX
+            {
+                s(k, StringUser::ModuleVariable(index))?;
             }
         }
         let ncode = self.code.len() as u64;
@@ -427,6 +440,10 @@ impl Module {
         for r in &self.remotes {
             s(r.robot, StringUser::RemoteSite)?;
             s(r.proc, StringUser::RemoteSite)?;
+            // A text is its robot's own handle: it cannot be sent to another robot.
+            if r.args.contains(&Type::Text) {
+                return Err(E::RemoteText);
+            }
         }
         for x in &self.signals_sent {
             s(x.robot, StringUser::SignalSite)?;

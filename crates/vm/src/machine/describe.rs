@@ -8,12 +8,15 @@ use super::handlers::check_trigger;
 use super::waits::deadline;
 use super::{EventKind, span_ns};
 use crate::bytecode::{Instr, LogPart, Module};
+use crate::texts::Texts;
 use crate::types::{Dim, Type, fmt_quantity};
 
 /// What [`describe`] reads besides the instruction.
 pub(super) struct Context<'a> {
     pub(super) m: &'a Module,
     pub(super) model: &'a RobotModel,
+    /// The texts the run made, for `log` and `fail` of a text.
+    pub(super) texts: &'a Texts,
     /// The stack of the thread that stopped (the main program's or a handler's), and the
     /// main program's.
     pub(super) stack: &'a [u64],
@@ -126,7 +129,7 @@ pub(super) fn describe(
         Instr::Grip(s) => EventKind::Grip { site: s },
         Instr::Release(s) => EventKind::Release { site: s },
         Instr::Log(f) | Instr::Fail(f) => {
-            let text = format(cx.m, cx.model, cx.stack, f);
+            let text = format(cx.m, cx.model, cx.texts, cx.stack, f);
             if matches!(ins, Instr::Fail(_)) {
                 EventKind::Error { message: text }
             } else {
@@ -147,7 +150,7 @@ pub(super) fn describe(
 
 /// The text of a `log`/`fail` message whose values are on top of the stack.
 /// The text of a `log`/`fail` message whose values are on top of stack `s`.
-pub(super) fn format(m: &Module, model: &RobotModel, s: &[u64], f: u32) -> String {
+pub(super) fn format(m: &Module, model: &RobotModel, texts: &Texts, s: &[u64], f: u32) -> String {
     let fmt = &m.log_formats[f as usize];
     let width = fmt.value_width() as usize;
     let mut at = s.len() - width;
@@ -163,6 +166,7 @@ pub(super) fn format(m: &Module, model: &RobotModel, s: &[u64], f: u32) -> Strin
                 match ty {
                     Type::Bool => out.push_str(if v[0] != 0 { "true" } else { "false" }),
                     Type::Int => out.push_str(&(v[0] as i64).to_string()),
+                    Type::Text => out.push_str(texts.get(m, v[0]).unwrap_or("<no such text>")),
                     Type::Num(d) => out.push_str(&fmt_quantity(num(v[0]), *d)),
                     Type::Pose => {
                         let parts: Vec<String> = (0..6)

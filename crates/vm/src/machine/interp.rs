@@ -10,6 +10,7 @@ use super::view::{Sight, View};
 use crate::bytecode::{Module, SrcPos};
 use crate::exec::{RuntimeError, Stop, Thread};
 use crate::motion::NS;
+use crate::texts::Texts;
 use crate::types::{Dim, fmt_quantity};
 
 /// Which globals the main program and handlers read at the current instant.
@@ -38,6 +39,8 @@ impl ReadLog {
 pub(super) struct Interp {
     /// Module variables (slots).
     vars: Vec<u64>,
+    /// The texts the run made (RAPID's strings), which text slots hold handles of.
+    pub(super) texts: Texts,
     /// Globals as the SE last gave them (slot bits by module global index).
     globals: Vec<u64>,
     /// Reads of globals by the main program and handlers, for race warnings.
@@ -71,6 +74,7 @@ impl Interp {
             .collect();
         Interp {
             vars,
+            texts: Texts::default(),
             read_log: ReadLog {
                 at: vec![-1; globals.len()],
                 new: Vec::with_capacity(4),
@@ -150,6 +154,7 @@ impl Interp {
                 reads: log.as_ref(),
             },
             &mut self.vars,
+            &mut self.texts,
             &mut budget,
             cfg.max_depth,
         );

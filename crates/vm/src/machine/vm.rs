@@ -646,6 +646,7 @@ impl Vm {
             describe::Context {
                 m: &self.m,
                 model: self.arm.model(),
+                texts: &self.interp.texts,
                 stack: &self.thread(in_handler).stack,
                 main_stack: &self.main.stack,
                 cycle_ns: self.cfg.cycle_ns,

@@ -197,6 +197,9 @@ pub(crate) fn builtin_named(name: &str) -> Option<&'static BuiltinInfo> {
 
 impl Compiler<'_> {
     pub(super) fn builtin(&mut self, name: &Ident, args: &[Expr], sp: Span) -> Out {
+        if let Some(out) = self.text_function(name, args, sp) {
+            return out;
+        }
         let n = name.name.as_str();
         let Some(info) = builtin_named(n) else {
             self.unknown_proc(n, name.span);

@@ -61,7 +61,7 @@ impl Compiler<'_> {
             ConstValue::Num(x) => {
                 self.emit(Instr::PushNum(*x), span);
             }
-            ConstValue::Joints(_) | ConstValue::Pose(_) => {
+            ConstValue::Joints(_) | ConstValue::Pose(_) | ConstValue::Text(_) => {
                 let k = self.pool(v, ty, span);
                 self.emit(Instr::PushConst(k), span);
             }

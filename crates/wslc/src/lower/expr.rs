@@ -208,6 +208,10 @@ impl Compiler<'_> {
             ExprKind::Num(x) => konst(self, ConstValue::Num(*x), Ty::Num(Dim::PLAIN), true),
             ExprKind::Quantity(x, d) => konst(self, ConstValue::Num(*x), Ty::Num(*d), false),
             ExprKind::Bool(b) => konst(self, ConstValue::Bool(*b), Ty::Bool, false),
+            ExprKind::Str(s) if self.texts => {
+                let k = self.str(s);
+                konst(self, ConstValue::Text(k), Ty::Text, false)
+            }
             ExprKind::Str(_) => {
                 self.err(
                     Diagnostic::error(
@@ -600,6 +604,15 @@ impl Compiler<'_> {
         let bare = lo.bare && ro.bare;
         let cmp = cmp_of;
         match (op, lt, rt) {
+            // Texts (a translation from RAPID): `+` joins, `=`/`<>` compare.
+            (Add, Ty::Text, Ty::Text) => {
+                self.emit(Instr::TextCat, sp);
+                Out::of(Ty::Text)
+            }
+            (Eq | Ne, Ty::Text, Ty::Text) => {
+                self.emit(Instr::CmpT(cmp(op)), sp);
+                Out::of(Ty::Bool)
+            }
             (Add | Sub | Mul | Div | Mod, Ty::Int, Ty::Int) => {
                 self.emit(
                     match op {

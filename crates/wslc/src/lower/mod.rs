@@ -45,6 +45,7 @@ mod expr;
 mod resolve;
 mod rules;
 mod stmt;
+mod texts;
 
 pub(crate) use builtins::BUILTINS;
 use builtins::builtin_named;
@@ -57,6 +58,8 @@ pub(crate) enum Ty {
     Num(Dim),
     Joints,
     Pose,
+    /// A text (only in a translation from RAPID: WSL writes text only in `log`/`fail`).
+    Text,
     Void,
     Error,
 }
@@ -69,6 +72,7 @@ impl Ty {
             Ty::Num(d) => Type::Num(d),
             Ty::Joints => Type::Joints,
             Ty::Pose => Type::Pose,
+            Ty::Text => Type::Text,
             _ => return None,
         })
     }
@@ -83,6 +87,7 @@ impl Ty {
             Ty::Num(d) => d.described(),
             Ty::Joints => "a joints value".into(),
             Ty::Pose => "a pose".into(),
+            Ty::Text => "a text".into(),
             Ty::Void => "no value".into(),
             Ty::Error => "an invalid value".into(),
         }
@@ -260,6 +265,7 @@ pub(crate) fn lower(
         pending_handlers: Vec::new(),
         disabled: Vec::new(),
         scratch_facts: Facts::default(),
+        texts: ast.texts,
     };
     c.module(ast);
     c.m
@@ -284,6 +290,8 @@ struct Compiler<'d> {
     disabled: Vec<(u32, Span)>,
     /// Facts of module-level initializers, which are discarded.
     scratch_facts: Facts,
+    /// Text values are allowed ([`SourceModule::texts`]: a translation from RAPID).
+    texts: bool,
 }
 
 const TYPE_NAMES: &str =

@@ -19,6 +19,7 @@ impl Compiler<'_> {
             "angaccel" => Dim::ANGACCEL,
             "joints" => return Ty::Joints,
             "pose" => return Ty::Pose,
+            "text" if self.texts => return Ty::Text,
             "string" => {
                 self.err(
                     Diagnostic::error(

@@ -154,9 +154,7 @@ pub(crate) const GROUPS: &[Group] = &[
             "IsStopStateEvent", "IsSysId", "IsVar", "MaxRobSpeed", "MirPos", "NonMotionMode",
             "NOrient", "NumToDnum", "OpMode", "PathLevel", "PFRestart", "PoseVect", "Pow",
             "PowDnum", "PPMovedInManMode", "Present", "ReadMotor", "RemainingRetries",
-            "RobName", "RunMode", "StrDigCalc", "StrDigCmp", "StrFind", "StrLen",
-            "StrMap", "StrMatch", "StrMemb", "StrOrder", "StrPart", "StrToByte", "StrToVal",
-            "TaskRunMec", "TaskRunRob", "TasksInSync", "TestAndSet", "TestSignRead", "TextGet",
+            "RobName", "RunMode", "StrDigCalc", "StrDigCmp",             "StrOrder", "StrToByte",             "TaskRunMec", "TaskRunRob", "TasksInSync", "TestAndSet", "TestSignRead", "TextGet",
             "TextTabFreeToUse", "TextTabGet", "Type", "UIAlphaEntry", "UIClientExist",
             "UIDnumEntry", "UIDnumTune", "UIListView", "UIMessageBox", "UINumEntry",
             "UINumTune", "ValidIO", "VectMagn", "IOUnitState", "ParIdPosValid", "ParIdRobValid",
@@ -479,7 +477,7 @@ mod tests {
             "`SocketCreate` is an instruction of RobotWare's Socket Messaging, which vworks does not simulate"
         );
         assert!(find("SocketCreate", &[Kind::Function]).is_none());
-        let e = find("STRLEN", &[Kind::Function]).unwrap();
+        let e = find("STRORDER", &[Kind::Function]).unwrap();
         assert!(
             e.message()
                 .ends_with("base system that vworks does not run yet")

@@ -115,7 +115,8 @@ impl Ty {
                 (".running", Type::Bool),
             ],
             Ty::Wobj => &[(".uframe", Type::Pose), (".oframe", Type::Pose)],
-            Ty::Str | Ty::Load | Ty::Conf | Ty::Extax | Ty::Syncident | Ty::Tasks => &[],
+            Ty::Str => &[("", Type::Text)],
+            Ty::Load | Ty::Conf | Ty::Extax | Ty::Syncident | Ty::Tasks => &[],
         }
     }
 

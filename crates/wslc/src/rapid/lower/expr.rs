@@ -40,11 +40,7 @@ impl Tr<'_> {
         match &e.kind {
             r::ExprKind::Num(x) => Some(Val::one(Ty::Num, b::num(*x, span))),
             r::ExprKind::Bool(v) => Some(Val::one(Ty::Bool, b::expr(w::ExprKind::Bool(*v), span))),
-            r::ExprKind::Str(s) => Some(Val {
-                ty: Ty::Str,
-                parts: Vec::new(),
-                text: Some(s.clone()),
-            }),
+            r::ExprKind::Str(s) => Some(Val::text(s.clone(), span)),
             r::ExprKind::Name(n) => self.name_value(n),
             r::ExprKind::Aggregate(_) => {
                 self.error(
@@ -292,22 +288,18 @@ impl Tr<'_> {
             O::IntDiv | O::Mod | O::Xor => w::BinOp::Mod,
         };
         match (a.ty, c.ty, op) {
-            (Ty::Str, Ty::Str, O::Add) => Some(Val {
-                ty: Ty::Str,
-                parts: Vec::new(),
-                text: Some(format!(
-                    "{}{}",
-                    a.text.unwrap_or_default(),
-                    c.text.unwrap_or_default()
-                )),
-            }),
-            (Ty::Str, Ty::Str, O::Eq | O::Ne) => {
-                let same = a.text == c.text;
-                Some(Val::one(
+            // Texts known when compiling are joined and compared then; others at run time.
+            (Ty::Str, Ty::Str, O::Add) => match (&a.text, &c.text) {
+                (Some(x), Some(y)) => Some(Val::text(format!("{x}{y}"), span)),
+                _ => Some(Val::one(Ty::Str, b::bin(w::BinOp::Add, a.leaf(), c.leaf()))),
+            },
+            (Ty::Str, Ty::Str, O::Eq | O::Ne) => match (&a.text, &c.text) {
+                (Some(x), Some(y)) => Some(Val::one(
                     Ty::Bool,
-                    b::expr(w::ExprKind::Bool(same == (op == O::Eq)), span),
-                ))
-            }
+                    b::expr(w::ExprKind::Bool((x == y) == (op == O::Eq)), span),
+                )),
+                _ => Some(Val::one(Ty::Bool, b::bin(wop(op), a.leaf(), c.leaf()))),
+            },
             (Ty::Num, Ty::Num, O::Add | O::Sub | O::Mul | O::Div) => {
                 Some(Val::one(Ty::Num, b::bin(wop(op), a.leaf(), c.leaf())))
             }

@@ -20,6 +20,7 @@ mod expr;
 mod functions;
 mod io;
 mod stmt;
+mod strings;
 pub(crate) mod table;
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -76,7 +77,10 @@ pub(crate) fn translate(
         }
     }
     t.declare_signals();
-    w::SourceModule { items: t.items }
+    w::SourceModule {
+        items: t.items,
+        texts: true,
+    }
 }
 
 /// Data the front-end knows by name.
@@ -138,6 +142,14 @@ impl Val {
             ty,
             parts: vec![e],
             text: None,
+        }
+    }
+    /// A text known when compiling.
+    pub(crate) fn text(s: String, span: Span) -> Val {
+        Val {
+            ty: Ty::Str,
+            parts: vec![b::expr(w::ExprKind::Str(s.clone()), span)],
+            text: Some(s),
         }
     }
     /// The single leaf (types of one leaf only).
@@ -498,11 +510,6 @@ impl Tr<'_> {
             readonly: d.storage == Storage::Const,
             tasks: Vec::new(),
         };
-        if ty == Ty::Str {
-            self.string_data(d, &mut data);
-            self.declare(d.local, key, Sym::Data(data));
-            return;
-        }
         if ty == Ty::Syncident {
             self.syncident(d, &data);
             self.declare(d.local, key, Sym::Data(data));
@@ -515,6 +522,13 @@ impl Tr<'_> {
                 .flatten()
                 .filter_map(|v| v.text.clone())
                 .collect();
+        }
+        // A CONST string's text is known when compiling (a task list's names, a TPWrite).
+        if ty == Ty::Str && d.storage == Storage::Const && len.is_none() {
+            data.text = inits
+                .as_ref()
+                .and_then(|v| v.first())
+                .and_then(|v| v.text.clone());
         }
         // A CONST scalar of literal leaves is folded where it is used (array sizes, …).
         if d.storage == Storage::Const
@@ -582,29 +596,6 @@ impl Tr<'_> {
                 d.span,
                 "declare `VAR syncident name;`",
             );
-        }
-    }
-
-    fn string_data(&mut self, d: &r::DataDecl, data: &mut Data) {
-        if d.storage != Storage::Const || !d.dims.is_empty() {
-            self.unsupported(
-                &format!("`{} string` data", d.storage.keyword()),
-                d.span,
-                "declare texts as `CONST string`; vworks prints them with TPWrite and ErrWrite",
-            );
-            return;
-        }
-        match &d.init {
-            Some(e) => {
-                if let Some(v) = self.expr(e)
-                    && v.ty == Ty::Str
-                {
-                    data.text = v.text;
-                } else {
-                    self.error(Code::E0020, "a `CONST string` needs a text", e.span);
-                }
-            }
-            None => data.text = Some(String::new()),
         }
     }
 
@@ -744,7 +735,7 @@ impl Tr<'_> {
                     "use the module-level array directly",
                 );
             }
-            if *ty == Ty::Str || (ty.leaves().is_empty() && *ty != Ty::Load) {
+            if ty.leaves().is_empty() && *ty != Ty::Load {
                 self.unsupported(
                     &format!("a parameter of type `{}`", ty.name()),
                     p.span,
@@ -841,24 +832,26 @@ impl Tr<'_> {
             readonly: d.storage == Storage::Const,
             tasks: Vec::new(),
         };
-        if ty == Ty::Str {
-            self.string_data(d, &mut data);
-        } else {
-            if d.storage == Storage::Pers {
-                self.unsupported(
-                    "`PERS` data inside a routine",
-                    d.span,
-                    "declare PERS data at module level",
-                );
-            }
-            let inits = self.initial_values(d, ty, len);
-            for (decl, name) in Self::leaf_decls(d, &data, inits.as_deref()) {
-                self.used.insert(name);
-                out.push(w::Stmt {
-                    kind: w::StmtKind::Var(decl),
-                    span: d.span,
-                });
-            }
+        if d.storage == Storage::Pers {
+            self.unsupported(
+                "`PERS` data inside a routine",
+                d.span,
+                "declare PERS data at module level",
+            );
+        }
+        let inits = self.initial_values(d, ty, len);
+        if ty == Ty::Str && d.storage == Storage::Const && len.is_none() {
+            data.text = inits
+                .as_ref()
+                .and_then(|v| v.first())
+                .and_then(|v| v.text.clone());
+        }
+        for (decl, name) in Self::leaf_decls(d, &data, inits.as_deref()) {
+            self.used.insert(name);
+            out.push(w::Stmt {
+                kind: w::StmtKind::Var(decl),
+                span: d.span,
+            });
         }
         self.spelled
             .entry(d.name.key())

@@ -231,13 +231,12 @@ impl Tr<'_> {
         if let r::ExprKind::Field(x, f) = &target.kind {
             return self.assign_component(x, f, value, span).unwrap_or_default();
         }
+        if let Some(stmts) = self.str_to_val(target, value, span) {
+            return stmts;
+        }
         let Some((d, idx)) = self.place(target) else {
             return Vec::new();
         };
-        if d.ty == Ty::Str {
-            self.unsupported("assigning a string", span, "use CONST string data");
-            return Vec::new();
-        }
         let Some(v) = self.value(value, d.ty) else {
             return Vec::new();
         };
@@ -455,11 +454,11 @@ impl Tr<'_> {
         let Some(v) = self.expr(value) else {
             return w::StmtKind::Error;
         };
-        if !matches!(v.ty, Ty::Num | Ty::Bool) {
+        if !matches!(v.ty, Ty::Num | Ty::Bool | Ty::Str) {
             self.unsupported(
                 &format!("TEST of {}", article(v.ty)),
                 value.span,
-                "TEST a num or a bool",
+                "TEST a num, a bool or a string",
             );
             return w::StmtKind::Error;
         }
@@ -972,24 +971,8 @@ impl Tr<'_> {
                 self.text_parts(a, out);
                 self.text_parts(c, out);
             }
-            r::ExprKind::Call(f, args) if matches!(f.key().as_str(), "numtostr" | "valtostr") => {
-                let first = args.iter().find_map(|a| match a {
-                    Arg::Pos(e) => Some(e),
-                    Arg::Opt(..) => None,
-                });
-                if let Some(x) = first
-                    && let Some(v) = self.expr(x)
-                {
-                    out.extend(self.printable(v, x.span));
-                }
-            }
             _ => match self.expr(e) {
-                Some(v) if v.ty == Ty::Str => {
-                    out.push(b::expr(
-                        w::ExprKind::Str(v.text.unwrap_or_default()),
-                        e.span,
-                    ));
-                }
+                Some(v) if v.ty == Ty::Str => out.extend(self.printable(v, e.span)),
                 Some(v) => {
                     self.error(
                         Code::E0020,
@@ -1013,7 +996,10 @@ impl Tr<'_> {
             | Ty::Pose
             | Ty::Robtarget
             | Ty::Jointtarget => v.parts,
-            Ty::Str => vec![b::expr(w::ExprKind::Str(v.text.unwrap_or_default()), span)],
+            Ty::Str => match v.text {
+                Some(s) => vec![b::expr(w::ExprKind::Str(s), span)],
+                None => v.parts,
+            },
             t => {
                 self.unsupported(
                     &format!("printing {}", article(t)),

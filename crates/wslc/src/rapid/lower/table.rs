@@ -53,8 +53,6 @@ pub(crate) enum InstrLowering {
 pub(crate) enum FuncLowering {
     /// Arguments checked, then lowered by the function.
     Lower(FuncFn),
-    /// RAPID that vworks does not run here: E0300 with this help.
-    NotRun(&'static str),
 }
 
 /// One row of a table.
@@ -402,9 +400,7 @@ pub(crate) const INSTRUCTIONS: &[Row<InstrLowering>] = &[
     ),
 ];
 
-use FuncLowering::{Lower as F, NotRun as FNotRun};
-
-const NOT_HERE: &str = "NumToStr and ValToStr are read only inside TPWrite and ErrWrite; docs/rapid.md lists the functions vworks runs";
+use FuncLowering::Lower as F;
 
 /// Every function the front-end knows, in docs/rapid.md's order.
 pub(crate) const FUNCTIONS: &[Row<FuncLowering>] = &[
@@ -568,17 +564,66 @@ pub(crate) const FUNCTIONS: &[Row<FuncLowering>] = &[
     ),
     row(
         "NumToStr",
-        0..=usize::MAX,
-        &[],
-        FNotRun(NOT_HERE),
-        "only inside TPWrite/ErrWrite texts",
+        2..=2,
+        &["Exp"],
+        F(|t, c| t.string_function(c)),
+        "a num as text, rounded to the decimals given",
     ),
     row(
         "ValToStr",
-        0..=usize::MAX,
+        1..=1,
         &[],
-        FNotRun(NOT_HERE),
-        "only inside TPWrite/ErrWrite texts",
+        F(|t, c| t.val_to_str(c)),
+        "a num or bool as text",
+    ),
+    row(
+        "StrLen",
+        1..=1,
+        &[],
+        F(|t, c| t.string_function(c)),
+        "a string's length in characters",
+    ),
+    row(
+        "StrPart",
+        3..=3,
+        &[],
+        F(|t, c| t.string_function(c)),
+        "a part of a string",
+    ),
+    row(
+        "StrFind",
+        3..=3,
+        &["NotInSet"],
+        F(|t, c| t.string_function(c)),
+        "the position of the first character in (not in) a set",
+    ),
+    row(
+        "StrMatch",
+        3..=3,
+        &[],
+        F(|t, c| t.string_function(c)),
+        "the position of a pattern",
+    ),
+    row(
+        "StrMemb",
+        3..=3,
+        &[],
+        F(|t, c| t.string_function(c)),
+        "whether a character is in a set",
+    ),
+    row(
+        "StrMap",
+        3..=3,
+        &[],
+        F(|t, c| t.string_function(c)),
+        "a string with characters mapped",
+    ),
+    row(
+        "StrToVal",
+        2..=2,
+        &[],
+        F(|t, c| t.str_to_val_here(c)),
+        "`ok := StrToVal(text, x);`: the num a text writes",
     ),
 ];
 
@@ -644,19 +689,11 @@ impl Tr<'_> {
         span: Span,
     ) -> Option<Option<Val>> {
         let row = find(FUNCTIONS, key)?;
-        Some(match row.lower {
-            FNotRun(help) => {
-                self.unsupported(
-                    &format!("the function `{}` here", name.text),
-                    name.span,
-                    help,
-                );
-                None
-            }
-            F(lower) => self
-                .checked(row, key, name, args, span)
+        let F(lower) = row.lower;
+        Some(
+            self.checked(row, key, name, args, span)
                 .and_then(|call| lower(self, &call)),
-        })
+        )
     }
 }
 
@@ -734,9 +771,6 @@ mod tests {
             );
         }
         for r in FUNCTIONS {
-            if matches!(r.lower, FNotRun(_)) {
-                continue;
-            }
             assert!(
                 written(functions, r.name),
                 "docs/rapid.md's functions do not list `{}`",
