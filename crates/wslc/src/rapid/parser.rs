@@ -691,6 +691,12 @@ impl Parser<'_, '_, Token> {
             }
             if self.eat_tok(&Tok::Backslash) {
                 let n = self.name("an optional argument's name")?;
+                if self.eat_tok(&Tok::Question) {
+                    let x = self.name("the name of an optional parameter")?;
+                    out.push(Arg::Cond(n, x));
+                    self.eat_tok(&Tok::Comma);
+                    continue;
+                }
                 let v = if self.eat_tok(&Tok::Assign) {
                     Some(self.expr()?)
                 } else {

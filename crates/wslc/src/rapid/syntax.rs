@@ -156,6 +156,9 @@ pub enum Arg {
     Pos(Expr),
     /// An optional argument by name, with its value (a switch has none).
     Opt(Name, Option<Expr>),
+    /// `\Name?x`: the optional argument given if, and as, the caller's optional parameter
+    /// `x` was given to it.
+    Cond(Name, Name),
 }
 
 /// Statement kinds.

@@ -37,6 +37,8 @@ pub(crate) enum Ty {
     Conf,
     Extax,
     Intnum,
+    /// An optional parameter that is only given or not (`\switch On`).
+    Switch,
     /// A stopwatch (`ClkStart`, `ClkRead`): when it last started, the time it ran before,
     /// and whether it runs.
     Clock,
@@ -68,6 +70,7 @@ pub(crate) const TYPES: &[(&str, Ty)] = &[
     ("extjoint", Ty::Extax),
     ("intnum", Ty::Intnum),
     ("clock", Ty::Clock),
+    ("switch", Ty::Switch),
     ("syncident", Ty::Syncident),
     ("tasks", Ty::Tasks),
 ];
@@ -116,7 +119,7 @@ impl Ty {
             ],
             Ty::Wobj => &[(".uframe", Type::Pose), (".oframe", Type::Pose)],
             Ty::Str => &[("", Type::Text)],
-            Ty::Load | Ty::Conf | Ty::Extax | Ty::Syncident | Ty::Tasks => &[],
+            Ty::Load | Ty::Conf | Ty::Extax | Ty::Syncident | Ty::Tasks | Ty::Switch => &[],
         }
     }
 
@@ -287,6 +290,20 @@ pub(crate) mod build {
     /// `pose(x, y, z, rx, ry, rz)` from six WSL expressions.
     pub(crate) fn pose(parts: [w::Expr; 6], span: Span) -> w::Expr {
         call("pose", parts.into(), span)
+    }
+
+    /// The zero value of a WSL type: 0 in its unit, FALSE, the empty text, the identity
+    /// pose, all-zero joints.
+    pub(crate) fn zero(t: Type, span: Span) -> w::Expr {
+        match t {
+            Type::Bool => expr(w::ExprKind::Bool(false), span),
+            Type::Int => expr(w::ExprKind::Int(0), span),
+            Type::Num(d) if d.is_plain() => num(0.0, span),
+            Type::Num(d) => quantity(0.0, d, span),
+            Type::Text => expr(w::ExprKind::Str(String::new()), span),
+            Type::Pose => identity(span),
+            Type::Joints => call("joints", Vec::new(), span),
+        }
     }
 
     /// The identity pose.

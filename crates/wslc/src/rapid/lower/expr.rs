@@ -475,7 +475,7 @@ impl Tr<'_> {
             Ty::Load => 6,
             Ty::Extax => 6,
             Ty::Tasks => 1,
-            Ty::Num | Ty::Bool | Ty::Str | Ty::Intnum | Ty::Syncident | Ty::Clock => {
+            Ty::Num | Ty::Bool | Ty::Str | Ty::Intnum | Ty::Syncident | Ty::Clock | Ty::Switch => {
                 self.error(
                     Code::E0020,
                     format!("expected {}, found `[…]`", article(want)),
@@ -696,7 +696,9 @@ impl Tr<'_> {
                     text: name.text,
                 })
             }
-            Ty::Num | Ty::Bool | Ty::Str | Ty::Intnum | Ty::Syncident | Ty::Clock => None,
+            Ty::Num | Ty::Bool | Ty::Str | Ty::Intnum | Ty::Syncident | Ty::Clock | Ty::Switch => {
+                None
+            }
         }
     }
 
@@ -718,7 +720,7 @@ impl Tr<'_> {
         }
         match self.lookup(&key) {
             Some(Sym::Routine(sig)) if sig.kind == r::RoutineKind::Func => {
-                let wargs = self.call_args(f, &sig.params, args, span)?;
+                let wargs = self.call_args(f, &sig, args, span)?;
                 let ret = sig.ret.unwrap_or(Ty::Num);
                 // (A FUNC of a type held in more than one WSL value, a speeddata or a
                 // zonedata, is E0300 where it is declared: no value here.)
@@ -759,25 +761,50 @@ impl Tr<'_> {
         }
     }
 
-    /// The WSL arguments of a call of a PROC or FUNC with parameter types `params`.
+    /// The WSL arguments of a call of a PROC or FUNC of signature `sig`: the required
+    /// arguments' leaves, then for each optional parameter its leaves and whether it is
+    /// given (`\\x:=e`; a switch `\\On`; `\\x?y` as the caller's own optional `y` is;
+    /// not given: its type's zero and FALSE).
     pub(crate) fn call_args(
         &mut self,
         f: &r::Name,
-        params: &[Ty],
+        sig: &super::Sig,
         args: &[Arg],
         span: Span,
     ) -> Option<Vec<w::Expr>> {
+        let params = &sig.params;
         let mut pos = Vec::new();
+        let mut given: Vec<(&r::Name, &Arg)> = Vec::new();
         for a in args {
             match a {
                 Arg::Pos(e) => pos.push(e),
-                Arg::Opt(n, _) => {
-                    self.unsupported(
-                        &format!("the optional argument `\\{}` of a user routine", n.text),
-                        n.span,
-                        "make the parameter required",
-                    );
-                    return None;
+                Arg::Opt(n, _) | Arg::Cond(n, _) => {
+                    if !sig.optional.iter().any(|o| o.key == n.key()) {
+                        let known: Vec<String> = sig
+                            .optional
+                            .iter()
+                            .map(|o| format!("\\{}", o.spelled))
+                            .collect();
+                        let near = crate::suggest::nearest(
+                            &n.key(),
+                            sig.optional.iter().map(|o| o.key.as_str()),
+                        )
+                        .and_then(|k| sig.optional.iter().find(|o| o.key == k))
+                        .map(|o| format!("did you mean `\\{}`? ", o.spelled))
+                        .unwrap_or_default();
+                        self.error(
+                            Code::E0301,
+                            format!("`{}` has no optional parameter `\\{}`", f.text, n.text),
+                            n.span,
+                        )
+                        .help = Some(if known.is_empty() {
+                            format!("`{}` has no optional parameters", f.text)
+                        } else {
+                            format!("{near}its optional parameters: {}", known.join(", "))
+                        });
+                        return None;
+                    }
+                    given.push((n, a));
                 }
             }
         }
@@ -799,7 +826,101 @@ impl Tr<'_> {
         for (e, t) in pos.into_iter().zip(params) {
             out.extend(self.value(e, *t)?.parts);
         }
+        for o in &sig.optional {
+            let zero = |sp: Span| -> Vec<w::Expr> {
+                o.ty.leaves().iter().map(|(_, t)| b::zero(*t, sp)).collect()
+            };
+            let yes = |v: bool, sp: Span| b::expr(w::ExprKind::Bool(v), sp);
+            match given.iter().find(|(n, _)| n.key() == o.key) {
+                None => {
+                    out.extend(zero(span));
+                    out.push(yes(false, span));
+                }
+                Some((n, Arg::Opt(_, None))) => {
+                    if o.ty != Ty::Switch {
+                        self.error(
+                            Code::E0301,
+                            format!("`\\{}` needs a value: `\\{}:=…`", n.text, n.text),
+                            n.span,
+                        );
+                        return None;
+                    }
+                    out.push(yes(true, n.span));
+                }
+                Some((n, Arg::Opt(_, Some(e)))) => {
+                    if o.ty == Ty::Switch {
+                        self.error(
+                            Code::E0301,
+                            format!("`\\{}` is a switch: it takes no value", n.text),
+                            e.span,
+                        );
+                        return None;
+                    }
+                    out.extend(self.value(e, o.ty)?.parts);
+                    out.push(yes(true, n.span));
+                }
+                Some((_, Arg::Cond(_, x))) => {
+                    let d = match self.lookup(&x.key()) {
+                        Some(Sym::Data(d)) if d.optional => d,
+                        _ => {
+                            self.error(
+                                Code::E0020,
+                                format!(
+                                    "`{}` is not an optional parameter of this routine",
+                                    x.text
+                                ),
+                                x.span,
+                            )
+                            .help = Some("`\\name?x` passes the routine's own optional parameter `x` on, if it was given".into());
+                            return None;
+                        }
+                    };
+                    if d.ty != o.ty {
+                        self.error(
+                            Code::E0020,
+                            format!(
+                                "`\\{}` is {}, `{}` {}",
+                                o.spelled,
+                                article(o.ty),
+                                x.text,
+                                article(d.ty)
+                            ),
+                            x.span,
+                        );
+                        return None;
+                    }
+                    out.extend(Tr::leaf_names(&d, None).iter().map(|n| b::name(n, x.span)));
+                    out.push(b::name(&d.present(), x.span));
+                }
+                Some((_, Arg::Pos(_))) => {}
+            }
+        }
         Some(out)
+    }
+
+    /// `Present(x)`: whether the optional parameter `x` of this routine was given.
+    pub(crate) fn present(&mut self, c: &super::table::Call<'_>) -> Option<Val> {
+        let e = c.pos[0];
+        let d = match &e.kind {
+            r::ExprKind::Name(n) => match self.lookup(&n.key()) {
+                Some(Sym::Data(d)) if d.optional => Some(d),
+                _ => None,
+            },
+            _ => None,
+        };
+        let Some(d) = d else {
+            self.error(
+                Code::E0020,
+                "Present takes an optional parameter of this routine",
+                e.span,
+            )
+            .help = Some(
+                "a required parameter is always present; declare it `\\num x` to make it optional"
+                    .into(),
+            );
+            return None;
+        };
+        Some(Val::one(Ty::Bool, b::name(&d.present(), e.span)))
     }
 
     /// The value of the optional argument `key` (lower case) among `opts`: `Ok(None)` if
@@ -839,6 +960,14 @@ impl Tr<'_> {
         for a in args {
             match a {
                 Arg::Pos(e) => pos.push(e),
+                Arg::Cond(n, _) => {
+                    self.unsupported(
+                        &format!("the conditional argument `\\{}?…` of a built-in", n.text),
+                        n.span,
+                        "pass the argument, or leave it out, in an IF on Present(…)",
+                    );
+                    return None;
+                }
                 Arg::Opt(n, v) => {
                     let k = n.key();
                     if !optional.iter().any(|o| o.eq_ignore_ascii_case(&k)) {

@@ -85,7 +85,7 @@ impl Tr<'_> {
                         if k.starts_with("isignal") || k == "itimer" {
                             let last = args.iter().rev().find_map(|a| match a {
                                 Arg::Pos(e) => Some(e),
-                                Arg::Opt(..) => None,
+                                Arg::Opt(..) | Arg::Cond(..) => None,
                             });
                             if let Some(r::Expr {
                                 kind: r::ExprKind::Name(n),
@@ -174,7 +174,9 @@ impl Tr<'_> {
             }
         }
         for (intno, instr, args) in orders {
-            let single = args.iter().any(|a| matches!(a, Arg::Opt(..)));
+            let single = args
+                .iter()
+                .any(|a| matches!(a, Arg::Opt(..) | Arg::Cond(..)));
             self.orders
                 .entry(intno.clone())
                 .or_default()

@@ -93,6 +93,8 @@ pub(crate) struct Data {
     /// The WSL name the leaves' names start with.
     pub(crate) base: String,
     pub(crate) span: Span,
+    /// An optional parameter of the routine (`\num x`): `Present(x)` reads its flag.
+    pub(crate) optional: bool,
     /// A `CONST string`'s text.
     pub(crate) text: Option<String>,
     /// Predefined data (`v100`, `fine`, `tool0`): its leaves as WSL constants.
@@ -109,10 +111,24 @@ pub(crate) struct Data {
 #[derive(Clone, Debug)]
 pub(crate) struct Sig {
     pub(crate) kind: r::RoutineKind,
+    /// The required parameters' types, in order.
     pub(crate) params: Vec<Ty>,
+    /// The optional parameters (`\num x`, `\switch On`), in order: each is its leaves
+    /// (none for a switch) and a flag of whether the caller gave it.
+    pub(crate) optional: Vec<OptParam>,
     pub(crate) ret: Option<Ty>,
     pub(crate) wsl: String,
     pub(crate) span: Span,
+}
+
+/// An optional parameter of a routine.
+#[derive(Clone, Debug)]
+pub(crate) struct OptParam {
+    /// Its name, lower case.
+    pub(crate) key: String,
+    /// As written.
+    pub(crate) spelled: String,
+    pub(crate) ty: Ty,
 }
 
 #[derive(Clone, Debug)]
@@ -210,6 +226,13 @@ pub(crate) fn wsl_name(n: &r::Name) -> String {
         format!("{k}'")
     } else {
         k
+    }
+}
+
+impl Data {
+    /// The WSL name of an optional parameter's flag: whether the caller gave it.
+    pub(crate) fn present(&self) -> String {
+        format!("{}'present", self.base)
     }
 }
 
@@ -338,13 +361,24 @@ impl Tr<'_> {
 
     fn signature(&mut self, rt: &r::Routine) -> Sig {
         let mut params = Vec::new();
+        let mut optional = Vec::new();
         for p in &rt.params {
-            params.push(self.type_of(&p.ty).unwrap_or(Ty::Num));
+            let ty = self.type_of(&p.ty).unwrap_or(Ty::Num);
+            if p.optional {
+                optional.push(OptParam {
+                    key: p.name.key(),
+                    spelled: p.name.text.clone(),
+                    ty,
+                });
+            } else {
+                params.push(ty);
+            }
         }
         let ret = rt.ret.as_ref().map(|t| self.type_of(t).unwrap_or(Ty::Num));
         Sig {
             kind: rt.kind,
             params,
+            optional,
             ret,
             wsl: self.module_level_name(&rt.name, rt.local),
             span: rt.name.span,
@@ -509,6 +543,7 @@ impl Tr<'_> {
             local: false,
             readonly: d.storage == Storage::Const,
             tasks: Vec::new(),
+            optional: false,
         };
         if ty == Ty::Syncident {
             self.syncident(d, &data);
@@ -710,14 +745,14 @@ impl Tr<'_> {
             ret: sig.ret,
         });
         let mut params = Vec::new();
-        for (p, ty) in rt.params.iter().zip(&sig.params) {
-            if p.optional {
-                self.unsupported(
-                    &format!("the optional parameter `\\{}`", p.name.text),
-                    p.span,
-                    "make the parameter required",
-                );
-            }
+        let (mut required, mut optional) = (sig.params.iter(), sig.optional.iter());
+        for p in &rt.params {
+            let ty = if p.optional {
+                optional.next().map(|o| &o.ty)
+            } else {
+                required.next()
+            };
+            let Some(ty) = ty else { continue };
             if p.mode == r::Mode::Ref {
                 self.unsupported(
                     &format!(
@@ -735,7 +770,7 @@ impl Tr<'_> {
                     "use the module-level array directly",
                 );
             }
-            if ty.leaves().is_empty() && *ty != Ty::Load {
+            if ty.leaves().is_empty() && !matches!(*ty, Ty::Load | Ty::Switch) {
                 self.unsupported(
                     &format!("a parameter of type `{}`", ty.name()),
                     p.span,
@@ -753,11 +788,18 @@ impl Tr<'_> {
                 local: true,
                 readonly: false,
                 tasks: Vec::new(),
+                optional: p.optional,
             };
             for (name, (_, wty)) in Self::leaf_names(&data, None).iter().zip(ty.leaves()) {
                 params.push(w::Param {
                     name: b::ident(name, p.name.span),
                     ty: b::type_name(*wty, p.ty.span),
+                });
+            }
+            if p.optional {
+                params.push(w::Param {
+                    name: b::ident(&data.present(), p.name.span),
+                    ty: b::ident("bool", p.name.span),
                 });
             }
             self.spelled
@@ -831,6 +873,7 @@ impl Tr<'_> {
             local: true,
             readonly: d.storage == Storage::Const,
             tasks: Vec::new(),
+            optional: false,
         };
         if d.storage == Storage::Pers {
             self.unsupported(
@@ -886,6 +929,7 @@ fn predefined(key: &str) -> Option<Data> {
         local: false,
         readonly: true,
         tasks: Vec::new(),
+        optional: false,
     };
     if let Some((_, v, o)) = data::SPEEDS.iter().find(|(n, _, _)| *n == key) {
         d.ty = Ty::Speed;

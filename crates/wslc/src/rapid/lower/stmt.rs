@@ -421,6 +421,7 @@ impl Tr<'_> {
                 local: true,
                 readonly: true,
                 tasks: Vec::new(),
+                optional: false,
             },
         );
         self.locals.push(scope);
@@ -519,7 +520,7 @@ impl Tr<'_> {
         let mut push = |kind| out.push(w::Stmt { kind, span });
         match self.lookup(&key) {
             Some(Sym::Routine(sig)) if sig.kind == r::RoutineKind::Proc => {
-                if let Some(wargs) = self.call_args(name, &sig.params, args, span) {
+                if let Some(wargs) = self.call_args(name, &sig, args, span) {
                     push(w::StmtKind::Call {
                         name: b::ident(&sig.wsl, name.span),
                         args: wargs,

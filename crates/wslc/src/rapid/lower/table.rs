@@ -563,6 +563,13 @@ pub(crate) const FUNCTIONS: &[Row<FuncLowering>] = &[
         "FALSE: vworks is not a real controller (as on a virtual one)",
     ),
     row(
+        "Present",
+        1..=1,
+        &[],
+        F(|t, c| t.present(c)),
+        "whether an optional parameter was given",
+    ),
+    row(
         "NumToStr",
         2..=2,
         &["Exp"],
