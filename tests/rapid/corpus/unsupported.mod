@@ -1,9 +1,6 @@
 MODULE Unsupported
   ! Constructs vworks does not run: each is an error naming it and its line.
-  RECORD partinfo
-    num id;
-    string name;
-  ENDRECORD
+  VAR socketdev sock;
   CONST robtarget pStart := [[500,0,300],[0,0,1,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];
   CONST robtarget pEnd := [[500,200,300],[0,0,1,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];
   VAR robtarget pFound;

@@ -321,20 +321,32 @@ impl Parser<'_, '_, Token> {
         if self.at("proc") || self.at("func") || self.at("trap") {
             return Ok(Some(Item::Routine(self.routine(local, start)?)));
         }
-        if self.at("record") || self.at("alias") {
-            let what = if self.at("record") { "RECORD" } else { "ALIAS" };
+        if self.eat("record") {
+            let name = self.name("the record's name")?;
+            let mut fields = Vec::new();
+            while !self.at("endrecord") && !self.at_tok(&Tok::Eof) {
+                let ty = self.name("a component's type")?;
+                let field = self.name("a component's name")?;
+                self.expect_tok(Tok::Semi, "`;`")?;
+                fields.push((ty, field));
+            }
+            self.expect("endrecord")?;
+            return Ok(Some(Item::Record(RecordDecl {
+                local,
+                name,
+                fields,
+                span: start.to(self.prev_span()),
+            })));
+        }
+        if self.at("alias") {
             let d = Diagnostic::error(
                 Code::E0300,
-                format!("`{what}` declarations are not supported by vworks's RAPID front-end"),
+                "`ALIAS` declarations are not supported by vworks's RAPID front-end",
                 self.span(),
             )
-            .with_help("use the built-in data types (docs/rapid.md lists them)");
+            .with_help("use the data type the alias names");
             self.diags.push(d);
-            if what == "RECORD" {
-                self.skip_past_word("endrecord");
-            } else {
-                self.skip_past_semi();
-            }
+            self.skip_past_semi();
             return Ok(None);
         }
         Err(self.unexpected(

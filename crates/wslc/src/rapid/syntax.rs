@@ -37,6 +37,21 @@ pub enum Item {
     Data(DataDecl),
     /// `PROC`, `FUNC` or `TRAP`.
     Routine(Routine),
+    /// `RECORD name … ENDRECORD`: a data type of named components.
+    Record(RecordDecl),
+}
+
+/// `RECORD name` with its components (`num x;`, `robtarget p;`), `ENDRECORD`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RecordDecl {
+    /// `LOCAL`: its module's own.
+    pub local: bool,
+    /// The type's name.
+    pub name: Name,
+    /// Each component: its type's name and its name.
+    pub fields: Vec<(Name, Name)>,
+    /// Where.
+    pub span: Span,
 }
 
 /// How data is stored.

@@ -31,7 +31,7 @@ impl Tr<'_> {
             );
             return None;
         }
-        let names = Tr::leaf_names(&d, idx);
+        let names = self.leaf_names(&d, idx);
         let leaf = |k: usize| b::name(&names[k], e.span);
         Some([leaf(0), leaf(1), leaf(2)])
     }

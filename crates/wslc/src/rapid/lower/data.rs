@@ -42,6 +42,8 @@ pub(crate) enum Ty {
     /// A stopwatch (`ClkStart`, `ClkRead`): when it last started, the time it ran before,
     /// and whether it runs.
     Clock,
+    /// A `RECORD` of the task (its index among the task's records).
+    Record(u16),
     /// A MultiMove synchronisation point (`WaitSyncTask`).
     Syncident,
     /// A task name, in the task lists of `WaitSyncTask`.
@@ -89,6 +91,9 @@ impl Ty {
 
     /// The name as RAPID writes it.
     pub(crate) fn name(self) -> &'static str {
+        if let Ty::Record(_) = self {
+            return "record";
+        }
         TYPES
             .iter()
             .find(|(_, t)| *t == self)
@@ -119,15 +124,13 @@ impl Ty {
             ],
             Ty::Wobj => &[(".uframe", Type::Pose), (".oframe", Type::Pose)],
             Ty::Str => &[("", Type::Text)],
-            Ty::Load | Ty::Conf | Ty::Extax | Ty::Syncident | Ty::Tasks | Ty::Switch => &[],
-        }
-    }
-
-    /// Its one leaf's type, for a type held in one WSL value.
-    pub(crate) fn leaf_type(self) -> Option<Type> {
-        match self.leaves() {
-            [(_, t)] => Some(*t),
-            _ => None,
+            Ty::Load
+            | Ty::Conf
+            | Ty::Extax
+            | Ty::Syncident
+            | Ty::Tasks
+            | Ty::Switch
+            | Ty::Record(_) => &[],
         }
     }
 

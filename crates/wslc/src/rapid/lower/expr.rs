@@ -191,7 +191,8 @@ impl Tr<'_> {
         }
         Val {
             ty,
-            parts: Tr::leaf_names(d, index)
+            parts: self
+                .leaf_names(d, index)
                 .iter()
                 .map(|n| b::name(n, span))
                 .collect(),
@@ -250,17 +251,17 @@ impl Tr<'_> {
         }
         let iv = self.value(i, Ty::Num)?.leaf();
         let index = b::call("int", vec![iv], i.span);
-        let parts =
-            d.ty.leaves()
-                .iter()
-                .map(|(suffix, _)| {
-                    b::call(
-                        &format!("{}{{}}{suffix}", d.base),
-                        vec![index.clone()],
-                        span,
-                    )
-                })
-                .collect();
+        let parts = self
+            .leaves(d.ty)
+            .iter()
+            .map(|(suffix, _)| {
+                b::call(
+                    &format!("{}{{}}{suffix}", d.base),
+                    vec![index.clone()],
+                    span,
+                )
+            })
+            .collect();
         Some(Val {
             ty: d.ty,
             parts,
@@ -389,6 +390,9 @@ impl Tr<'_> {
     /// `e.field` read.
     fn field_value(&mut self, x: &r::Expr, f: &r::Name, span: Span) -> Option<Val> {
         let v = self.expr(x)?;
+        if let Ty::Record(_) = v.ty {
+            return self.record_field(v, f);
+        }
         let key = f.key();
         let num_of = |e: w::Expr, dim: Dim| Some(Val::one(Ty::Num, b::without_unit(e, dim)));
         match (v.ty, key.as_str()) {
@@ -475,6 +479,7 @@ impl Tr<'_> {
             Ty::Load => 6,
             Ty::Extax => 6,
             Ty::Tasks => 1,
+            Ty::Record(_) => return self.record_aggregate(items, want, span),
             Ty::Num | Ty::Bool | Ty::Str | Ty::Intnum | Ty::Syncident | Ty::Clock | Ty::Switch => {
                 self.error(
                     Code::E0020,
@@ -696,9 +701,14 @@ impl Tr<'_> {
                     text: name.text,
                 })
             }
-            Ty::Num | Ty::Bool | Ty::Str | Ty::Intnum | Ty::Syncident | Ty::Clock | Ty::Switch => {
-                None
-            }
+            Ty::Num
+            | Ty::Bool
+            | Ty::Str
+            | Ty::Intnum
+            | Ty::Syncident
+            | Ty::Clock
+            | Ty::Switch
+            | Ty::Record(_) => None,
         }
     }
 
@@ -724,7 +734,7 @@ impl Tr<'_> {
                 let ret = sig.ret.unwrap_or(Ty::Num);
                 // (A FUNC of a type held in more than one WSL value, a speeddata or a
                 // zonedata, is E0300 where it is declared: no value here.)
-                ret.leaf_type()?;
+                self.leaf_type(ret)?;
                 Some(Val::one(ret, b::call(&sig.wsl, wargs, span)))
             }
             Some(Sym::Routine(_)) => {
@@ -827,8 +837,9 @@ impl Tr<'_> {
             out.extend(self.value(e, *t)?.parts);
         }
         for o in &sig.optional {
+            let leaves = self.leaves(o.ty);
             let zero = |sp: Span| -> Vec<w::Expr> {
-                o.ty.leaves().iter().map(|(_, t)| b::zero(*t, sp)).collect()
+                leaves.iter().map(|(_, t)| b::zero(*t, sp)).collect()
             };
             let yes = |v: bool, sp: Span| b::expr(w::ExprKind::Bool(v), sp);
             match given.iter().find(|(n, _)| n.key() == o.key) {
@@ -889,7 +900,7 @@ impl Tr<'_> {
                         );
                         return None;
                     }
-                    out.extend(Tr::leaf_names(&d, None).iter().map(|n| b::name(n, x.span)));
+                    out.extend(self.leaf_names(&d, None).iter().map(|n| b::name(n, x.span)));
                     out.push(b::name(&d.present(), x.span));
                 }
                 Some((_, Arg::Pos(_))) => {}

@@ -19,6 +19,7 @@ pub(crate) mod data;
 mod expr;
 mod functions;
 mod io;
+mod records;
 mod stmt;
 mod strings;
 pub(crate) mod table;
@@ -57,7 +58,9 @@ pub(crate) fn translate(
         orders: BTreeMap::new(),
         grip_parts: Vec::new(),
         named_signals: Vec::new(),
+        records: records::Records::default(),
     };
+    t.collect_records(modules);
     t.collect(modules);
     t.collect_connects(modules);
     for (k, m) in modules.iter().enumerate() {
@@ -216,6 +219,8 @@ pub(crate) struct Tr<'d> {
     /// order (lower case): without the workcell's I/O (`io` is `None`), these alone are
     /// signals where an expression reads a bare name.
     pub(crate) named_signals: Vec<String>,
+    /// The task's `RECORD` types.
+    pub(crate) records: records::Records,
 }
 
 /// The WSL name of a RAPID name: lower case (RAPID is case-insensitive).
@@ -286,6 +291,7 @@ impl Tr<'_> {
                 let (name, local) = match it {
                     r::Item::Data(d) => (&d.name, d.local),
                     r::Item::Routine(rt) => (&rt.name, rt.local),
+                    r::Item::Record(_) => continue,
                 };
                 let key = name.key();
                 self.spelled
@@ -388,6 +394,9 @@ impl Tr<'_> {
     /// The type of a type name, or E0014.
     pub(crate) fn type_of(&mut self, n: &r::Name) -> Option<Ty> {
         if let Some(t) = Ty::from_name(&n.text) {
+            return Some(t);
+        }
+        if let Some(t) = self.record_named(&n.key()) {
             return Some(t);
         }
         if !self.not_run(n, &[Kind::DataType]) {
@@ -512,12 +521,12 @@ impl Tr<'_> {
     }
 
     /// The WSL names of the leaves of element `index` (1-based, arrays) of data `d`.
-    pub(crate) fn leaf_names(d: &Data, index: Option<u32>) -> Vec<String> {
+    pub(crate) fn leaf_names(&self, d: &Data, index: Option<u32>) -> Vec<String> {
         let base = match index {
             Some(i) => format!("{}{{{i}}}", d.base),
             None => d.base.clone(),
         };
-        d.ty.leaves()
+        self.leaves(d.ty)
             .iter()
             .map(|(suffix, _)| format!("{base}{suffix}"))
             .collect()
@@ -579,14 +588,14 @@ impl Tr<'_> {
             && !d.local
             && len.is_none()
             && matches!(ty, Ty::Num | Ty::Bool);
-        for (decl, _) in Self::leaf_decls(d, &data, inits.as_deref()) {
+        for (decl, _) in self.leaf_decls(d, &data, inits.as_deref()) {
             self.items.push(match d.storage {
                 Storage::Const => w::Item::Const(decl),
                 Storage::Pers if scalar_global => w::Item::Global(decl),
                 _ => w::Item::Var(decl),
             });
         }
-        if len.is_some() && !ty.leaves().is_empty() {
+        if len.is_some() && !self.leaves(ty).is_empty() {
             self.array_accessors(&data);
         }
         self.declare(d.local, key, Sym::Data(data));
@@ -595,6 +604,7 @@ impl Tr<'_> {
     /// One WSL declaration per element and leaf of `data` (declared by `d`), with the
     /// initial values `inits` (one per element), and each declaration's name.
     fn leaf_decls(
+        &self,
         d: &r::DataDecl,
         data: &Data,
         inits: Option<&[Val]>,
@@ -605,15 +615,15 @@ impl Tr<'_> {
         };
         let mut out = Vec::new();
         for (k, idx) in elements.iter().enumerate() {
-            let names = Self::leaf_names(data, *idx);
-            for (j, (name, (_, wty))) in names.into_iter().zip(data.ty.leaves()).enumerate() {
+            let names = self.leaf_names(data, *idx);
+            for (j, (name, (_, wty))) in names.into_iter().zip(self.leaves(data.ty)).enumerate() {
                 let init = inits
                     .and_then(|v| v.get(k))
                     .and_then(|v| v.parts.get(j))
                     .cloned();
                 let decl = w::VarDecl {
                     name: b::ident(&name, d.name.span),
-                    ty: Some(b::type_name(*wty, d.ty.span)),
+                    ty: Some(b::type_name(wty, d.ty.span)),
                     init,
                     span: d.span,
                 };
@@ -668,13 +678,13 @@ impl Tr<'_> {
     /// For an array `a` at module level: `a{}` (get element `i`) per leaf, generated.
     fn array_accessors(&mut self, d: &Data) {
         let Some(n) = d.len else { return };
-        for (j, (suffix, wty)) in d.ty.leaves().iter().enumerate() {
+        for (j, (suffix, wty)) in self.leaves(d.ty).iter().enumerate() {
             let span = d.span;
             let fname = format!("{}{{}}{suffix}", d.base);
             let i = b::name("i", span);
             let mut branches = Vec::new();
             for k in 1..=n {
-                let names = Self::leaf_names(d, Some(k));
+                let names = self.leaf_names(d, Some(k));
                 let cond = b::bin(
                     w::BinOp::Eq,
                     i.clone(),
@@ -770,7 +780,7 @@ impl Tr<'_> {
                     "use the module-level array directly",
                 );
             }
-            if ty.leaves().is_empty() && !matches!(*ty, Ty::Load | Ty::Switch) {
+            if self.leaves(*ty).is_empty() && !matches!(*ty, Ty::Load | Ty::Switch) {
                 self.unsupported(
                     &format!("a parameter of type `{}`", ty.name()),
                     p.span,
@@ -790,10 +800,10 @@ impl Tr<'_> {
                 tasks: Vec::new(),
                 optional: p.optional,
             };
-            for (name, (_, wty)) in Self::leaf_names(&data, None).iter().zip(ty.leaves()) {
+            for (name, (_, wty)) in self.leaf_names(&data, None).iter().zip(self.leaves(*ty)) {
                 params.push(w::Param {
                     name: b::ident(name, p.name.span),
-                    ty: b::type_name(*wty, p.ty.span),
+                    ty: b::type_name(wty, p.ty.span),
                 });
             }
             if p.optional {
@@ -815,7 +825,7 @@ impl Tr<'_> {
         }
         body.extend(self.stmts(&rt.body));
         let ret = match (rt.kind, sig.ret) {
-            (r::RoutineKind::Func, Some(t)) => match t.leaves() {
+            (r::RoutineKind::Func, Some(t)) => match self.leaves(t).as_slice() {
                 [(_, wty)] => Some(b::type_name(
                     *wty,
                     rt.ret.as_ref().map_or(rt.span, |n| n.span),
@@ -889,7 +899,7 @@ impl Tr<'_> {
                 .and_then(|v| v.first())
                 .and_then(|v| v.text.clone());
         }
-        for (decl, name) in Self::leaf_decls(d, &data, inits.as_deref()) {
+        for (decl, name) in self.leaf_decls(d, &data, inits.as_deref()) {
             self.used.insert(name);
             out.push(w::Stmt {
                 kind: w::StmtKind::Var(decl),

@@ -124,6 +124,13 @@ impl Tr<'_> {
     /// The data an assignment or `Incr` writes: a name, or an array element at a
     /// constant index.
     pub(crate) fn place(&mut self, e: &r::Expr) -> Option<(Data, Option<u32>)> {
+        // A component of a record: data of its own leaves.
+        if let r::ExprKind::Field(x, f) = &e.kind
+            && let Some(Ty::Record(_)) = self.place_type(x)
+        {
+            let (d, idx) = self.place(x)?;
+            return Some((self.record_component_data(&d, idx, f)?, None));
+        }
         let (n, idx) = match &e.kind {
             r::ExprKind::Name(n) => (n, None),
             r::ExprKind::Index(x, idx) => match (&x.kind, idx.as_slice()) {
@@ -228,7 +235,9 @@ impl Tr<'_> {
 
     /// `target := value;` as WSL assignments (one per leaf).
     fn assign(&mut self, target: &r::Expr, value: &r::Expr, span: Span) -> Vec<w::StmtKind> {
-        if let r::ExprKind::Field(x, f) = &target.kind {
+        if let r::ExprKind::Field(x, f) = &target.kind
+            && !matches!(self.place_type(x), Some(Ty::Record(_)))
+        {
             return self.assign_component(x, f, value, span).unwrap_or_default();
         }
         if let Some(stmts) = self.str_to_val(target, value, span) {
@@ -240,7 +249,7 @@ impl Tr<'_> {
         let Some(v) = self.value(value, d.ty) else {
             return Vec::new();
         };
-        Tr::leaf_names(&d, idx)
+        self.leaf_names(&d, idx)
             .iter()
             .zip(v.parts)
             .map(|(n, p)| Self::assign_kind(b::name(n, target.span), p))
@@ -262,7 +271,7 @@ impl Tr<'_> {
             _ => (x, vec![key.clone()]),
         };
         let (d, idx) = self.place(base)?;
-        let names = Tr::leaf_names(&d, idx);
+        let names = self.leaf_names(&d, idx);
         let leaf = |i: usize| b::name(&names[i], base.span);
         let path: Vec<&str> = path.iter().map(String::as_str).collect();
         let num = |t: &mut Self, dim: Dim| -> Option<w::Expr> {
@@ -465,7 +474,7 @@ impl Tr<'_> {
         }
         let ty = v.ty;
         let t = self.temp("test");
-        let wty = ty.leaf_type().map(|t| b::type_name(t, span));
+        let wty = self.leaf_type(ty).map(|t| b::type_name(t, span));
         let decl = w::Stmt {
             kind: w::StmtKind::Var(w::VarDecl {
                 name: b::ident(&t, span),
@@ -668,7 +677,7 @@ impl Tr<'_> {
         } else {
             w::BinOp::Add
         };
-        let target = b::name(&Tr::leaf_names(&d, idx)[0], p[0].span);
+        let target = b::name(&self.leaf_names(&d, idx)[0], p[0].span);
         let kind = w::StmtKind::Assign {
             target,
             op: Some(op),
@@ -872,7 +881,7 @@ impl Tr<'_> {
         let timed_out = || b::call("timed_out", vec![], span);
         match flag {
             Some((d, idx)) if d.ty == Ty::Bool => out.push(w::Stmt {
-                kind: Self::assign_kind(b::name(&Tr::leaf_names(&d, idx)[0], span), timed_out()),
+                kind: Self::assign_kind(b::name(&self.leaf_names(&d, idx)[0], span), timed_out()),
                 span,
             }),
             Some((d, _)) => {

@@ -128,8 +128,8 @@ impl Tr<'_> {
             return Some(Vec::new());
         }
         let s = self.value(text, Ty::Str)?.leaf();
-        let ok_name = b::name(&Tr::leaf_names(&ok, ok_idx)[0], target.span);
-        let x_name = b::name(&Tr::leaf_names(&d, idx)[0], x.span);
+        let ok_name = b::name(&self.leaf_names(&ok, ok_idx)[0], target.span);
+        let x_name = b::name(&self.leaf_names(&d, idx)[0], x.span);
         let set = |t: w::Expr, v: w::Expr| w::StmtKind::Assign {
             target: t,
             op: None,
