@@ -21,7 +21,31 @@ pub struct Frame {
     pub ret_pc: u32,
     /// First slot of this frame in the locals area.
     pub base: u32,
+    /// The operand stack's height when the frame started (its arguments taken).
+    pub stack_base: u32,
+    /// While its error handler runs: the instruction that failed (absolute), else
+    /// `u32::MAX`.
+    pub failed_at: u32,
+    /// The `Retry`s of the error being handled.
+    pub retries: u8,
 }
+
+impl Frame {
+    fn new(proc: u32, ret_pc: u32, base: u32, stack_base: u32) -> Frame {
+        Frame {
+            proc,
+            ret_pc,
+            base,
+            stack_base,
+            failed_at: u32::MAX,
+            retries: 0,
+        }
+    }
+}
+
+/// How many times an error handler may `Retry` one error (RAPID's default): more is the
+/// error ERR_EXCRTYMAX, which no handler catches.
+pub const MAX_RETRIES: u8 = 4;
 
 /// An execution context: the main program, a handler, or a remote request.
 #[derive(Clone, Debug, Default)]
@@ -34,6 +58,8 @@ pub struct Thread {
     pub locals: Vec<u64>,
     /// Absolute pc of the next instruction.
     pub pc: u32,
+    /// The number of the most recent error raised (RAPID's `ERRNO`), 0 before any.
+    pub errno: i64,
 }
 
 /// Why the interpreter stopped.
@@ -55,6 +81,9 @@ pub struct RuntimeError {
     pub pc: u32,
     /// Its source position.
     pub pos: SrcPos,
+    /// The error's number, if an error handler may catch it (`Raise`, RAPID's errors);
+    /// `None`: it stops the program.
+    pub errno: Option<i64>,
 }
 
 /// What zero-time code may read from the robot and the cell.
@@ -96,11 +125,7 @@ impl Thread {
         let p = &m.procs[proc as usize];
         self.locals.extend_from_slice(args);
         self.locals.resize(p.frame_slots as usize, 0);
-        self.frames.push(Frame {
-            proc,
-            ret_pc: u32::MAX,
-            base: 0,
-        });
+        self.frames.push(Frame::new(proc, u32::MAX, 0, 0));
         self.pc = p.code_start;
     }
 
@@ -137,16 +162,106 @@ impl Thread {
     }
 
     fn frame(&self) -> Frame {
-        self.frames.last().copied().unwrap_or(Frame {
-            proc: 0,
-            ret_pc: u32::MAX,
-            base: 0,
-        })
+        self.frames
+            .last()
+            .copied()
+            .unwrap_or(Frame::new(0, u32::MAX, 0, 0))
     }
 
     /// Runs until an event instruction or the end of the bottom frame. `budget` counts
-    /// down per instruction; at zero the run fails with the line of the loop.
+    /// down per instruction; at zero the run fails with the line of the loop. An error
+    /// with a number goes to the error handler of the procedure it happened in, or of the
+    /// nearest caller that has one (the frames above it are left), and the run goes on
+    /// there; an error inside an error handler, or one no handler takes, is the result.
+    #[allow(clippy::too_many_arguments)]
     pub fn run(
+        &mut self,
+        m: &Module,
+        r: &dyn Reader,
+        vars: &mut [u64],
+        texts: &mut Texts,
+        budget: &mut u64,
+        max_depth: usize,
+    ) -> Result<Stop, RuntimeError> {
+        loop {
+            match self.run_segment(m, r, vars, texts, budget, max_depth) {
+                Err(e) if e.errno.is_some() && *budget > 0 => {
+                    if !self.catch(m, &e) {
+                        return Err(e);
+                    }
+                }
+                other => return other,
+            }
+        }
+    }
+
+    /// Hands error `e` to the nearest error handler: true if one takes it.
+    fn catch(&mut self, m: &Module, e: &RuntimeError) -> bool {
+        let Some(errno) = e.errno else {
+            return false;
+        };
+        self.errno = errno;
+        let mut failed = e.pc;
+        for k in (0..self.frames.len()).rev() {
+            let f = self.frames[k];
+            if f.failed_at != u32::MAX {
+                return false; // An error inside an error handler.
+            }
+            let p = &m.procs[f.proc as usize];
+            if let Some(h) = &p.handler {
+                if let Some(above) = self.frames.get(k + 1) {
+                    self.locals.truncate(above.base as usize);
+                }
+                self.frames.truncate(k + 1);
+                self.stack.truncate(f.stack_base as usize);
+                if let Some(fr) = self.frames.last_mut() {
+                    fr.failed_at = failed;
+                }
+                self.pc = p.code_start + h.pc;
+                return true;
+            }
+            failed = f.ret_pc.wrapping_sub(1);
+        }
+        false
+    }
+
+    /// `Retry` (`again`) or `TryNext`: leaves the error handler for the statement that
+    /// failed, or the one after it.
+    fn resume(&mut self, m: &Module, again: bool) -> Result<(), String> {
+        let Some(f) = self.frames.last().copied() else {
+            return Err("no procedure is running".into());
+        };
+        let p = &m.procs[f.proc as usize];
+        let (Some(h), true) = (&p.handler, f.failed_at != u32::MAX) else {
+            return Err(format!(
+                "`{}` outside an error handler",
+                if again { "RETRY" } else { "TRYNEXT" }
+            ));
+        };
+        let Some((start, end)) = h.statement_at(f.failed_at - p.code_start) else {
+            return Err(
+                "the statement that failed is not in the procedure's table (a corrupt module)"
+                    .into(),
+            );
+        };
+        let retries = if again { f.retries + 1 } else { 0 };
+        if retries > MAX_RETRIES {
+            return Err(format!(
+                "ERR_EXCRTYMAX: the error handler retried error {} more than {MAX_RETRIES} times",
+                self.errno
+            ));
+        }
+        self.stack.truncate(f.stack_base as usize);
+        if let Some(fr) = self.frames.last_mut() {
+            fr.failed_at = u32::MAX;
+            fr.retries = retries;
+        }
+        self.pc = p.code_start + if again { start } else { end };
+        Ok(())
+    }
+
+    /// The run between errors: until an event, the end, or an error.
+    fn run_segment(
         &mut self,
         m: &Module,
         r: &dyn Reader,
@@ -159,6 +274,7 @@ impl Thread {
             message,
             pc,
             pos: m.pos_of(pc),
+            errno: None,
         };
         loop {
             let pc = self.pc;
@@ -352,6 +468,45 @@ impl Thread {
                 | Instr::ValText(_)
                 | Instr::TextIsNum
                 | Instr::TextNum => self.text(ins, m, texts).map_err(|e| err(pc, e))?,
+                Instr::Raise(msg) => {
+                    let n = self.pop() as i64;
+                    let text = m.strings.get(msg as usize).map_or("", String::as_str);
+                    return Err(RuntimeError {
+                        errno: Some(n),
+                        ..err(pc, format!("{text} (error {n}; no error handler took it)"))
+                    });
+                }
+                Instr::RaiseUp => {
+                    let n = self.errno;
+                    let fr = self.frames.pop().unwrap_or(Frame::new(0, u32::MAX, 0, 0));
+                    self.locals.truncate(fr.base as usize);
+                    self.stack.truncate(fr.stack_base as usize);
+                    if fr.failed_at == u32::MAX {
+                        return Err(err(pc, "`RAISE;` outside an error handler".into()));
+                    }
+                    if self.frames.is_empty() || fr.ret_pc == u32::MAX {
+                        return Err(err(
+                            pc,
+                            format!(
+                                "error {n}, raised on from the error handler of the task's first routine: no error handler took it"
+                            ),
+                        ));
+                    }
+                    self.pc = fr.ret_pc;
+                    return Err(RuntimeError {
+                        errno: Some(n),
+                        ..err(
+                            fr.ret_pc - 1,
+                            format!(
+                                "error {n}, raised on by an error handler: no error handler took it"
+                            ),
+                        )
+                    });
+                }
+                Instr::Retry | Instr::TryNext => self
+                    .resume(m, ins == Instr::Retry)
+                    .map_err(|e| err(pc, e))?,
+                Instr::ErrNo => self.stack.push(self.errno as u64),
                 Instr::MinF | Instr::MaxF | Instr::Atan2 => {
                     let y = f(self.pop());
                     let x = f(self.pop());
@@ -470,19 +625,12 @@ impl Thread {
                         .iter_mut()
                         .for_each(|v| *v = 0);
                     self.stack.truncate(from);
-                    self.frames.push(Frame {
-                        proc: p,
-                        ret_pc: pc + 1,
-                        base: new_base as u32,
-                    });
+                    self.frames
+                        .push(Frame::new(p, pc + 1, new_base as u32, from as u32));
                     self.pc = callee.code_start;
                 }
                 Instr::Ret | Instr::RetVal => {
-                    let fr = self.frames.pop().unwrap_or(Frame {
-                        proc: 0,
-                        ret_pc: u32::MAX,
-                        base: 0,
-                    });
+                    let fr = self.frames.pop().unwrap_or(Frame::new(0, u32::MAX, 0, 0));
                     self.locals.truncate(fr.base as usize);
                     if self.frames.is_empty() || fr.ret_pc == u32::MAX {
                         self.frames.clear();

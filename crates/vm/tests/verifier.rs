@@ -5,7 +5,8 @@
 
 use vworks_vm::bytecode::ConstInfo;
 use vworks_vm::bytecode::{
-    CodeProblem, Instr, LoadError, ProcInfo, ProcKind, SrcPos, StringUser, VerifyError,
+    CodeProblem, ErrorHandler, Instr, LoadError, ProcInfo, ProcKind, SrcPos, StringUser,
+    VerifyError,
 };
 use vworks_vm::{ConstValue, Module, Type};
 
@@ -27,6 +28,7 @@ fn module(code: Vec<Instr>, kind: ProcKind, ret: Option<Type>, frame: u32) -> Mo
                 col: 1,
             },
             max_stack: 0,
+            handler: None,
         }],
         code,
         ..Module::default()
@@ -73,6 +75,48 @@ fn a_good_module_verifies_and_gets_its_stack_depth() {
     assert_eq!(m.procs[0].max_stack, 2);
     // And survives the binary round trip.
     assert_eq!(Module::decode(&m.encode()), Ok(m));
+}
+
+/// An error handler's entries (the handler, and where `Retry`/`TryNext` go) start with an
+/// empty stack and lie inside the procedure; its table survives the round trip.
+#[test]
+fn error_handlers_are_checked_as_entries() {
+    // 0..2: one statement (push, store); 2: Ret; 3..5: the handler (push 7, raise).
+    let code = vec![
+        Instr::PushInt(1),
+        Instr::StoreLocal(0),
+        Instr::Ret,
+        Instr::PushInt(7),
+        Instr::Raise(0),
+    ];
+    let mut m = module(code.clone(), ProcKind::Proc, None, 1);
+    m.procs[0].handler = Some(ErrorHandler {
+        pc: 3,
+        stmts: vec![(0, 2)],
+    });
+    m.verify().unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(Module::decode(&m.encode()), Ok(m.clone()));
+    // A handler past the end.
+    m.procs[0].handler = Some(ErrorHandler {
+        pc: 9,
+        stmts: vec![],
+    });
+    assert!(matches!(
+        code_problem(m.clone()),
+        (0, CodeProblem::HandlerOutside { len: 5 })
+    ));
+    // A statement whose start has a value on the stack: `Retry` would go there with none.
+    m.procs[0].handler = Some(ErrorHandler {
+        pc: 3,
+        stmts: vec![(1, 2)],
+    });
+    assert!(matches!(
+        code_problem(m),
+        (
+            1,
+            CodeProblem::HeightMismatch { .. } | CodeProblem::Underflow { .. }
+        )
+    ));
 }
 
 #[test]

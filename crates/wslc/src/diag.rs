@@ -89,6 +89,7 @@ codes! {
     E0301 = "RAPID optional argument not accepted",
     E0302 = "unknown I/O signal",
     E0303 = "interrupt not connected or not ordered",
+    E0304 = "error recovery outside an error handler",
     E0900 = "internal compiler error",
     W0001 = "local shadows a global",
     W0002 = "`disable` of a handler never enabled",

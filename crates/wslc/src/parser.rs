@@ -339,6 +339,7 @@ impl Parser<'_, '_, Token> {
             params,
             ret,
             body,
+            handler: None,
             span,
         })
     }

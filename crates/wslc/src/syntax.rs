@@ -101,6 +101,8 @@ pub struct ProcDecl {
     pub ret: Option<Ident>,
     /// Body.
     pub body: Block,
+    /// Its error handler (only in a translation from RAPID: an `ERROR` clause).
+    pub handler: Option<Block>,
     /// From the keyword to the end of the parameter list.
     pub span: Span,
 }
@@ -319,6 +321,17 @@ pub enum StmtKind {
     Fail(Vec<Expr>),
     /// `stop;`
     Stop,
+    /// Raises error `errno` (an int) with `message`, or, with `None` in an error handler,
+    /// its error again where the procedure was called (a translation from RAPID only:
+    /// `RAISE`).
+    Raise(Option<Expr>, String),
+    /// In an error handler: run the statement that failed again (`RETRY`).
+    Retry,
+    /// In an error handler: go on after the statement that failed (`TRYNEXT`).
+    TryNext,
+    /// One statement of a procedure with an error handler, as `Retry` runs it again and
+    /// `TryNext` goes on after it (a translation from RAPID: one RAPID statement).
+    Recover(Block),
     /// `{ … }`
     Block(Block),
     /// A statement that did not parse (already reported).

@@ -183,6 +183,18 @@ impl Module {
                 w.u32(p.code_start);
                 w.u32(p.code_len);
                 w.pos(p.pos);
+                match &p.handler {
+                    None => w.u8(0),
+                    Some(h) => {
+                        w.u8(1);
+                        w.u32(h.pc);
+                        w.len(h.stmts.len());
+                        for (s, e) in &h.stmts {
+                            w.u32(*s);
+                            w.u32(*e);
+                        }
+                    }
+                }
             }
         });
         w.section(SECTIONS[6], |w| {
@@ -402,6 +414,14 @@ impl Module {
                             code_len: s.u32()?,
                             pos: s.pos()?,
                             max_stack: 0,
+                            handler: match s.u8()? {
+                                0 => None,
+                                1 => Some(ErrorHandler {
+                                    pc: s.u32()?,
+                                    stmts: s.list(8, |s| Ok((s.u32()?, s.u32()?)))?,
+                                }),
+                                b => return Err(s.error(format!("bad error-handler flag {b}"))),
+                            },
                         })
                     })?
                 }

@@ -352,6 +352,21 @@ instruction_set! {
     0x9a TextIsNum;
     /// Pops a text; pushes the number it writes, or 0: `StrToVal`'s value.
     0x9b TextNum;
+    /// Pops an int, an error's number, and raises it with the message of string `s`: the
+    /// error handler of this procedure, or of the nearest caller that has one, runs
+    /// (RAPID's `RAISE n`, and the errors the translation raises); with none, the program
+    /// stops with the message.
+    0x9c Raise(s: u32);
+    /// In an error handler: raises its error again where the procedure was called
+    /// (RAPID's `RAISE;`).
+    0x9d RaiseUp;
+    /// In an error handler: runs the statement that failed again (RAPID's `RETRY`; a
+    /// fifth retry of one error is ERR_EXCRTYMAX, which stops the program).
+    0x9e Retry;
+    /// In an error handler: goes on after the statement that failed (RAPID's `TRYNEXT`).
+    0x9f TryNext;
+    /// Pushes the number of the most recent error raised (an int): RAPID's `ERRNO`.
+    0xa0 ErrNo;
     /// Pops `n` nums, pushes a joints value (zero-padded to MAX_AXES slots).
     0x58 MakeJoints(n: u8);
     /// Pops an index and a joints value, pushes that axis's value.
@@ -476,6 +491,9 @@ impl Instr {
             Instr::AbsI | Instr::AbsF | Instr::Sqrt | Instr::Sin | Instr::Cos => eff(1, 1),
             Instr::TextCat | Instr::CmpT(_) | Instr::NumToText => eff(2, 1),
             Instr::TextLen | Instr::ValText(_) | Instr::TextIsNum | Instr::TextNum => eff(1, 1),
+            Instr::Raise(_) => eff(1, 0),
+            Instr::RaiseUp | Instr::Retry | Instr::TryNext => eff(0, 0),
+            Instr::ErrNo => eff(0, 1),
             Instr::TextPart
             | Instr::TextFind(_)
             | Instr::TextMatch
@@ -587,7 +605,15 @@ impl Instr {
     pub fn ends_block(&self) -> bool {
         matches!(
             self,
-            Instr::Jump(_) | Instr::Ret | Instr::RetVal | Instr::Stop | Instr::Fail(_)
+            Instr::Jump(_)
+                | Instr::Ret
+                | Instr::RetVal
+                | Instr::Stop
+                | Instr::Fail(_)
+                | Instr::Raise(_)
+                | Instr::RaiseUp
+                | Instr::Retry
+                | Instr::TryNext
         )
     }
 

@@ -142,6 +142,30 @@ pub struct ProcInfo {
     pub pos: SrcPos,
     /// The deepest the operand stack gets (slots); computed by [`Module::verify`].
     pub max_stack: u32,
+    /// Its error handler (RAPID's `ERROR` clause), if it has one.
+    pub handler: Option<ErrorHandler>,
+}
+
+/// A procedure's error handler: where it starts, and the procedure's statements, for
+/// `Retry` (run the statement that failed again) and `TryNext` (go on after it).
+#[derive(Clone, PartialEq, Eq, Debug, Default)]
+pub struct ErrorHandler {
+    /// Its first instruction, relative to the procedure's start.
+    pub pc: u32,
+    /// Every statement of the procedure's body as `[start, end)` (relative); the
+    /// innermost one holding a pc is the statement that failed there.
+    pub stmts: Vec<(u32, u32)>,
+}
+
+impl ErrorHandler {
+    /// The innermost statement holding relative pc `pc`.
+    pub fn statement_at(&self, pc: u32) -> Option<(u32, u32)> {
+        self.stmts
+            .iter()
+            .filter(|(s, e)| *s <= pc && pc < *e)
+            .min_by_key(|(s, e)| e - s)
+            .copied()
+    }
 }
 
 impl ProcInfo {

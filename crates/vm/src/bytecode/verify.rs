@@ -198,6 +198,14 @@ pub enum CodeProblem {
         /// The procedure's length.
         len: usize,
     },
+    /// The error handler or one of its statements lies outside the procedure.
+    #[error(
+        "the error handler or one of its statements lies outside the procedure's {len} instructions"
+    )]
+    HandlerOutside {
+        /// The procedure's length.
+        len: usize,
+    },
     /// Two paths reach the instruction with different stack heights.
     #[error("stack height {height} here, but {other} on another path")]
     HeightMismatch {
@@ -583,6 +591,7 @@ impl Module {
                     .is_some_and(|t| t.kind == ProcKind::Proc),
                 Instr::Grip(x) | Instr::Release(x) => (x as usize) < self.parts.len(),
                 Instr::Log(f) | Instr::Fail(f) => (f as usize) < self.log_formats.len(),
+                Instr::Raise(x) => (x as usize) < self.strings.len(),
                 _ => true,
             };
             if !ok {
@@ -609,9 +618,26 @@ impl Module {
                 return Err(at(pc, CodeProblem::JumpOutside { target: t, len: n }));
             }
         }
-        // Stack heights along every path from the entry.
+        // Stack heights along every path from the entry, and from the error handler's
+        // entries: the handler itself, and the statements `Retry`/`TryNext` go to, where
+        // the stack is empty.
         let mut height: Vec<Option<u32>> = vec![None; n];
         let mut work = vec![(0usize, 0u32)];
+        if let Some(h) = &p.handler {
+            let inside = |x: u32| (x as usize) < n;
+            if !inside(h.pc)
+                || h.stmts
+                    .iter()
+                    .any(|&(s, e)| s > e || !inside(s) || !inside(e))
+            {
+                return Err(at(0, CodeProblem::HandlerOutside { len: n }));
+            }
+            work.push((h.pc as usize, 0));
+            for &(s, e) in &h.stmts {
+                work.push((s as usize, 0));
+                work.push((e as usize, 0));
+            }
+        }
         let mut max = 0;
         while let Some((pc, h)) = work.pop() {
             match height[pc] {

@@ -229,6 +229,7 @@ pub(super) fn zero_time_loop(m: &Module, pc: u32, th: &Thread, what: String) -> 
         None => (pc, "this statement"),
     };
     RuntimeError {
+        errno: None,
         message: format!(
             "{place} never lets time pass ({what}): an endless zero-time loop; add a motion, a delay or a wait that blocks inside it"
         ),

@@ -101,6 +101,7 @@ impl Compiler<'_> {
             code_len: 0,
             pos,
             max_stack: 0,
+            handler: None,
         });
         self.facts.push(Facts::default());
         self.proc_code.push((Vec::new(), Vec::new()));

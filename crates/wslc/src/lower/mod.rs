@@ -42,10 +42,10 @@ use crate::syntax::*;
 mod builtins;
 mod codegen;
 mod expr;
+mod from_rapid;
 mod resolve;
 mod rules;
 mod stmt;
-mod texts;
 
 pub(crate) use builtins::BUILTINS;
 use builtins::builtin_named;
@@ -209,6 +209,11 @@ struct FnCtx {
     loops: Vec<Loop>,
     /// Captured locals of the enclosing procedure: name, its slot there, width, type.
     captures: Vec<(String, u32, u8, Ty)>,
+    /// The statements' `[start, end)` of a procedure with an error handler (for `Retry`
+    /// and `TryNext`), while its body is compiled.
+    stmts: Option<Vec<(u32, u32)>>,
+    /// Compiling an error handler: `Retry`, `TryNext` and `RAISE;` may stand here.
+    in_handler: bool,
     /// Inside a `parallel` block's local branch: `Some(loops)`, the loops open around
     /// the block (a `break` or `continue` to one of them, or a `return`, would leave the
     /// block before its join: E0063).
@@ -227,6 +232,8 @@ impl FnCtx {
             next_slot: 0,
             loops: Vec::new(),
             captures: Vec::new(),
+            stmts: None,
+            in_handler: false,
             in_parallel: None,
         }
     }

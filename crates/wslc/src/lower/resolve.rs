@@ -337,6 +337,9 @@ impl Compiler<'_> {
             FnKind::Proc
         };
         self.fns.push(FnCtx::new(idx, kind, sig.ret));
+        if p.handler.is_some() {
+            self.f().stmts = Some(Vec::new());
+        }
         for (name, ty) in &sig.params {
             self.add_local(name, *ty, true);
         }
@@ -368,6 +371,27 @@ impl Compiler<'_> {
                     p.body.span.end as usize,
                 ),
             );
+        }
+        if let Some(h) = &p.handler {
+            // The error handler: after the body; reaching its end returns from the
+            // procedure (a function's error goes on to its caller).
+            let stmts = self.f().stmts.take().unwrap_or_default();
+            let pc = self.here() as u32;
+            self.f().in_handler = true;
+            if !self.block(h) {
+                let end = Span::new(h.span.end.saturating_sub(1) as usize, h.span.end as usize);
+                self.emit(
+                    if p.is_func {
+                        Instr::RaiseUp
+                    } else {
+                        Instr::Ret
+                    },
+                    end,
+                );
+            }
+            if let Some(info) = self.m.procs.get_mut(idx as usize) {
+                info.handler = Some(vworks_vm::bytecode::ErrorHandler { pc, stmts });
+            }
         }
         self.finish_fn();
     }

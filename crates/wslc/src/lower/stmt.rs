@@ -79,8 +79,22 @@ impl Compiler<'_> {
         true
     }
 
-    /// Compiles a statement; true if control never continues after it.
+    /// Compiles a statement; true if control never continues after it. In a procedure
+    /// with an error handler, its `[start, end)` is noted.
     pub(super) fn stmt(&mut self, s: &Stmt) -> bool {
+        let StmtKind::Recover(b) = &s.kind else {
+            return self.stmt_code(s);
+        };
+        let start = self.here() as u32;
+        let diverges = self.block(b);
+        let end = self.here() as u32;
+        if let Some(v) = self.f().stmts.as_mut() {
+            v.push((start, end));
+        }
+        diverges
+    }
+
+    fn stmt_code(&mut self, s: &Stmt) -> bool {
         let sp = s.span;
         match &s.kind {
             StmtKind::Error => {}
@@ -319,6 +333,11 @@ impl Compiler<'_> {
                 return true;
             }
             StmtKind::Block(b) => return self.block(b),
+            StmtKind::Raise(..) | StmtKind::Retry | StmtKind::TryNext => {
+                self.recovery(&s.kind, sp);
+                return true;
+            }
+            StmtKind::Recover(b) => return self.block(b),
         }
         false
     }

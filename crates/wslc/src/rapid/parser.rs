@@ -441,7 +441,9 @@ impl Parser<'_, '_, Token> {
         }
         let body = self.stmts();
         let mut handler = None;
+        let mut other_handler = None;
         while self.at("error") || self.at("backward") || self.at("undo") {
+            let error = self.at("error");
             let s = self.bump().span;
             if self.eat_tok(&Tok::LParen) {
                 while !self.at_tok(&Tok::RParen) && !self.at_tok(&Tok::Eof) {
@@ -449,8 +451,12 @@ impl Parser<'_, '_, Token> {
                 }
                 self.bump();
             }
-            handler.get_or_insert(s);
-            let _ = self.stmts();
+            let stmts = self.stmts();
+            if error && handler.is_none() {
+                handler = Some((s, stmts));
+            } else {
+                other_handler.get_or_insert(s);
+            }
         }
         if !self.eat(end) {
             let d = Diagnostic::error(
@@ -476,6 +482,7 @@ impl Parser<'_, '_, Token> {
             locals,
             body,
             handler,
+            other_handler,
             span,
         })
     }
@@ -616,12 +623,24 @@ impl Parser<'_, '_, Token> {
             self.expect_tok(Tok::Semi, "`;`")?;
             return Ok(StmtKind::Connect { intno, trap });
         }
-        for (word, what) in [
-            ("goto", "GOTO"),
-            ("raise", "RAISE"),
-            ("retry", "RETRY"),
-            ("trynext", "TRYNEXT"),
-        ] {
+        if self.eat("raise") {
+            let v = if self.at_tok(&Tok::Semi) {
+                None
+            } else {
+                Some(self.expr()?)
+            };
+            self.expect_tok(Tok::Semi, "`;`")?;
+            return Ok(StmtKind::Raise(v));
+        }
+        if self.eat("retry") {
+            self.expect_tok(Tok::Semi, "`;`")?;
+            return Ok(StmtKind::Retry);
+        }
+        if self.eat("trynext") {
+            self.expect_tok(Tok::Semi, "`;`")?;
+            return Ok(StmtKind::TryNext);
+        }
+        for (word, what) in [("goto", "GOTO")] {
             if self.eat(word) {
                 self.skip_past_semi();
                 return Ok(StmtKind::Unsupported(what));

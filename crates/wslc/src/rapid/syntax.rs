@@ -123,8 +123,10 @@ pub struct Routine {
     pub locals: Vec<DataDecl>,
     /// The statements.
     pub body: Vec<Stmt>,
-    /// `ERROR` or `BACKWARD`/`UNDO` handler given (not supported; where).
-    pub handler: Option<Span>,
+    /// The `ERROR` handler: where its keyword is, and its statements.
+    pub handler: Option<(Span, Vec<Stmt>)>,
+    /// A `BACKWARD` or `UNDO` handler given (not supported; where).
+    pub other_handler: Option<Span>,
     /// From the keyword to the end of the parameter list.
     pub span: Span,
 }
@@ -240,8 +242,14 @@ pub enum StmtKind {
         /// The trap routine.
         trap: Name,
     },
+    /// `RAISE [errno];`
+    Raise(Option<Expr>),
+    /// `RETRY;`
+    Retry,
+    /// `TRYNEXT;`
+    TryNext,
     /// A construct the front-end does not run (already parsed so the message names it):
-    /// `GOTO`, labels, `RAISE`, `RETRY`, `TRYNEXT`, late binding.
+    /// `GOTO`, labels, late binding.
     Unsupported(&'static str),
     /// A statement that did not parse (already reported).
     Error,

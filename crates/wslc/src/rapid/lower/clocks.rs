@@ -148,6 +148,7 @@ impl Tr<'_> {
             ],
             ret: Some(b::ident("time", span)),
             body: block(body, span),
+            handler: None,
             span,
         }));
     }

@@ -71,6 +71,7 @@ pub(crate) const TYPES: &[(&str, Ty)] = &[
     ("confdata", Ty::Conf),
     ("extjoint", Ty::Extax),
     ("intnum", Ty::Intnum),
+    ("errnum", Ty::Num),
     ("clock", Ty::Clock),
     ("switch", Ty::Switch),
     ("syncident", Ty::Syncident),
@@ -139,6 +140,22 @@ impl Ty {
         matches!(self, Ty::Pos | Ty::Orient | Ty::Pose | Ty::Robtarget)
     }
 }
+
+/// RAPID's error numbers the engine raises or a program names, with vworks's own numbers
+/// (a program compares `ERRNO` with the names; RAISE of a program's own error takes 1 to
+/// 90, `BookErrNo` books from 90 down).
+pub(crate) const ERRORS: &[(&str, i32)] = &[
+    ("ERR_WAIT_MAXTIME", 1001),
+    ("ERR_WAITSYNCTASK", 1002),
+    ("ERR_INDEX", 1003),
+    ("ERR_DIVZERO", 1004),
+    ("ERR_STRTOOLNG", 1005),
+    ("ERR_OUTOFBND", 1006),
+    ("ERR_NOTPRES", 1007),
+    ("ERR_EXCRTYMAX", 1008),
+    ("ERR_TP_MAXTIME", 1009),
+    ("ERR_TP_NO_CLIENT", 1010),
+];
 
 /// Predefined `speeddata`: (name, v_tcp mm/s, v_ori deg/s), as the RAPID reference lists
 /// them (`vmax` is 5000 mm/s, as on most arms).

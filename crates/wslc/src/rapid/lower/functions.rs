@@ -334,6 +334,7 @@ impl Tr<'_> {
             }],
             ret: Some(b::ident("num", span)),
             body: super::block(body, span),
+            handler: None,
             span,
         }));
     }

@@ -73,6 +73,15 @@ impl Tr<'_> {
                         {
                             found.3.push(n.key());
                         }
+                        // (An errnum BookErrNo books: its number is its rank among them.)
+                        if k == "bookerrno"
+                            && let Some(Arg::Pos(r::Expr {
+                                kind: r::ExprKind::Name(n),
+                                ..
+                            })) = args.first()
+                        {
+                            found.3.push(format!("bookerrno:{}", n.key()));
+                        }
                         if k == "gripload"
                             && let Some(Arg::Pos(r::Expr {
                                 kind: r::ExprKind::Name(n),
@@ -123,6 +132,9 @@ impl Tr<'_> {
             for it in &m.items {
                 if let r::Item::Routine(rt) = it {
                     walk(&rt.body, mi, &mut found);
+                    if let Some((_, h)) = &rt.handler {
+                        walk(h, mi, &mut found);
+                    }
                 }
             }
         }
@@ -132,6 +144,10 @@ impl Tr<'_> {
         self.grip_parts = parts;
         signals.sort();
         signals.dedup();
+        let (booked, signals): (Vec<String>, Vec<String>) = signals
+            .into_iter()
+            .partition(|s| s.starts_with("bookerrno:"));
+        self.helpers.extend(booked);
         self.named_signals = signals;
         for (intno, trap, span, mi) in connects {
             self.module = mi;
@@ -599,6 +615,7 @@ impl Tr<'_> {
                     params: Vec::new(),
                     ret: None,
                     body: block(body, span),
+                    handler: None,
                     span,
                 }));
             }

@@ -144,6 +144,10 @@ pub(crate) enum Sym {
 pub(crate) struct RoutineCx {
     pub(crate) kind: r::RoutineKind,
     pub(crate) ret: Option<Ty>,
+    /// It has an `ERROR` handler: each statement is one for `RETRY` and `TRYNEXT`.
+    pub(crate) has_handler: bool,
+    /// Translating its error handler.
+    pub(crate) in_handler: bool,
 }
 
 /// A translated RAPID value: its type and its WSL leaves.
@@ -728,6 +732,7 @@ impl Tr<'_> {
                 }],
                 ret: Some(b::type_name(*wty, span)),
                 body: block(body, span),
+                handler: None,
                 span,
             }));
         }
@@ -740,11 +745,11 @@ impl Tr<'_> {
         if sig.span != rt.name.span {
             return;
         }
-        if let Some(h) = rt.handler {
+        if let Some(h) = rt.other_handler {
             self.unsupported(
-                "an error handler (`ERROR`, `BACKWARD`, `UNDO`)",
+                "a `BACKWARD` or `UNDO` handler",
                 h,
-                "remove the handler: a runtime error stops the simulation and names the line",
+                "remove the handler: vworks does not run programs backward or undo them",
             );
         }
         self.locals = vec![BTreeMap::new()];
@@ -753,6 +758,8 @@ impl Tr<'_> {
         self.routine = Some(RoutineCx {
             kind: rt.kind,
             ret: sig.ret,
+            has_handler: rt.handler.is_some(),
+            in_handler: false,
         });
         let mut params = Vec::new();
         let (mut required, mut optional) = (sig.params.iter(), sig.optional.iter());
@@ -824,6 +831,12 @@ impl Tr<'_> {
             self.local_data(d, &mut body);
         }
         body.extend(self.stmts(&rt.body));
+        let handler = rt.handler.as_ref().map(|(at, stmts)| {
+            if let Some(cx) = self.routine.as_mut() {
+                cx.in_handler = true;
+            }
+            block(self.stmts(stmts), *at)
+        });
         let ret = match (rt.kind, sig.ret) {
             (r::RoutineKind::Func, Some(t)) => match self.leaves(t).as_slice() {
                 [(_, wty)] => Some(b::type_name(
@@ -848,6 +861,7 @@ impl Tr<'_> {
             params,
             ret,
             body: block(body, rt.span),
+            handler,
             span: rt.span,
         }));
         self.locals.clear();
@@ -977,6 +991,22 @@ fn predefined(key: &str) -> Option<Data> {
         "high" => d.inline = Some(vec![b::num(1.0, span)]),
         "low" => d.inline = Some(vec![b::num(0.0, span)]),
         "wait_max" => d.inline = Some(vec![b::num(8_388_608.0, span)]),
+        // The most recent error's number (in an error handler: the one it handles).
+        "errno" => {
+            d.inline = Some(vec![b::call(
+                "num",
+                vec![b::call("errno'", Vec::new(), span)],
+                span,
+            )]);
+        }
+        k if data::ERRORS.iter().any(|(n, _)| n.eq_ignore_ascii_case(k)) => {
+            let (_, n) = data::ERRORS
+                .iter()
+                .find(|(n, _)| n.eq_ignore_ascii_case(k))
+                .copied()
+                .unwrap_or(("", 0));
+            d.inline = Some(vec![b::num(f64::from(n), span)]);
+        }
         _ => return None,
     }
     Some(d)

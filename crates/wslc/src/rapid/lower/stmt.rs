@@ -28,6 +28,24 @@ impl Tr<'_> {
     }
 
     fn stmt(&mut self, s: &r::Stmt, out: &mut Vec<w::Stmt>) {
+        // In a routine with an error handler each statement is one for RETRY/TRYNEXT.
+        if self
+            .routine
+            .as_ref()
+            .is_some_and(|cx| cx.has_handler && !cx.in_handler)
+        {
+            let mut inner = Vec::new();
+            self.stmt_lowered(s, &mut inner);
+            out.push(w::Stmt {
+                kind: w::StmtKind::Recover(block(inner, s.span)),
+                span: s.span,
+            });
+        } else {
+            self.stmt_lowered(s, out);
+        }
+    }
+
+    fn stmt_lowered(&mut self, s: &r::Stmt, out: &mut Vec<w::Stmt>) {
         let span = s.span;
         let mut push = |kind| out.push(w::Stmt { kind, span });
         match &s.kind {
@@ -98,6 +116,46 @@ impl Tr<'_> {
             r::StmtKind::Exit => push(w::StmtKind::Stop),
             // Bound for the whole task before any routine (`collect_connects`).
             r::StmtKind::Connect { .. } => {}
+            r::StmtKind::Raise(errno) => {
+                let in_handler = self.routine.as_ref().is_some_and(|cx| cx.in_handler);
+                match errno {
+                    Some(e) => {
+                        if let Some(v) = self.value(e, Ty::Num) {
+                            let n = b::call("int", vec![v.leaf()], e.span);
+                            push(w::StmtKind::Raise(Some(n), "RAISE".into()));
+                        }
+                    }
+                    None if in_handler => push(w::StmtKind::Raise(None, String::new())),
+                    None => {
+                        self.error(
+                            Code::E0304,
+                            "`RAISE;` without an error number outside an error handler",
+                            span,
+                        )
+                        .help = Some("give the error's number (`RAISE ERR_MYERR;`), or move it into the routine's ERROR clause".into());
+                    }
+                }
+            }
+            r::StmtKind::Retry | r::StmtKind::TryNext => {
+                let retry = matches!(s.kind, r::StmtKind::Retry);
+                if self.routine.as_ref().is_some_and(|cx| cx.in_handler) {
+                    push(if retry {
+                        w::StmtKind::Retry
+                    } else {
+                        w::StmtKind::TryNext
+                    });
+                } else {
+                    self.error(
+                        Code::E0304,
+                        format!(
+                            "{} outside an error handler",
+                            if retry { "RETRY" } else { "TRYNEXT" }
+                        ),
+                        span,
+                    )
+                    .help = Some("it goes in the routine's ERROR clause".into());
+                }
+            }
             r::StmtKind::Unsupported(what) => {
                 self.unsupported(what, span, "write the program without it");
             }
@@ -893,13 +951,11 @@ impl Tr<'_> {
             }
             None if has_timeout => {
                 // Without \TimeFlag, an expired \MaxTime is the error ERR_WAIT_MAXTIME.
-                let fail = w::Stmt {
-                    kind: w::StmtKind::Fail(vec![b::expr(
-                        w::ExprKind::Str(format!("{instr}: \\MaxTime expired (ERR_WAIT_MAXTIME)")),
-                        span,
-                    )]),
+                let fail = raise(
+                    "ERR_WAIT_MAXTIME",
+                    format!("{instr}: \\MaxTime expired (ERR_WAIT_MAXTIME)"),
                     span,
-                };
+                );
                 out.push(w::Stmt {
                     kind: w::StmtKind::If {
                         branches: vec![(timed_out(), block(vec![fail], span))],
@@ -956,13 +1012,11 @@ impl Tr<'_> {
             span,
         });
         if has_timeout {
-            let fail = w::Stmt {
-                kind: w::StmtKind::Fail(vec![b::expr(
-                    w::ExprKind::Str("WaitSyncTask: \\TimeOut expired (ERR_WAITSYNCTASK)".into()),
-                    span,
-                )]),
+            let fail = raise(
+                "ERR_WAITSYNCTASK",
+                "WaitSyncTask: \\TimeOut expired (ERR_WAITSYNCTASK)".into(),
                 span,
-            };
+            );
             out.push(w::Stmt {
                 kind: w::StmtKind::If {
                     branches: vec![(b::call("timed_out", vec![], span), block(vec![fail], span))],
@@ -1027,5 +1081,18 @@ fn is_identity_pose(e: &w::Expr) -> bool {
     match &e.kind {
         w::ExprKind::Call(f, a) if f.name == "pose" => a.iter().all(|x| b::literal(x) == Some(0.0)),
         _ => false,
+    }
+}
+
+/// The statement raising RAPID's error `name` (one of [`super::data::ERRORS`]) with
+/// `message`, which names it if no error handler takes it.
+fn raise(name: &str, message: String, span: Span) -> w::Stmt {
+    let n = super::data::ERRORS
+        .iter()
+        .find(|(e, _)| *e == name)
+        .map_or(0, |(_, n)| i64::from(*n));
+    w::Stmt {
+        kind: w::StmtKind::Raise(Some(b::expr(w::ExprKind::Int(n), span)), message),
+        span,
     }
 }

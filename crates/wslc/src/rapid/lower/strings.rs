@@ -69,6 +69,42 @@ impl Tr<'_> {
         Some(Val::one(Ty::Str, b::call(f, vec![v.leaf()], c.span)))
     }
 
+    /// `BookErrNo e;`: the errnum `e` gets a number of its own, from 90 down by the
+    /// errnums' names in order, one per errnum the task books (the same each time).
+    pub(crate) fn book_errno(&mut self, c: &Call<'_>, out: &mut Vec<w::Stmt>) {
+        let Some((d, idx)) = self.place(c.pos[0]) else {
+            return;
+        };
+        if d.ty != Ty::Num {
+            self.error(
+                Code::E0020,
+                format!("BookErrNo books an errnum, not {}", article(d.ty)),
+                c.pos[0].span,
+            );
+            return;
+        }
+        let name = self.leaf_names(&d, idx)[0].clone();
+        // Its rank among the errnums the task books (found before any routine).
+        let key = match &c.pos[0].kind {
+            r::ExprKind::Name(n) => format!("bookerrno:{}", n.key()),
+            _ => String::new(),
+        };
+        let rank = self
+            .helpers
+            .iter()
+            .filter(|h| h.starts_with("bookerrno:"))
+            .position(|h| *h == key)
+            .unwrap_or(0);
+        out.push(w::Stmt {
+            kind: w::StmtKind::Assign {
+                target: b::name(&name, c.pos[0].span),
+                op: None,
+                value: b::num(90.0 - rank as f64, c.span),
+            },
+            span: c.span,
+        });
+    }
+
     /// `StrToVal(text, x)` outside an assignment of its result: it writes `x`.
     pub(crate) fn str_to_val_here(&mut self, c: &Call<'_>) -> Option<Val> {
         self.unsupported(

@@ -210,6 +210,13 @@ pub(crate) const INSTRUCTIONS: &[Row<InstrLowering>] = &[
         "wait until the robot stands at its point",
     ),
     row(
+        "BookErrNo",
+        1..=1,
+        &[],
+        I(|t, c, out| t.book_errno(c, out)),
+        "an errnum gets an error number of its own for RAISE",
+    ),
+    row(
         "ClkReset",
         1..=1,
         &[],

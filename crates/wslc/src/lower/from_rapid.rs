@@ -1,7 +1,9 @@
-//! The text functions of a translation from RAPID ([`SourceModule::texts`]): RAPID's
-//! string functions (`StrLen`, `StrPart`, `NumToStr`, …) as the RAPID front-end calls them,
-//! by names WSL source cannot write (they end in `'`), each one text instruction
-//! (docs/bytecode.md). WSL itself has no text values.
+//! What only a translation from RAPID ([`SourceModule::texts`]) compiles: RAPID's string
+//! functions (`StrLen`, `StrPart`, `NumToStr`, …) and `ERRNO`, which the RAPID front-end
+//! calls by names WSL source cannot write (they end in `'`), each one instruction
+//! (docs/bytecode.md); and error recovery (`RAISE`, `RETRY`, `TRYNEXT`), which the
+//! error handlers of `crate::lower::resolve` surround. WSL itself has no text values and
+//! no error handlers.
 
 use super::*;
 
@@ -11,6 +13,7 @@ enum T {
     Text,
     Num,
     Bool,
+    Int,
 }
 
 impl T {
@@ -19,6 +22,7 @@ impl T {
             T::Text => Ty::Text,
             T::Num => Ty::Num(Dim::PLAIN),
             T::Bool => Ty::Bool,
+            T::Int => Ty::Int,
         }
     }
 }
@@ -67,6 +71,7 @@ const TEXT_FUNCTIONS: &[(&str, &[T], T, Instr)] = &[
     ("valtostr_num'", &[T::Num], T::Text, Instr::ValText(1)),
     ("strisnum'", &[T::Text], T::Bool, Instr::TextIsNum),
     ("strnum'", &[T::Text], T::Num, Instr::TextNum),
+    ("errno'", &[], T::Int, Instr::ErrNo),
 ];
 
 impl Compiler<'_> {
@@ -100,5 +105,38 @@ impl Compiler<'_> {
         }
         self.emit(instr, sp);
         Some(Out::of(ret.ty()))
+    }
+
+    /// `Raise`, `Retry`, `TryNext` (they end the block).
+    pub(super) fn recovery(&mut self, kind: &StmtKind, sp: Span) {
+        let in_handler = self.f().in_handler;
+        match kind {
+            StmtKind::Raise(Some(e), message) => {
+                let o = self.expr(e);
+                self.coerce(o, Ty::Int, e.span, "an error number");
+                let s = self.str(message);
+                self.emit(Instr::Raise(s), sp);
+            }
+            StmtKind::Raise(None, _) if in_handler => {
+                self.emit(Instr::RaiseUp, sp);
+            }
+            StmtKind::Retry if in_handler => {
+                self.emit(Instr::Retry, sp);
+            }
+            StmtKind::TryNext if in_handler => {
+                self.emit(Instr::TryNext, sp);
+            }
+            _ => {
+                let what = match kind {
+                    StmtKind::Retry => "RETRY",
+                    StmtKind::TryNext => "TRYNEXT",
+                    _ => "`RAISE;` (raising the handler's error again)",
+                };
+                self.err(
+                    Diagnostic::error(Code::E0304, format!("{what} outside an error handler"), sp)
+                        .with_help("it goes in the routine's `ERROR` clause"),
+                );
+            }
+        }
     }
 }
