@@ -221,26 +221,10 @@ impl Tr<'_> {
                 return None;
             }
         };
-        let [i] = idx else {
-            self.unsupported(
-                "an index of more than one dimension",
-                span,
-                "use one-dimensional arrays",
-            );
-            return None;
+        let index = match self.flat_index(n, &d, idx)? {
+            super::arrays::Flat::Const(k) => return Some(self.data_value(&d, Some(k), span)),
+            super::arrays::Flat::Var(e) => e,
         };
-        let len = d.len.unwrap_or(0);
-        if let Some(k) = self.const_num(i) {
-            if k.fract() != 0.0 || k < 1.0 || k > f64::from(len) {
-                self.error(
-                    Code::E0025,
-                    format!("index {k} is outside `{}`'s elements 1 to {len}", n.text),
-                    i.span,
-                );
-                return None;
-            }
-            return Some(self.data_value(&d, Some(k as u32), span));
-        }
         if d.local {
             self.unsupported(
                 "a routine's local array indexed by a variable",
@@ -249,8 +233,7 @@ impl Tr<'_> {
             );
             return None;
         }
-        let iv = self.value(i, Ty::Num)?.leaf();
-        let index = b::call("int", vec![iv], i.span);
+
         let parts = self
             .leaves(d.ty)
             .iter()

@@ -281,20 +281,32 @@ impl Tr<'_> {
         ))
     }
 
-    /// `Dim(a, 1)`.
+    /// `Dim(a, k)`: the size of dimension `k` (a constant).
     pub(crate) fn dim(&mut self, c: &Call<'_>) -> Option<Val> {
         let span = c.span;
         let p = &c.pos;
         let (_, d) = self.data_arg(p[0], "an array", |d| d.len.is_some())?;
-        let len = d.len.unwrap_or(0);
-        if self.const_num(p[1]) != Some(1.0) {
+        let k = self.const_num(p[1]);
+        let size = k
+            .filter(|k| k.fract() == 0.0 && *k >= 1.0)
+            .and_then(|k| d.dims.get(k as usize - 1));
+        let Some(&len) = size else {
             self.error(
                 Code::E0025,
-                "vworks's arrays have one dimension: Dim(a, 1)",
+                format!(
+                    "the array has {} dimension{}: Dim(a, 1){}",
+                    d.dims.len(),
+                    if d.dims.len() == 1 { "" } else { "s" },
+                    if d.dims.len() > 1 {
+                        format!(" to Dim(a, {})", d.dims.len())
+                    } else {
+                        String::new()
+                    }
+                ),
                 p[1].span,
             );
             return None;
-        }
+        };
         Some(Val::one(Ty::Num, b::num(f64::from(len), span)))
     }
 

@@ -14,6 +14,7 @@
 //! Every WSL node gets the span of the RAPID construct it comes from, so the bytecode's
 //! line table, the event trace and runtime errors name RAPID lines.
 
+mod arrays;
 mod clocks;
 pub(crate) mod data;
 mod expr;
@@ -92,6 +93,9 @@ pub(crate) struct Data {
     pub(crate) ty: Ty,
     /// Elements of an array (1-based in RAPID), `None` for a scalar.
     pub(crate) len: Option<u32>,
+    /// An array's dimensions (`a{3, 4}`: 3 and 4; elements are held row after row, so
+    /// `a{i, j}` is element `(i - 1) · 4 + j`); empty for a scalar.
+    pub(crate) dims: Vec<u32>,
     pub(crate) storage: Storage,
     /// The WSL name the leaves' names start with.
     pub(crate) base: String,
@@ -420,39 +424,46 @@ impl Tr<'_> {
         None
     }
 
-    /// The array length of a declaration, if any: a constant of at least 1.
-    fn dims(&mut self, d: &r::DataDecl) -> Result<Option<u32>, ()> {
-        match d.dims.as_slice() {
-            [] => Ok(None),
-            [n] => match self.const_num(n) {
-                Some(x) if (1.0..=100_000.0).contains(&x) && x.fract() == 0.0 => Ok(Some(x as u32)),
-                Some(x) => {
-                    self.error(
-                        Code::E0025,
-                        format!("an array's size must be a whole number from 1 to 100000, not {x}"),
-                        n.span,
-                    );
-                    Err(())
-                }
-                None => {
-                    // (A name declared nowhere is unknown, as anywhere else.)
-                    match &n.kind {
-                        r::ExprKind::Name(name) if self.lookup(&name.key()).is_none() => {
-                            self.unknown_name(name);
-                        }
-                        _ => {
-                            self.error(Code::E0080, "an array's size must be a constant", n.span);
-                        }
-                    }
-                    Err(())
-                }
-            },
-            [first, ..] => {
-                self.unsupported(
-                    "an array of more than one dimension",
-                    first.span,
-                    "use a one-dimensional array",
+    /// The dimensions of a declaration (none for a scalar): constants of at least 1, with
+    /// at most 100000 elements in all.
+    fn dims(&mut self, d: &r::DataDecl) -> Result<Vec<u32>, ()> {
+        let mut out = Vec::new();
+        for n in &d.dims {
+            out.push(self.dim_size(n)?);
+        }
+        if out.iter().map(|&n| u64::from(n)).product::<u64>() > 100_000 {
+            self.error(
+                Code::E0025,
+                "an array holds at most 100000 elements in all",
+                d.name.span,
+            );
+            return Err(());
+        }
+        Ok(out)
+    }
+
+    /// One dimension's size.
+    fn dim_size(&mut self, n: &r::Expr) -> Result<u32, ()> {
+        match self.const_num(n) {
+            Some(x) if (1.0..=100_000.0).contains(&x) && x.fract() == 0.0 => Ok(x as u32),
+            Some(x) => {
+                self.error(
+                    Code::E0025,
+                    format!("an array's size must be a whole number from 1 to 100000, not {x}"),
+                    n.span,
                 );
+                Err(())
+            }
+            None => {
+                // (A name declared nowhere is unknown, as anywhere else.)
+                match &n.kind {
+                    r::ExprKind::Name(name) if self.lookup(&name.key()).is_none() => {
+                        self.unknown_name(name);
+                    }
+                    _ => {
+                        self.error(Code::E0080, "an array's size must be a constant", n.span);
+                    }
+                }
                 Err(())
             }
         }
@@ -540,7 +551,8 @@ impl Tr<'_> {
         let Some(ty) = self.type_of(&d.ty) else {
             return;
         };
-        let Ok(len) = self.dims(d) else { return };
+        let Ok(dims) = self.dims(d) else { return };
+        let len = (!dims.is_empty()).then(|| dims.iter().product::<u32>());
         let key = d.name.key();
         if matches!(self.declared(d.local, &key), Some(Sym::Routine(_))) {
             return; // Reported as a duplicate.
@@ -548,6 +560,7 @@ impl Tr<'_> {
         let mut data = Data {
             ty,
             len,
+            dims: dims.clone(),
             storage: d.storage,
             base: self.module_level_name(&d.name, d.local),
             span: d.name.span,
@@ -563,7 +576,7 @@ impl Tr<'_> {
             self.declare(d.local, key, Sym::Data(data));
             return;
         }
-        let inits = self.initial_values(d, ty, len);
+        let inits = self.initial_values(d, ty, &dims);
         if ty == Ty::Tasks {
             data.tasks = inits
                 .iter()
@@ -649,34 +662,53 @@ impl Tr<'_> {
     }
 
     /// The declaration's initial value(s), one per element, type-checked.
-    fn initial_values(&mut self, d: &r::DataDecl, ty: Ty, len: Option<u32>) -> Option<Vec<Val>> {
+    fn initial_values(&mut self, d: &r::DataDecl, ty: Ty, dims: &[u32]) -> Option<Vec<Val>> {
         let init = d.init.as_ref()?;
-        match len {
-            None => self.value(init, ty).map(|v| vec![v]),
-            Some(n) => {
-                let r::ExprKind::Aggregate(items) = &init.kind else {
-                    self.error(
-                        Code::E0020,
-                        format!("an array of {n} needs `[…]` with {n} values"),
-                        init.span,
-                    );
-                    return None;
-                };
-                if items.len() != n as usize {
-                    self.error(
-                        Code::E0013,
-                        format!(
-                            "`{}` has {n} elements but {} values are given",
-                            d.name.text,
-                            items.len()
-                        ),
-                        init.span,
-                    );
-                    return None;
-                }
-                items.iter().map(|e| self.value(e, ty)).collect()
-            }
+        if dims.is_empty() {
+            return self.value(init, ty).map(|v| vec![v]);
         }
+        let mut out = Vec::new();
+        self.array_values(&d.name.text, init, ty, dims, &mut out)?;
+        Some(out)
+    }
+
+    /// The values of an array aggregate of dimensions `dims`, row after row: `[…]` of
+    /// `dims[0]` values, each an aggregate of the next dimensions.
+    pub(crate) fn array_values(
+        &mut self,
+        name: &str,
+        e: &r::Expr,
+        ty: Ty,
+        dims: &[u32],
+        out: &mut Vec<Val>,
+    ) -> Option<()> {
+        let Some((&n, rest)) = dims.split_first() else {
+            out.push(self.value(e, ty)?);
+            return Some(());
+        };
+        let r::ExprKind::Aggregate(items) = &e.kind else {
+            self.error(
+                Code::E0020,
+                format!("an array of {n} needs `[…]` with {n} values"),
+                e.span,
+            );
+            return None;
+        };
+        if items.len() != n as usize {
+            self.error(
+                Code::E0013,
+                format!(
+                    "`{name}` has {n} elements here but {} values are given",
+                    items.len()
+                ),
+                e.span,
+            );
+            return None;
+        }
+        for item in items {
+            self.array_values(name, item, ty, rest, out)?;
+        }
+        Some(())
     }
 
     /// For an array `a` at module level: `a{}` (get element `i`) per leaf, generated.
@@ -797,6 +829,7 @@ impl Tr<'_> {
             let data = Data {
                 ty: *ty,
                 len: None,
+                dims: Vec::new(),
                 storage: Storage::Var,
                 base: self.fresh_local(&wsl_name(&p.name)),
                 span: p.name.span,
@@ -873,7 +906,8 @@ impl Tr<'_> {
         let Some(ty) = self.type_of(&d.ty) else {
             return;
         };
-        let Ok(len) = self.dims(d) else { return };
+        let Ok(dims) = self.dims(d) else { return };
+        let len = (!dims.is_empty()).then(|| dims.iter().product::<u32>());
         if self
             .locals
             .last()
@@ -889,6 +923,7 @@ impl Tr<'_> {
         let mut data = Data {
             ty,
             len,
+            dims: dims.clone(),
             storage: d.storage,
             base: self.fresh_local(&wsl_name(&d.name)),
             span: d.name.span,
@@ -906,7 +941,7 @@ impl Tr<'_> {
                 "declare PERS data at module level",
             );
         }
-        let inits = self.initial_values(d, ty, len);
+        let inits = self.initial_values(d, ty, &dims);
         if ty == Ty::Str && d.storage == Storage::Const && len.is_none() {
             data.text = inits
                 .as_ref()
@@ -945,6 +980,7 @@ fn predefined(key: &str) -> Option<Data> {
     let mut d = Data {
         ty: Ty::Num,
         len: None,
+        dims: Vec::new(),
         storage: Storage::Const,
         base: key.to_string(),
         span,

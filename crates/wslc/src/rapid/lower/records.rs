@@ -253,6 +253,7 @@ impl Tr<'_> {
         Some(Data {
             ty: t,
             len: None,
+            dims: Vec::new(),
             base,
             text: None,
             inline: None,

@@ -191,8 +191,8 @@ impl Tr<'_> {
         }
         let (n, idx) = match &e.kind {
             r::ExprKind::Name(n) => (n, None),
-            r::ExprKind::Index(x, idx) => match (&x.kind, idx.as_slice()) {
-                (r::ExprKind::Name(n), [i]) => (n, Some(i)),
+            r::ExprKind::Index(x, idx) => match &x.kind {
+                r::ExprKind::Name(n) => (n, Some(idx.as_slice())),
                 _ => {
                     self.unsupported(
                         "this assignment target",
@@ -252,21 +252,13 @@ impl Tr<'_> {
         }
         let index = match (idx, d.len) {
             (None, None) => None,
-            (Some(i), Some(len)) => match self.const_num(i) {
-                Some(k) if k.fract() == 0.0 && k >= 1.0 && k <= f64::from(len) => Some(k as u32),
-                Some(k) => {
-                    self.error(
-                        Code::E0025,
-                        format!("index {k} is outside `{}`'s elements 1 to {len}", n.text),
-                        i.span,
-                    );
-                    return None;
-                }
-                None => {
+            (Some(i), Some(_)) => match self.flat_index(n, &d, i)? {
+                super::arrays::Flat::Const(k) => Some(k),
+                super::arrays::Flat::Var(_) => {
                     self.unsupported(
-                        "assigning an array element at a variable index",
+                        "this instruction on an array element at a variable index",
                         e.span,
-                        "assign at a constant index, or keep the values in separate data",
+                        "assign the element (`a{i} := …;`), or use a constant index",
                     );
                     return None;
                 }
@@ -299,6 +291,9 @@ impl Tr<'_> {
             return self.assign_component(x, f, value, span).unwrap_or_default();
         }
         if let Some(stmts) = self.str_to_val(target, value, span) {
+            return stmts;
+        }
+        if let Some(stmts) = self.assign_array_place(target, value, span) {
             return stmts;
         }
         let Some((d, idx)) = self.place(target) else {
@@ -480,6 +475,7 @@ impl Tr<'_> {
             Data {
                 ty: Ty::Num,
                 len: None,
+                dims: Vec::new(),
                 storage: Storage::Var,
                 base: i.clone(),
                 span: var.span,
