@@ -640,11 +640,10 @@ impl Parser<'_, '_, Token> {
             self.expect_tok(Tok::Semi, "`;`")?;
             return Ok(StmtKind::TryNext);
         }
-        for (word, what) in [("goto", "GOTO")] {
-            if self.eat(word) {
-                self.skip_past_semi();
-                return Ok(StmtKind::Unsupported(what));
-            }
+        if self.eat("goto") {
+            let label = self.name("a label")?;
+            self.expect_tok(Tok::Semi, "`;`")?;
+            return Ok(StmtKind::Goto(label));
         }
         if self.at_tok(&Tok::Percent) {
             self.skip_past_semi();
@@ -665,9 +664,9 @@ impl Parser<'_, '_, Token> {
         }
         // A label `name:`.
         if self.tok().tok == Tok::Ident && self.peek(1).tok == Tok::Colon {
+            let label = self.name("a label")?;
             self.bump();
-            self.bump();
-            return Ok(StmtKind::Unsupported("a label (for GOTO)"));
+            return Ok(StmtKind::Label(label));
         }
         let name = self.name("a statement")?;
         if matches!(self.tok().tok, Tok::Assign | Tok::Dot | Tok::LBrace) {

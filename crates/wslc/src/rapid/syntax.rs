@@ -246,6 +246,10 @@ pub enum StmtKind {
     Raise(Option<Expr>),
     /// `RETRY;`
     Retry,
+    /// `GOTO label;`
+    Goto(Name),
+    /// `label:`
+    Label(Name),
     /// `TRYNEXT;`
     TryNext,
     /// A construct the front-end does not run (already parsed so the message names it):

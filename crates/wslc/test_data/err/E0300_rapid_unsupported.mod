@@ -2,9 +2,9 @@
 MODULE m
   PROC main()
     SearchL \Stop, diSensor, pFound, pEnd, v100, tool0;
-    GOTO done;
+    %"Routine" + "1"%;
     MoveL pEnd, v100 \Inpos:=inpos50, fine, tool0;
-  ERROR
-    RETRY;
+  BACKWARD
+    MoveL pEnd, v100, fine, tool0;
   ENDPROC
 ENDMODULE

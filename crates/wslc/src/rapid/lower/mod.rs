@@ -19,6 +19,7 @@ mod clocks;
 pub(crate) mod data;
 mod expr;
 mod functions;
+mod goto;
 mod io;
 mod records;
 mod stmt;
@@ -152,6 +153,11 @@ pub(crate) struct RoutineCx {
     pub(crate) has_handler: bool,
     /// Translating its error handler.
     pub(crate) in_handler: bool,
+    /// Its labels (lower case, in order) and the WSL variable of the one to go on from,
+    /// when it has `GOTO`s (see `goto.rs`).
+    pub(crate) labels: Option<(Vec<String>, String)>,
+    /// How many RAPID loops (`WHILE`, `FOR`) the statement being translated is in.
+    pub(crate) loops: u32,
 }
 
 /// A translated RAPID value: its type and its WSL leaves.
@@ -792,6 +798,8 @@ impl Tr<'_> {
             ret: sig.ret,
             has_handler: rt.handler.is_some(),
             in_handler: false,
+            labels: None,
+            loops: 0,
         });
         let mut params = Vec::new();
         let (mut required, mut optional) = (sig.params.iter(), sig.optional.iter());
@@ -863,7 +871,7 @@ impl Tr<'_> {
         for d in &rt.locals {
             self.local_data(d, &mut body);
         }
-        body.extend(self.stmts(&rt.body));
+        body.extend(self.routine_body(&rt.body));
         let handler = rt.handler.as_ref().map(|(at, stmts)| {
             if let Some(cx) = self.routine.as_mut() {
                 cx.in_handler = true;

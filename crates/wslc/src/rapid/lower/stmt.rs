@@ -67,7 +67,9 @@ impl Tr<'_> {
             }
             r::StmtKind::While { cond, body } => {
                 let cond = self.condition(cond);
+                self.in_loop(1);
                 let body = block(self.stmts(body), span);
+                self.in_loop(-1);
                 push(w::StmtKind::While { cond, body });
             }
             r::StmtKind::For {
@@ -77,7 +79,9 @@ impl Tr<'_> {
                 step,
                 body,
             } => {
+                self.in_loop(1);
                 let k = self.for_loop(var, from, to, step.as_ref(), body, span);
+                self.in_loop(-1);
                 push(k);
             }
             r::StmtKind::Test {
@@ -136,6 +140,14 @@ impl Tr<'_> {
                     }
                 }
             }
+            r::StmtKind::Goto(label) => {
+                if let Some(kind) = self.goto(label) {
+                    for k in kind {
+                        push(k);
+                    }
+                }
+            }
+            r::StmtKind::Label(label) => self.misplaced_label(label),
             r::StmtKind::Retry | r::StmtKind::TryNext => {
                 let retry = matches!(s.kind, r::StmtKind::Retry);
                 if self.routine.as_ref().is_some_and(|cx| cx.in_handler) {
@@ -707,6 +719,31 @@ impl Tr<'_> {
     /// `Incr x;`, `Decr x;`, `Add x, e;` on a num.
     pub(crate) fn step(&mut self, c: &Call<'_>, out: &mut Vec<w::Stmt>) {
         let (p, span) = (&c.pos, c.span);
+        // An element at an index known only when running: `a{i} := a{i} + 1;`.
+        if let r::ExprKind::Index(_, idx) = &p[0].kind
+            && !idx.iter().all(|e| self.const_num(e).is_some())
+        {
+            let by = match c.key {
+                "add" => p[1].clone(),
+                _ => r::Expr {
+                    kind: r::ExprKind::Num(1.0),
+                    span,
+                },
+            };
+            let op = if c.key == "decr" {
+                r::BinOp::Sub
+            } else {
+                r::BinOp::Add
+            };
+            let value = r::Expr {
+                kind: r::ExprKind::Binary(op, Box::new(p[0].clone()), Box::new(by)),
+                span,
+            };
+            for kind in self.assign(p[0], &value, span) {
+                out.push(w::Stmt { kind, span });
+            }
+            return;
+        }
         let Some((d, idx)) = self.place(p[0]) else {
             return;
         };
