@@ -1,0 +1,9 @@
+MODULE DUMMY
+
+    PROC type name ENDPROC
+
+    FUNC name( ENDPROC
+
+    FUNC name name name) ENDPROC
+
+ENDMODULE
