@@ -135,7 +135,10 @@ fn out_of_scope(d: &Diagnostic) -> bool {
 /// The tasks of a `tasks.tsv` (a header, then `id<TAB>paths` with paths relative to
 /// `root`, separated by spaces, `%20` for a space in one): each task's outcome, and each
 /// file's (from the errors in it).
-fn run_tasks(root: &Path) -> (Vec<(String, Outcome, Vec<String>)>, Vec<Outcome>) {
+/// A task's id, its outcome, and the first of its errors that are not out of scope.
+type TaskRow = (String, Outcome, Vec<String>);
+
+fn run_tasks(root: &Path) -> (Vec<TaskRow>, Vec<Outcome>) {
     let list = std::fs::read_to_string(root.join("tasks.tsv"))
         .unwrap_or_else(|e| panic!("{}: {e}", root.display()));
     let (mut tasks, mut files_out) = (Vec::new(), Vec::new());
