@@ -713,6 +713,14 @@ impl Tr<'_> {
         }
         match self.lookup(&key) {
             Some(Sym::Routine(sig)) if sig.kind == r::RoutineKind::Func => {
+                if sig.by_ref.iter().any(Option::is_some) {
+                    self.unsupported(
+                        &format!("calling `{}`, a FUNC with `VAR`/`PERS`/`INOUT` parameters, in an expression", f.text),
+                        f.span,
+                        "make it a PROC that writes its result to a VAR parameter",
+                    );
+                    return None;
+                }
                 let wargs = self.call_args(f, &sig, args, span)?;
                 let ret = sig.ret.unwrap_or(Ty::Num);
                 // (A FUNC of a type held in more than one WSL value, a speeddata or a
@@ -816,8 +824,11 @@ impl Tr<'_> {
             return None;
         }
         let mut out = Vec::new();
-        for (e, t) in pos.into_iter().zip(params) {
-            out.extend(self.value(e, *t)?.parts);
+        for ((e, t), by_ref) in pos.into_iter().zip(params).zip(&sig.by_ref) {
+            // (An argument by reference is copied in and out around the call.)
+            if by_ref.is_none() {
+                out.extend(self.value(e, *t)?.parts);
+            }
         }
         for o in &sig.optional {
             let leaves = self.leaves(o.ty);

@@ -22,6 +22,7 @@ mod functions;
 mod goto;
 mod io;
 mod records;
+mod refs;
 mod stmt;
 mod strings;
 pub(crate) mod table;
@@ -121,6 +122,9 @@ pub(crate) struct Sig {
     pub(crate) kind: r::RoutineKind,
     /// The required parameters' types, in order.
     pub(crate) params: Vec<Ty>,
+    /// For each required parameter passed by reference (`VAR`, `PERS`, `INOUT`), the
+    /// WSL name its module variable starts with (`pick'p`); `None` for one by value.
+    pub(crate) by_ref: Vec<Option<String>>,
     /// The optional parameters (`\num x`, `\switch On`), in order: each is its leaves
     /// (none for a switch) and a flag of whether the caller gave it.
     pub(crate) optional: Vec<OptParam>,
@@ -381,7 +385,9 @@ impl Tr<'_> {
 
     fn signature(&mut self, rt: &r::Routine) -> Sig {
         let mut params = Vec::new();
+        let mut by_ref = Vec::new();
         let mut optional = Vec::new();
+        let wsl = self.module_level_name(&rt.name, rt.local);
         for p in &rt.params {
             let ty = self.type_of(&p.ty).unwrap_or(Ty::Num);
             if p.optional {
@@ -392,15 +398,18 @@ impl Tr<'_> {
                 });
             } else {
                 params.push(ty);
+                by_ref
+                    .push((p.mode == r::Mode::Ref).then(|| format!("{wsl}'{}", wsl_name(&p.name))));
             }
         }
         let ret = rt.ret.as_ref().map(|t| self.type_of(t).unwrap_or(Ty::Num));
         Sig {
             kind: rt.kind,
             params,
+            by_ref,
             optional,
             ret,
-            wsl: self.module_level_name(&rt.name, rt.local),
+            wsl,
             span: rt.name.span,
         }
     }
@@ -803,6 +812,7 @@ impl Tr<'_> {
         });
         let mut params = Vec::new();
         let (mut required, mut optional) = (sig.params.iter(), sig.optional.iter());
+        let mut params_seen = 0;
         for p in &rt.params {
             let ty = if p.optional {
                 optional.next().map(|o| &o.ty)
@@ -810,14 +820,24 @@ impl Tr<'_> {
                 required.next()
             };
             let Some(ty) = ty else { continue };
-            if p.mode == r::Mode::Ref {
+            // By reference: a module variable the caller copies its argument into and
+            // back out of (see `refs.rs`).
+            let shadow = if p.optional {
+                None
+            } else {
+                sig.by_ref.get(params_seen).cloned().flatten()
+            };
+            if !p.optional {
+                params_seen += 1;
+            }
+            if p.mode == r::Mode::Ref && p.optional {
                 self.unsupported(
                     &format!(
-                        "the `VAR`/`PERS`/`INOUT` parameter `{}` (by reference)",
+                        "the optional `VAR`/`PERS`/`INOUT` parameter `{}` (by reference)",
                         p.name.text
                     ),
                     p.span,
-                    "pass the value and return the result from a FUNC, or use a module variable",
+                    "make it required, or pass the value",
                 );
             }
             if p.array {
@@ -833,6 +853,10 @@ impl Tr<'_> {
                     p.span,
                     "pass numbers, bools, positions, joint targets, speeds, zones, tools or work objects",
                 );
+            }
+            if let Some(base) = shadow {
+                self.shadow_param(p, *ty, base);
+                continue;
             }
             let data = Data {
                 ty: *ty,

@@ -595,11 +595,15 @@ impl Tr<'_> {
         let mut push = |kind| out.push(w::Stmt { kind, span });
         match self.lookup(&key) {
             Some(Sym::Routine(sig)) if sig.kind == r::RoutineKind::Proc => {
-                if let Some(wargs) = self.call_args(name, &sig, args, span) {
+                if let Some(wargs) = self.call_args(name, &sig, args, span)
+                    && let Some((copy_in, copy_out)) = self.ref_copies(&sig, args)
+                {
+                    copy_in.into_iter().for_each(&mut push);
                     push(w::StmtKind::Call {
                         name: b::ident(&sig.wsl, name.span),
                         args: wargs,
                     });
+                    copy_out.into_iter().for_each(&mut push);
                 }
             }
             Some(Sym::Routine(sig)) if sig.kind == r::RoutineKind::Func => {
