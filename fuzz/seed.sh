@@ -10,7 +10,7 @@ for c in compile rapid load_bytecode workcell run urdf log; do mkdir -p "fuzz/co
 cp crates/wslc/test_data/ok/*.wsl crates/wslc/test_data/err/*.wsl crates/wslc/test_data/spec/*.wsl fuzz/corpus/compile/
 # RAPID: the fixtures, the example workcells' modules and the vendored corpus.
 cp crates/wslc/test_data/ok/*.mod crates/wslc/test_data/err/*.mod workcells/*/*.mod fuzz/corpus/rapid/
-find tests/rapid/corpus -type f \( -iname '*.mod' -o -iname '*.sys' -o -iname '*.prg' -o -iname '*.modx' \) -exec cp {} fuzz/corpus/rapid/ \; 2>/dev/null || true
+find tests/rapid/corpus tests/rapid/public -type f \( -iname '*.mod' -o -iname '*.sys' -o -iname '*.prg' -o -iname '*.modx' \) -exec cp {} fuzz/corpus/rapid/ \; 2>/dev/null || true
 cargo build -q -p vworks-cli
 for f in crates/wslc/test_data/ok/*.wsl; do
   ./target/debug/vworks build "$f" -o "fuzz/corpus/load_bytecode/$(basename "$f" .wsl).wslb" 2>/dev/null

@@ -238,7 +238,8 @@ impl Thread {
                 if again { "RETRY" } else { "TRYNEXT" }
             ));
         };
-        let Some((start, end)) = h.statement_at(f.failed_at - p.code_start) else {
+        let at = f.failed_at.checked_sub(p.code_start);
+        let Some((start, end)) = at.and_then(|at| h.statement_at(at)) else {
             return Err(
                 "the statement that failed is not in the procedure's table (a corrupt module)"
                     .into(),

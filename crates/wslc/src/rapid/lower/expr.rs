@@ -410,12 +410,11 @@ impl Tr<'_> {
             (Ty::Tool, "tframe") => Some(Val::one(Ty::Pose, v.leaf())),
             (Ty::Wobj, "uframe") => Some(Val::one(Ty::Pose, v.parts[0].clone())),
             (Ty::Wobj, "oframe") => Some(Val::one(Ty::Pose, v.parts[1].clone())),
-            (Ty::Jointtarget, "robax") => Some(v),
+            (Ty::Jointtarget, "robax") => Some(Val::one(Ty::Robjoint, v.leaf())),
             _ => {
-                // `jt.robax.rax_3`
-                if let (Ty::Jointtarget, Some(n)) = (v.ty, key.strip_prefix("rax_"))
+                // `r.rax_3`, `jt.robax.rax_3`
+                if let (Ty::Robjoint, Some(n)) = (v.ty, key.strip_prefix("rax_"))
                     && let Ok(k @ 1..=6) = n.parse::<i64>()
-                    && matches!(&x.kind, r::ExprKind::Field(_, g) if g.key() == "robax")
                 {
                     let j = b::expr(
                         w::ExprKind::Index(
@@ -455,6 +454,7 @@ impl Tr<'_> {
             Ty::Pose => 2,
             Ty::Robtarget => 4,
             Ty::Jointtarget => 2,
+            Ty::Robjoint => 6,
             Ty::Speed => 4,
             Ty::Zone => 7,
             Ty::Tool => 3,
@@ -540,14 +540,19 @@ impl Tr<'_> {
                 }
                 Some(Val::one(want, merge_pose(t, o, span)))
             }
-            Ty::Jointtarget => {
-                let r::ExprKind::Aggregate(ax) = &items[0].kind else {
-                    self.error(
-                        Code::E0020,
-                        "robax is written `[a1, a2, a3, a4, a5, a6]` (degrees)",
-                        items[0].span,
-                    );
-                    return None;
+            Ty::Jointtarget | Ty::Robjoint => {
+                let ax = if want == Ty::Robjoint {
+                    items
+                } else {
+                    let r::ExprKind::Aggregate(ax) = &items[0].kind else {
+                        self.error(
+                            Code::E0020,
+                            "robax is written `[a1, a2, a3, a4, a5, a6]` (degrees)",
+                            items[0].span,
+                        );
+                        return None;
+                    };
+                    ax
                 };
                 if ax.len() != 6 {
                     self.error(
@@ -557,7 +562,9 @@ impl Tr<'_> {
                     );
                     return None;
                 }
-                self.value(&items[1], Ty::Extax)?;
+                if want == Ty::Jointtarget {
+                    self.value(&items[1], Ty::Extax)?;
+                }
                 let mut vals = Vec::new();
                 for e in ax {
                     vals.push(self.value(e, Ty::Num)?.leaf());
@@ -570,7 +577,7 @@ impl Tr<'_> {
                     .into_iter()
                     .map(|e| b::with_unit(e, Dim::ANGLE))
                     .collect();
-                Some(Val::one(Ty::Jointtarget, b::call("joints", vals, span)))
+                Some(Val::one(want, b::call("joints", vals, span)))
             }
             Ty::Speed => {
                 let v = nums(self, 0, 4)?;

@@ -396,7 +396,10 @@ impl Tr<'_> {
             (Ty::Tool, ["tframe"]) => set(leaf(0), self.value(value, Ty::Pose)?.leaf()),
             (Ty::Wobj, ["uframe"]) => set(leaf(0), self.value(value, Ty::Pose)?.leaf()),
             (Ty::Wobj, ["oframe"]) => set(leaf(1), self.value(value, Ty::Pose)?.leaf()),
-            (Ty::Jointtarget, ["robax", rax]) if rax.starts_with("rax_") => {
+            (Ty::Jointtarget, ["robax"]) => set(leaf(0), self.value(value, Ty::Robjoint)?.leaf()),
+            (Ty::Jointtarget, ["robax", rax]) | (Ty::Robjoint, [rax])
+                if rax.starts_with("rax_") =>
+            {
                 let Ok(k @ 1..=6) = rax[4..].parse::<i64>() else {
                     self.unsupported(
                         &format!("the component `{}`", f.text),
@@ -705,6 +708,13 @@ impl Tr<'_> {
                 parts.push(b::expr(w::ExprKind::Str(" ".into()), span));
             }
             self.text_parts(e, &mut parts);
+        }
+        // The reason's further lines, `\RL2:=…` to `\RL4:=…`.
+        for (k, _, v) in &c.opts {
+            if let (true, Some(e)) = (k.starts_with("rl"), v) {
+                parts.push(b::expr(w::ExprKind::Str(" ".into()), span));
+                self.text_parts(e, &mut parts);
+            }
         }
         out.push(w::Stmt {
             kind: w::StmtKind::Log(parts),

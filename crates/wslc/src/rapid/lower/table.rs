@@ -142,7 +142,7 @@ pub(crate) const INSTRUCTIONS: &[Row<InstrLowering>] = &[
     row(
         "ErrWrite",
         2..=6,
-        &["W", "I"],
+        &["W", "I", "RL2", "RL3", "RL4"],
         I(|t, c, out| t.err_write(c, out)),
         "log \"ErrWrite: header reason …\"",
     ),
