@@ -26,8 +26,12 @@ pub struct Frame {
     /// While its error handler runs: the instruction that failed (absolute), else
     /// `u32::MAX`.
     pub failed_at: u32,
-    /// The `Retry`s of the error being handled.
+    /// The `Retry`s of the statement last retried (`retried`), counted until another
+    /// statement fails.
     pub retries: u8,
+    /// The statement (its first instruction, relative) the handler last retried, else
+    /// `u32::MAX`.
+    pub retried: u32,
 }
 
 impl Frame {
@@ -39,6 +43,7 @@ impl Frame {
             stack_base,
             failed_at: u32::MAX,
             retries: 0,
+            retried: u32::MAX,
         }
     }
 }
@@ -127,6 +132,7 @@ impl Thread {
         self.locals.resize(p.frame_slots as usize, 0);
         self.frames.push(Frame::new(proc, u32::MAX, 0, 0));
         self.pc = p.code_start;
+        self.errno = 0;
     }
 
     /// Reserves room for the deepest stack and frames a run may need.
@@ -214,8 +220,16 @@ impl Thread {
                 }
                 self.frames.truncate(k + 1);
                 self.stack.truncate(f.stack_base as usize);
+                // A failure of another statement than the one retried counts anew.
+                let stmt = failed
+                    .checked_sub(p.code_start)
+                    .and_then(|at| h.statement_at(at))
+                    .map_or(u32::MAX, |(start, _)| start);
                 if let Some(fr) = self.frames.last_mut() {
                     fr.failed_at = failed;
+                    if stmt != fr.retried {
+                        fr.retries = 0;
+                    }
                 }
                 self.pc = p.code_start + h.pc;
                 return true;
@@ -256,6 +270,7 @@ impl Thread {
         if let Some(fr) = self.frames.last_mut() {
             fr.failed_at = u32::MAX;
             fr.retries = retries;
+            fr.retried = if again { start } else { u32::MAX };
         }
         self.pc = p.code_start + if again { start } else { end };
         Ok(())
@@ -468,7 +483,14 @@ impl Thread {
                 | Instr::NumToText
                 | Instr::ValText(_)
                 | Instr::TextIsNum
-                | Instr::TextNum => self.text(ins, m, texts).map_err(|e| err(pc, e))?,
+                | Instr::TextNum => {
+                    if let Err((errno, e)) = self.text(ins, m, texts) {
+                        return Err(RuntimeError {
+                            errno,
+                            ..err(pc, e)
+                        });
+                    }
+                }
                 Instr::Raise(msg) => {
                     let n = self.pop() as i64;
                     let text = m.strings.get(msg as usize).map_or("", String::as_str);
@@ -681,10 +703,24 @@ impl Thread {
 
 impl Thread {
     /// A text instruction ([`crate::texts`]): pops its operands, pushes its result.
-    fn text(&mut self, ins: Instr, m: &Module, texts: &mut Texts) -> Result<(), String> {
-        fn text_of<'a>(t: &'a Texts, m: &'a Module, h: u64) -> Result<&'a str, String> {
-            t.get(m, h)
-                .ok_or_else(|| format!("a text handle no text has ({h}): a corrupt module"))
+    /// An error a handler may take carries RAPID's number (ERR_STRTOOLNG, ERR_OUTOFBND).
+    fn text(
+        &mut self,
+        ins: Instr,
+        m: &Module,
+        texts: &mut Texts,
+    ) -> Result<(), (Option<i64>, String)> {
+        fn text_of<'a>(
+            t: &'a Texts,
+            m: &'a Module,
+            h: u64,
+        ) -> Result<&'a str, (Option<i64>, String)> {
+            t.get(m, h).ok_or_else(|| {
+                (
+                    None,
+                    format!("a text handle no text has ({h}): a corrupt module"),
+                )
+            })
         }
         let v = match ins {
             Instr::TextCat => {
@@ -737,7 +773,9 @@ impl Thread {
                 u64::from(texts::parse_num(text_of(texts, m, self.pop())?).is_some())
             }
             Instr::TextNum => b(texts::parse_num(text_of(texts, m, self.pop())?).unwrap_or(0.0)),
-            _ => return Err(format!("`{}` is not a text instruction", ins.name())),
+            _ => {
+                return Err((None, format!("`{}` is not a text instruction", ins.name())));
+            }
         };
         self.stack.push(v);
         Ok(())

@@ -11,6 +11,7 @@
 //! The functions below are the text instructions' meaning, kept out of the dispatch loop.
 
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 use crate::bytecode::Module;
 
@@ -18,15 +19,25 @@ use crate::bytecode::Module;
 /// ERR_STRTOOLNG on the controller).
 pub const MAX_CHARS: usize = 80;
 
-/// The most texts one run may make: a loop that makes a new text every round would
-/// otherwise grow without bound.
-pub const MAX_MADE: usize = 1 << 20;
+/// The most texts one run may make (each kept once, shared by the list and the index: a
+/// few MiB at most): a loop that makes a new text every round would otherwise grow
+/// without bound.
+pub const MAX_MADE: usize = 1 << 16;
+
+/// RAPID's error numbers (vworks's own; the RAPID front-end names them) of the text
+/// errors a handler may take: a text too long, a position outside one.
+pub const ERR_STRTOOLNG: i64 = 1005;
+/// See [`ERR_STRTOOLNG`].
+pub const ERR_OUTOFBND: i64 = 1006;
+
+/// A text instruction's error: RAPID's number if a handler may take it, and the message.
+pub type TextError = (Option<i64>, String);
 
 /// The texts a robot's run made, and their handles.
 #[derive(Clone, Debug, Default)]
 pub struct Texts {
-    made: Vec<String>,
-    index: BTreeMap<String, u64>,
+    made: Vec<Arc<str>>,
+    index: BTreeMap<Arc<str>, u64>,
 }
 
 impl Texts {
@@ -35,32 +46,44 @@ impl Texts {
         let n = m.strings.len() as u64;
         match h {
             0 => Some(""),
-            h if h <= n => m.strings.get(h as usize - 1).map(String::as_str),
-            h => self.made.get((h - n - 1) as usize).map(String::as_str),
+            // (A module's string longer than any text is no text: a forged handle.)
+            h if h <= n => m
+                .strings
+                .get(h as usize - 1)
+                .map(String::as_str)
+                .filter(|s| s.len() <= 4 * MAX_CHARS),
+            h => self.made.get((h - n - 1) as usize).map(|s| &**s),
         }
     }
 
     /// The handle of `s`, made if it is new: an error if it is longer than
     /// [`MAX_CHARS`] characters or the run has made [`MAX_MADE`] texts.
-    pub fn make(&mut self, m: &Module, s: String) -> Result<u64, String> {
+    pub fn make(&mut self, m: &Module, s: String) -> Result<u64, TextError> {
         if s.is_empty() {
             return Ok(0);
         }
         let chars = s.chars().count();
         if chars > MAX_CHARS {
-            return Err(format!(
-                "a text of {chars} characters (ERR_STRTOOLNG): a string holds at most {MAX_CHARS}"
+            return Err((
+                Some(ERR_STRTOOLNG),
+                format!(
+                    "a text of {chars} characters (ERR_STRTOOLNG): a string holds at most {MAX_CHARS}"
+                ),
             ));
         }
-        if let Some(&h) = self.index.get(&s) {
+        if let Some(&h) = self.index.get(s.as_str()) {
             return Ok(h);
         }
         if self.made.len() >= MAX_MADE {
-            return Err(format!(
-                "the run made more than {MAX_MADE} different texts; build fewer distinct texts in the loop"
+            return Err((
+                None,
+                format!(
+                    "the run made more than {MAX_MADE} different texts; build fewer distinct texts in the loop"
+                ),
             ));
         }
         let h = m.strings.len() as u64 + 1 + self.made.len() as u64;
+        let s: Arc<str> = s.into();
         self.made.push(s.clone());
         self.index.insert(s, h);
         Ok(h)
@@ -68,36 +91,40 @@ impl Texts {
 }
 
 /// A 1-based character position from a num, or an error naming `what`.
-fn position(x: f64, what: &str) -> Result<usize, String> {
+fn position(x: f64, what: &str) -> Result<usize, TextError> {
     if x.fract() != 0.0 || !(1.0..=1e9).contains(&x) {
-        return Err(format!(
+        return Err(out_of_bounds(format!(
             "{what} must be a whole number from 1 (ERR_OUTOFBND), not {x}"
-        ));
+        )));
     }
     Ok(x as usize)
 }
 
+fn out_of_bounds(message: String) -> TextError {
+    (Some(ERR_OUTOFBND), message)
+}
+
 /// `StrPart(s, start, len)`: `len` characters from position `start`.
-pub fn part(s: &str, start: f64, len: f64) -> Result<String, String> {
+pub fn part(s: &str, start: f64, len: f64) -> Result<String, TextError> {
     let start = position(start, "the start of StrPart")?;
     if len.fract() != 0.0 || !(0.0..=1e9).contains(&len) {
-        return Err(format!(
+        return Err(out_of_bounds(format!(
             "the length of StrPart must be a whole number from 0 (ERR_OUTOFBND), not {len}"
-        ));
+        )));
     }
     let n = s.chars().count();
     let len = len as usize;
     if start + len > n + 1 {
-        return Err(format!(
+        return Err(out_of_bounds(format!(
             "StrPart from character {start} for {len} runs past the text's {n} characters (ERR_OUTOFBND)"
-        ));
+        )));
     }
     Ok(s.chars().skip(start - 1).take(len).collect())
 }
 
 /// `StrFind(s, start, set [\NotInSet])`: the position of the first character from `start`
 /// on that is in `set` (not in it, with `not_in`), or the length + 1 if none is.
-pub fn find(s: &str, start: f64, set: &str, not_in: bool) -> Result<f64, String> {
+pub fn find(s: &str, start: f64, set: &str, not_in: bool) -> Result<f64, TextError> {
     let start = start_in(s, start, "StrFind")?;
     let n = s.chars().count();
     let at = s
@@ -111,7 +138,7 @@ pub fn find(s: &str, start: f64, set: &str, not_in: bool) -> Result<f64, String>
 
 /// `StrMatch(s, start, pattern)`: the position of `pattern` from `start` on, or the
 /// length + 1 if it is not there.
-pub fn find_text(s: &str, start: f64, pattern: &str) -> Result<f64, String> {
+pub fn find_text(s: &str, start: f64, pattern: &str) -> Result<f64, TextError> {
     let start = start_in(s, start, "StrMatch")?;
     let chars: Vec<char> = s.chars().collect();
     let pat: Vec<char> = pattern.chars().collect();
@@ -123,14 +150,14 @@ pub fn find_text(s: &str, start: f64, pattern: &str) -> Result<f64, String> {
 }
 
 /// `StrMemb(s, pos, set)`: whether the character at `pos` is in `set`.
-pub fn member(s: &str, pos: f64, set: &str) -> Result<bool, String> {
+pub fn member(s: &str, pos: f64, set: &str) -> Result<bool, TextError> {
     let pos = position(pos, "the position of StrMemb")?;
     let n = s.chars().count();
     match s.chars().nth(pos - 1) {
         Some(c) => Ok(set.contains(c)),
-        None => Err(format!(
+        None => Err(out_of_bounds(format!(
             "StrMemb at character {pos} of a text of {n} (ERR_OUTOFBND)"
-        )),
+        ))),
     }
 }
 
@@ -148,27 +175,28 @@ pub fn map(s: &str, from: &str, to: &str) -> String {
 }
 
 /// The start of a search: from 1 to the length + 1 (an empty rest finds nothing).
-fn start_in(s: &str, start: f64, what: &str) -> Result<usize, String> {
+fn start_in(s: &str, start: f64, what: &str) -> Result<usize, TextError> {
     let k = position(start, &format!("the start of {what}"))?;
     let n = s.chars().count();
     if k > n + 1 {
-        return Err(format!(
+        return Err(out_of_bounds(format!(
             "{what} from character {k} of a text of {n} (ERR_OUTOFBND)"
-        ));
+        )));
     }
     Ok(k)
 }
 
 /// `NumToStr(x, dec)`: `x` rounded to `dec` decimals (a whole number, 0 to 15), half away
 /// from zero, without a sign on a value that rounds to zero.
-pub fn num_to_str(x: f64, dec: f64) -> Result<String, String> {
+pub fn num_to_str(x: f64, dec: f64) -> Result<String, TextError> {
     if dec.fract() != 0.0 || !(0.0..=15.0).contains(&dec) {
-        return Err(format!(
-            "NumToStr's decimals must be a whole number from 0 to 15, not {dec}"
+        return Err((
+            None,
+            format!("NumToStr's decimals must be a whole number from 0 to 15, not {dec}"),
         ));
     }
     if !x.is_finite() {
-        return Err(format!("NumToStr of {x}"));
+        return Err((None, format!("NumToStr of {x}")));
     }
     // Half away from zero on the decimals kept (2.25 to one decimal is 2.3).
     let k = 10f64.powi(dec as i32);

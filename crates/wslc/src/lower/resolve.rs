@@ -373,6 +373,23 @@ impl Compiler<'_> {
             );
         }
         if let Some(h) = &p.handler {
+            // A function's body ends in `return`; a TRYNEXT past its last statement comes
+            // here, before the handler, and ends the run.
+            if p.is_func {
+                let end = Span::new(
+                    p.body.span.end.saturating_sub(1) as usize,
+                    p.body.span.end as usize,
+                );
+                let text = Expr {
+                    kind: ExprKind::Str(format!(
+                        "function `{}` ended without a value (its error handler went on after its last statement)",
+                        p.name.name
+                    )),
+                    span: end,
+                };
+                let f = self.log_format(&[text]);
+                self.emit(Instr::Fail(f), end);
+            }
             // The error handler: after the body; reaching its end returns from the
             // procedure (a function's error goes on to its caller).
             let stmts = self.f().stmts.take().unwrap_or_default();

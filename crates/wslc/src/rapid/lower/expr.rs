@@ -40,7 +40,21 @@ impl Tr<'_> {
         match &e.kind {
             r::ExprKind::Num(x) => Some(Val::one(Ty::Num, b::num(*x, span))),
             r::ExprKind::Bool(v) => Some(Val::one(Ty::Bool, b::expr(w::ExprKind::Bool(*v), span))),
-            r::ExprKind::Str(s) => Some(Val::text(s.clone(), span)),
+            r::ExprKind::Str(s) => {
+                let n = s.chars().count();
+                if n > vworks_vm::texts::MAX_CHARS {
+                    self.error(
+                        Code::E0025,
+                        format!(
+                            "a string of {n} characters: RAPID's strings hold at most {}",
+                            vworks_vm::texts::MAX_CHARS
+                        ),
+                        span,
+                    );
+                    return None;
+                }
+                Some(Val::text(s.clone(), span))
+            }
             r::ExprKind::Name(n) => self.name_value(n),
             r::ExprKind::Aggregate(_) => {
                 self.error(

@@ -3,7 +3,9 @@
 //! after, so the routine's writes reach the caller's data when it returns. **Choice:** a
 //! routine that calls itself shares the variable, and a write the routine makes to the
 //! argument's own data directly is overwritten by the copy back (RAPID passes the data
-//! itself); neither is common in cell programs.
+//! itself); and when the routine fails and a caller's error handler takes the error, the
+//! copy back is skipped (a RETRY copies in again), so the routine's writes before the
+//! error are lost where RAPID would keep them. None of these is common in cell programs.
 
 use super::data::{Ty, build as b};
 use super::{Data, Sig, Tr};

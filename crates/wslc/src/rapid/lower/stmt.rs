@@ -123,6 +123,14 @@ impl Tr<'_> {
             r::StmtKind::Raise(errno) => {
                 let in_handler = self.routine.as_ref().is_some_and(|cx| cx.in_handler);
                 match errno {
+                    Some(e) if in_handler => {
+                        self.error(
+                            Code::E0304,
+                            "`RAISE` with an error number inside an error handler",
+                            e.span,
+                        )
+                        .help = Some("write `RAISE;`: it raises the handler's error again in the calling routine".into());
+                    }
                     Some(e) => {
                         if let Some(v) = self.value(e, Ty::Num) {
                             let n = b::call("int", vec![v.leaf()], e.span);
