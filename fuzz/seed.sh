@@ -16,7 +16,7 @@ for f in crates/wslc/test_data/ok/*.wsl; do
   ./target/debug/vworks build "$f" -o "fuzz/corpus/load_bytecode/$(basename "$f" .wsl).wslb" 2>/dev/null
 done
 # Cells: the `.case` files as they are; each example workcell as one bundle.
-for f in tests/errors/cell-*.case tests/runs/*.case; do
+for f in tests/errors/cell-*.case tests/runs/*.case tests/rapid/*.case; do
   cp "$f" "fuzz/corpus/workcell/$(basename "$f")"
   cp "$f" "fuzz/corpus/run/$(basename "$f")"
 done
