@@ -416,6 +416,9 @@ impl Tr<'_> {
                 ))
             }
             (Ty::Pos, "x" | "y" | "z") => num_of(b::field(v.leaf(), &key), Dim::LENGTH),
+            (Ty::Orient, "q1" | "q2" | "q3" | "q4") => {
+                Some(Val::one(Ty::Num, quaternion_part(v.leaf(), &key, span)))
+            }
             (Ty::Speed, "v_tcp") => num_of(v.parts[0].clone(), Dim::SPEED),
             (Ty::Speed, "v_ori") => num_of(v.parts[1].clone(), Dim::ANGSPEED),
             (Ty::Zone, "pzone_tcp") => num_of(v.parts[0].clone(), Dim::LENGTH),
@@ -442,7 +445,7 @@ impl Tr<'_> {
                 self.unsupported(
                     &format!("the component `{}` of {}", f.text, article(v.ty)),
                     f.span,
-                    "docs/rapid.md lists the components vworks reads: trans, rot, x, y, z, robax.rax_1…6, v_tcp, v_ori, pzone_tcp, pzone_ori, zone_ori, tframe, uframe, oframe",
+                    "docs/rapid.md lists the components vworks reads: trans, rot, x, y, z, q1…q4, robax.rax_1…6, v_tcp, v_ori, pzone_tcp, pzone_ori, zone_ori, tframe, uframe, oframe",
                 );
                 None
             }
@@ -1087,4 +1090,30 @@ pub(crate) fn article(t: Ty) -> String {
     } else {
         format!("a {n}")
     }
+}
+
+/// Component `q` (`q1` the scalar part, `q2`…`q4` the vector) of the quaternion of an
+/// orientation held as roll-pitch-yaw (`rx`, `ry`, `rz` of pose `p`; R = Rz·Ry·Rx): the
+/// sign is the conversion's (q and −q are one orientation).
+fn quaternion_part(p: w::Expr, q: &str, span: Span) -> w::Expr {
+    let half = |axis: &str| b::bin(w::BinOp::Div, b::field(p.clone(), axis), b::num(2.0, span));
+    let (c, s) = (
+        |axis: &str| b::call("cos", vec![half(axis)], span),
+        |axis: &str| b::call("sin", vec![half(axis)], span),
+    );
+    let prod = |a: w::Expr, bb: w::Expr, cc: w::Expr| {
+        b::bin(w::BinOp::Mul, b::bin(w::BinOp::Mul, a, bb), cc)
+    };
+    let (cr, sr, cp, sp, cy, sy) = (c("rx"), s("rx"), c("ry"), s("ry"), c("rz"), s("rz"));
+    let (first, op, second) = match q {
+        "q1" => (
+            prod(cr, cp.clone(), cy.clone()),
+            w::BinOp::Add,
+            prod(sr, sp, sy),
+        ),
+        "q2" => (prod(sr, cp, cy), w::BinOp::Sub, prod(cr, sp, sy)),
+        "q3" => (prod(cr, sp, cy), w::BinOp::Add, prod(sr, cp, sy)),
+        _ => (prod(cr, cp, sy), w::BinOp::Sub, prod(sr, sp, cy)),
+    };
+    b::bin(op, first, second)
 }
