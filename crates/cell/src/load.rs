@@ -126,8 +126,9 @@ pub(crate) fn load_parsed(
     let mut sources = vec![(file.clone(), text.to_string())];
     let mut files: Vec<(String, Vec<u8>)> = Vec::new();
     let mut robots = Vec::new();
-    // Each task name (lower case) and the robot that runs it.
-    let mut tasks: BTreeMap<String, usize> = BTreeMap::new();
+    // Each task name (lower case), the robot that runs it and the name as written (not an
+    // index into `robots`: a robot whose program has errors is never pushed there).
+    let mut tasks: BTreeMap<String, (String, String)> = BTreeMap::new();
     let mut modules: Vec<(ProgramKey, Arc<Module>)> = Vec::new();
     let mut diagnostics = Vec::new();
     let mut warnings = Vec::new();
@@ -225,17 +226,15 @@ pub(crate) fn load_parsed(
                 t.clone()
             }
         };
-        if let Some(&other) = tasks.get(&task.to_ascii_lowercase()) {
-            let other: &(Robot, String, bool) = &robots[other];
+        if let Some((robot, written)) = tasks.get(&task.to_ascii_lowercase()) {
             return Err(cx.bad(
                 &format!("{key}.task"),
                 format!(
-                    "robot `{}` already runs the task `{}`: give each robot a task name of its own",
-                    other.0.name, other.0.task
+                    "robot `{robot}` already runs the task `{written}`: give each robot a task name of its own"
                 ),
             ));
         }
-        tasks.insert(task.to_ascii_lowercase(), i);
+        tasks.insert(task.to_ascii_lowercase(), (r.name.clone(), task.clone()));
         let Some(program) = &r.program else {
             return Err(cx.bad(
                 &format!("{key}.program"),
