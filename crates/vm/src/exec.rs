@@ -308,7 +308,7 @@ impl Thread {
             }
             *budget -= 1;
             self.pc = pc + 1;
-            let base = self.frame().base as usize;
+            let base = self.frames.last().map_or(0, |f| f.base) as usize;
             match ins {
                 Instr::Nop => {}
                 Instr::PushBool(v) => self.stack.push(u64::from(v)),

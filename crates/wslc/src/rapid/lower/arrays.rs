@@ -177,29 +177,13 @@ impl Tr<'_> {
                 .iter()
                 .zip(&temps)
                 .map(|(leaf, t)| w::Stmt {
-                    kind: w::StmtKind::Assign {
-                        target: b::name(leaf, span),
-                        op: None,
-                        value: b::name(t, span),
-                    },
+                    kind: b::assign(b::name(leaf, span), b::name(t, span)),
                     span,
                 })
                 .collect();
             branches.push((cond, block(sets, span)));
         }
-        let fail = w::Stmt {
-            kind: w::StmtKind::Fail(vec![
-                b::expr(
-                    w::ExprKind::Str(format!(
-                        "index out of bounds (ERR_INDEX): `{}` has elements 1 to {len}, the index is ",
-                        d.base
-                    )),
-                    span,
-                ),
-                b::name(&i, span),
-            ]),
-            span,
-        };
+        let fail = index_fail(&d.base, len, b::name(&i, span), span);
         stmts.push(w::Stmt {
             kind: w::StmtKind::If {
                 branches,
@@ -259,11 +243,7 @@ impl Tr<'_> {
         let mut out = Vec::new();
         for (k, parts) in (1..=len).zip(values) {
             for (leaf, p) in self.leaf_names(d, Some(k)).iter().zip(parts) {
-                out.push(w::StmtKind::Assign {
-                    target: b::name(leaf, span),
-                    op: None,
-                    value: p,
-                });
+                out.push(b::assign(b::name(leaf, span), p));
             }
         }
         out
@@ -298,5 +278,21 @@ impl Tr<'_> {
                 Some(Flat::Const(_)) => None,
             },
         }
+    }
+}
+
+/// The statement that stops the run at an index past array `base`'s `len` elements.
+pub(crate) fn index_fail(base: &str, len: u32, index: w::Expr, span: Span) -> w::Stmt {
+    w::Stmt {
+        kind: w::StmtKind::Fail(vec![
+            b::expr(
+                w::ExprKind::Str(format!(
+                    "index out of bounds (ERR_INDEX): `{base}` has elements 1 to {len}, the index is "
+                )),
+                span,
+            ),
+            index,
+        ]),
+        span,
     }
 }

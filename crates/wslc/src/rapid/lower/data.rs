@@ -346,6 +346,15 @@ pub(crate) mod build {
         call("pose", parts.into(), span)
     }
 
+    /// `target = value;` (no compound operator).
+    pub(crate) fn assign(target: w::Expr, value: w::Expr) -> w::StmtKind {
+        w::StmtKind::Assign {
+            target,
+            op: None,
+            value,
+        }
+    }
+
     /// The zero value of a WSL type: 0 in its unit, FALSE, the empty text, the identity
     /// pose, all-zero joints.
     pub(crate) fn zero(t: Type, span: Span) -> w::Expr {

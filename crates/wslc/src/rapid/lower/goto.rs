@@ -133,11 +133,10 @@ impl Tr<'_> {
         };
         let span = label.span;
         Some(vec![
-            w::StmtKind::Assign {
-                target: b::name(&var, span),
-                op: None,
-                value: b::expr(w::ExprKind::Int(k as i64 + 1), span),
-            },
+            b::assign(
+                b::name(&var, span),
+                b::expr(w::ExprKind::Int(k as i64 + 1), span),
+            ),
             w::StmtKind::Continue,
         ])
     }

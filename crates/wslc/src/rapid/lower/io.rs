@@ -485,11 +485,7 @@ impl Tr<'_> {
                     els: None,
                 }));
             }
-            out.push(stmt(w::StmtKind::Assign {
-                target: held(),
-                op: None,
-                value: int(0),
-            }));
+            out.push(stmt(b::assign(held(), int(0))));
             return;
         }
         let k = self
@@ -498,11 +494,7 @@ impl Tr<'_> {
             .position(|x| *x == n.key())
             .unwrap_or(0);
         out.push(stmt(w::StmtKind::Grip(b::ident(&n.key(), n.span))));
-        out.push(stmt(w::StmtKind::Assign {
-            target: held(),
-            op: None,
-            value: int(k as i64 + 1),
-        }));
+        out.push(stmt(b::assign(held(), int(k as i64 + 1))));
     }
 
     /// `signal == int(value)` for the wait or interrupt instruction `key`, whose last two
@@ -637,11 +629,7 @@ impl Tr<'_> {
 /// `g = v;`
 fn assign(g: &str, v: w::Expr, span: Span) -> w::Stmt {
     w::Stmt {
-        kind: w::StmtKind::Assign {
-            target: b::name(g, span),
-            op: None,
-            value: v,
-        },
+        kind: b::assign(b::name(g, span), v),
         span,
     }
 }

@@ -747,19 +747,7 @@ impl Tr<'_> {
                 };
                 branches.push((cond, block(vec![ret], span)));
             }
-            let fail = w::Stmt {
-                kind: w::StmtKind::Fail(vec![
-                    b::expr(
-                        w::ExprKind::Str(format!(
-                            "index out of bounds (ERR_INDEX): `{}` has elements 1 to {n}, the index is ",
-                            d.base
-                        )),
-                        span,
-                    ),
-                    i.clone(),
-                ]),
-                span,
-            };
+            let fail = arrays::index_fail(&d.base, n, i.clone(), span);
             let body = vec![
                 w::Stmt {
                     kind: w::StmtKind::If {

@@ -91,16 +91,8 @@ impl Tr<'_> {
             let theirs = self.leaf_names(&d, idx);
             let ours = self.leaf_names(&shadow, None);
             for (t, o) in theirs.iter().zip(&ours) {
-                copy_in.push(w::StmtKind::Assign {
-                    target: b::name(o, e.span),
-                    op: None,
-                    value: b::name(t, e.span),
-                });
-                copy_out.push(w::StmtKind::Assign {
-                    target: b::name(t, e.span),
-                    op: None,
-                    value: b::name(o, e.span),
-                });
+                copy_in.push(b::assign(b::name(o, e.span), b::name(t, e.span)));
+                copy_out.push(b::assign(b::name(t, e.span), b::name(o, e.span)));
             }
         }
         Some((copy_in, copy_out))

@@ -295,14 +295,6 @@ impl Tr<'_> {
         Some((d, index))
     }
 
-    fn assign_kind(target: w::Expr, value: w::Expr) -> w::StmtKind {
-        w::StmtKind::Assign {
-            target,
-            op: None,
-            value,
-        }
-    }
-
     /// `target := value;` as WSL assignments (one per leaf).
     fn assign(&mut self, target: &r::Expr, value: &r::Expr, span: Span) -> Vec<w::StmtKind> {
         if let r::ExprKind::Field(x, f) = &target.kind
@@ -325,7 +317,7 @@ impl Tr<'_> {
         self.leaf_names(&d, idx)
             .iter()
             .zip(v.parts)
-            .map(|(n, p)| Self::assign_kind(b::name(n, target.span), p))
+            .map(|(n, p)| b::assign(b::name(n, target.span), p))
             .collect()
     }
 
@@ -350,7 +342,7 @@ impl Tr<'_> {
         let num = |t: &mut Self, dim: Dim| -> Option<w::Expr> {
             Some(b::with_unit(t.value(value, Ty::Num)?.leaf(), dim))
         };
-        let set = |target: w::Expr, v: w::Expr| vec![Self::assign_kind(target, v)];
+        let set = |target: w::Expr, v: w::Expr| vec![b::assign(target, v)];
         Some(match (d.ty, path.as_slice()) {
             (Ty::Robtarget | Ty::Pose, ["trans", c @ ("x" | "y" | "z")])
             | (Ty::Pos, [c @ ("x" | "y" | "z")]) => {
@@ -994,7 +986,7 @@ impl Tr<'_> {
         let timed_out = || b::call("timed_out", vec![], span);
         match flag {
             Some((d, idx)) if d.ty == Ty::Bool => out.push(w::Stmt {
-                kind: Self::assign_kind(b::name(&self.leaf_names(&d, idx)[0], span), timed_out()),
+                kind: b::assign(b::name(&self.leaf_names(&d, idx)[0], span), timed_out()),
                 span,
             }),
             Some((d, _)) => {

@@ -166,11 +166,7 @@ impl Tr<'_> {
         let s = self.value(text, Ty::Str)?.leaf();
         let ok_name = b::name(&self.leaf_names(&ok, ok_idx)[0], target.span);
         let x_name = b::name(&self.leaf_names(&d, idx)[0], x.span);
-        let set = |t: w::Expr, v: w::Expr| w::StmtKind::Assign {
-            target: t,
-            op: None,
-            value: v,
-        };
+        let set = |t: w::Expr, v: w::Expr| b::assign(t, v);
         Some(vec![
             set(ok_name.clone(), b::call("strisnum'", vec![s.clone()], span)),
             w::StmtKind::If {
